@@ -1,0 +1,48 @@
+#include "apps/hil/cli_common.hpp"
+
+#include <fstream>
+#include <iterator>
+
+namespace hil::apps {
+
+void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary) {
+  cmd.add_option("frames", input.frames,
+                 binary ? "Frame bytes as hex, e.g. 2A 2B 2C 2D 01 70 70 (spaces optional)"
+                        : "Frames as text (use --hex to give them as hex)");
+  cmd.add_option("-f,--file", input.file, "Decode a raw byte stream read from a file ('-' for stdin)");
+  if (!binary) cmd.add_flag("--hex", input.hex, "Command-line frames are hex bytes, not text");
+  cmd.add_flag("!--no-raw", input.show_raw, "Do not print the raw bytes of decoded frames");
+}
+
+protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {
+  protocol::Bytes bytes;
+  if (!input.file.empty()) {
+    if (input.file == "-") {
+      bytes.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    } else {
+      std::ifstream in(input.file, std::ios::binary);
+      if (!in) throw CLI::ValidationError("--file", "cannot open '" + input.file + "'");
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+  }
+  for (std::size_t i = 0; i < input.frames.size(); ++i) {
+    const std::string& arg = input.frames[i];
+    if (binary || input.hex) {
+      const auto parsed = protocol::parse_hex(arg);
+      if (!parsed) {
+        throw CLI::ValidationError("frames", "argument " + std::to_string(i + 1) + " '" + arg +
+                                                 "' is not hex bytes (pairs of 0-9 A-F)");
+      }
+      bytes.insert(bytes.end(), parsed->begin(), parsed->end());
+    } else {
+      bytes.insert(bytes.end(), arg.begin(), arg.end());
+    }
+  }
+  return bytes;
+}
+
+std::string render_bytes(protocol::ByteView bytes, bool binary) {
+  return binary ? protocol::to_hex(bytes) : protocol::escape(bytes);
+}
+
+}  // namespace hil::apps

@@ -1,0 +1,80 @@
+#pragma once
+// Pieces every `hil encode` / `hil decode` protocol command shares.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <iostream>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "protocol/common/bytes.hpp"
+#include "protocol/common/decode.hpp"
+
+namespace hil::apps {
+
+/// Where `hil decode <protocol>` takes its bytes from.
+struct DecodeInput {
+  std::vector<std::string> frames;  ///< frames on the command line (joined, in order)
+  std::string file;                 ///< a raw byte stream from a file, "-" for stdin
+  bool hex = false;                 ///< command-line frames are hex (always so for binary protocols)
+  bool show_raw = true;             ///< print each frame's raw bytes too
+};
+
+/// Adds the positional frames and --file/--hex/--no-raw options.
+void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary);
+
+/// The bytes to decode. Throws CLI::ValidationError with a precise message
+/// when the input is unreadable or bad hex.
+protocol::Bytes read_decode_input(const DecodeInput& input, bool binary);
+
+/// How a protocol renders bytes for a person: text protocols as escaped
+/// text, binary ones as spaced uppercase hex.
+std::string render_bytes(protocol::ByteView bytes, bool binary);
+
+/// Prints one line per decoded item; returns the exit status: 0 when every
+/// item is a frame, 1 when any error was found, 2 when there was nothing.
+template <class Message, class Decoder>
+int print_items(Decoder decoder, protocol::ByteView bytes, bool binary, const DecodeInput& input,
+                const std::function<std::string(const Message&)>& describe, std::ostream& out = std::cout) {
+  std::vector<protocol::DecodeItem<Message>> items;
+  decoder.feed(bytes, items);
+  decoder.finish(items);
+  int status = items.empty() ? 2 : 0;
+  std::size_t offset = 0;
+  for (const auto& item : items) {
+    if (const auto* f = std::get_if<protocol::Frame<Message>>(&item)) {
+      out << "frame @" << offset << "  " << describe(f->message);
+      if (f->tolerated) out << "  (tolerated: " << protocol::to_string(*f->tolerated) << ')';
+      if (input.show_raw) out << "\n    raw: " << render_bytes(f->raw, binary);
+      out << '\n';
+      offset += f->raw.size();
+    } else {
+      const auto& e = std::get<protocol::DecodeError>(item);
+      out << "error @" << offset << "  " << protocol::to_string(e.kind) << ": " << e.detail;
+      if (!e.context.empty()) out << "  [" << e.context << ']';
+      out << "\n    raw: " << render_bytes(e.raw, binary) << '\n';
+      offset += e.raw.size();
+      status = 1;
+    }
+  }
+  if (items.empty()) out << "no bytes to decode\n";
+  return status;
+}
+
+/// Registers `hil encode <name>` and `hil decode <name>` for one protocol.
+/// `run` is set to the action the parsed command line selects; it returns the
+/// exit status.
+struct CommandSet {
+  CLI::App& encode;
+  CLI::App& decode;
+  std::function<int()>& run;
+};
+
+void register_logi(CommandSet& commands);
+void register_wr8(CommandSet& commands);
+void register_arduino(CommandSet& commands);
+void register_leka(CommandSet& commands);
+
+}  // namespace hil::apps

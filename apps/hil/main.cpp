@@ -1,0 +1,37 @@
+// hil: hardware-in-the-loop harness and mock cars for robot-car clients.
+// This file only wires the subcommands together.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <iostream>
+
+#include "apps/hil/cli_common.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"hil: test harness and mock cars for robot-car client software"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hil 0.1.0");
+  app.footer(
+      "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, binary).\n"
+      "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for each protocol's forms.");
+
+  auto* encode = app.add_subcommand("encode", "Print the frame for a message (binary frames as hex)");
+  encode->require_subcommand(1);
+  auto* decode = app.add_subcommand("decode", "Decode frames or a byte stream and print every frame and error");
+  decode->require_subcommand(1);
+
+  std::function<int()> run;
+  hil::apps::CommandSet commands{*encode, *decode, run};
+  hil::apps::register_logi(commands);
+  hil::apps::register_wr8(commands);
+  hil::apps::register_arduino(commands);
+  hil::apps::register_leka(commands);
+
+  try {
+    app.parse(argc, argv);
+    return run ? run() : 0;
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+}

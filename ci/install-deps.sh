@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of hil from Debian 12 packages.
+# Safe to run again: apt-get skips what is already installed.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  clang libclang-rt-14-dev   # libFuzzer targets and the fuzz smoke run
+  libasio-dev                # standalone Asio (header-only)
+  libgtest-dev libgmock-dev  # GoogleTest / GoogleMock
+  librapidcheck-dev          # property-based tests
+  libbox2d-dev               # Box2D 2.4
+  libcli11-dev               # command-line parsing
+  libbenchmark-dev           # Google Benchmark
+)
+
+if [ "$(id -u)" -ne 0 ]; then
+  sudo=sudo
+else
+  sudo=
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,25 @@
+#pragma once
+// Small strict parsers for the decimal and hex fields of the text protocols.
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace hil::protocol {
+
+/// Decimal integer with an optional leading '-' (and '+' when allow_plus),
+/// at most `max_digits` digits, nothing else. Returns nullopt otherwise.
+std::optional<long long> parse_decimal(std::string_view text, bool allow_sign, bool allow_plus = false,
+                                       std::size_t max_digits = 9);
+
+/// Exactly two hex digits; sets `lowercase` when any digit is a lowercase letter.
+std::optional<std::uint8_t> parse_hex_byte(std::string_view text, bool* lowercase = nullptr);
+
+/// Splits at every occurrence of `sep` (empty pieces kept).
+std::vector<std::string_view> split(std::string_view text, char sep);
+
+/// Printable ASCII (0x20..0x7E) only.
+bool is_printable_ascii(std::string_view text);
+
+}  // namespace hil::protocol

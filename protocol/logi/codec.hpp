@@ -1,0 +1,80 @@
+#pragma once
+// LOGI frames: LOGI:<payload>:<CS>#, encode and incremental decode.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "protocol/common/bytes.hpp"
+#include "protocol/common/decode.hpp"
+#include "protocol/common/delimited_framer.hpp"
+#include "protocol/logi/message.hpp"
+
+namespace hil::protocol::logi {
+
+inline constexpr std::string_view kHeader = "LOGI:";
+inline constexpr std::uint8_t kTail = '#';
+/// A full STAT frame is about 110 bytes; 256 leaves room for fields a newer
+/// firmware may add, and is the most a decoder ever holds.
+inline constexpr std::size_t kDefaultMaxFrameBytes = 256;
+
+/// Low 8 bits of the byte sum of `base` ("LOGI:" + payload).
+std::uint8_t checksum(std::string_view base);
+
+/// The payload text of a message, e.g. "SP:050". Throws std::invalid_argument
+/// for a message whose values the protocol cannot carry (a programming error).
+std::string payload_of(const Message& m);
+
+/// Wraps any payload text into a frame: "LOGI:" + payload + ":" + CS + "#".
+/// Used for messages and for deliberately odd payloads (fault injection, QA).
+std::string frame_text(std::string_view payload);
+
+/// A complete frame for the message, e.g. "LOGI:SP:050:D7#".
+std::string encode_text(const Message& m);
+Bytes encode(const Message& m);
+
+struct PayloadError {
+  ErrorKind kind;       ///< bad_format, bad_value or unknown_code
+  std::string detail;
+  std::string context;  ///< the command code ("SP", "STAT", ...) when recognised
+};
+
+/// Parses payload text (no header, checksum or tail) into a message.
+std::variant<Message, PayloadError> parse_payload(std::string_view payload);
+
+struct DecoderOptions {
+  std::size_t max_frame_bytes = kDefaultMaxFrameBytes;
+  /// The profile requires uppercase checksum hex. When false, a lowercase
+  /// checksum is an ErrorKind::lowercase_checksum error; when true the frame
+  /// is delivered with `tolerated = lowercase_checksum`.
+  bool accept_lowercase_checksum = false;
+};
+
+using Item = DecodeItem<Message>;
+
+/// Checks and parses one complete candidate frame (header through tail).
+Item decode_frame(ByteView raw, const DecoderOptions& options = {});
+
+/// Incremental stream decoder: any chunking of the stream yields the same
+/// items in the same order. Never throws on input; holds at most
+/// `max_frame_bytes` bytes.
+class Decoder {
+ public:
+  explicit Decoder(DecoderOptions options = {});
+
+  void feed(ByteView bytes, std::vector<Item>& out);
+  /// End of stream: a partial frame comes out as ErrorKind::truncated.
+  void finish(std::vector<Item>& out);
+  std::size_t buffered() const { return framer_.buffered(); }
+
+ private:
+  void convert(std::vector<Item>& out);
+
+  DecoderOptions options_;
+  DelimitedFramer framer_;
+  std::vector<DelimitedFramer::Event> events_;
+};
+
+}  // namespace hil::protocol::logi

@@ -1,0 +1,99 @@
+// Every complete frame the LOGI specification lists (its button-to-command
+// table) is a test vector: encode must produce it byte for byte, and decode
+// must give the message back.
+
+#include <gtest/gtest.h>
+
+#include "protocol/logi/codec.hpp"
+
+namespace hil::protocol::logi {
+namespace {
+
+struct Vector {
+  const char* frame;
+  Message message;
+};
+
+const Vector kSpecFrames[] = {
+    {"LOGI:MD:MAN:0C#", SetMode{Mode::manual}},
+    {"LOGI:MD:AUTO:69#", SetMode{Mode::automatic}},
+    {"LOGI:SP:030:D5#", SetSpeed{30}},
+    {"LOGI:SP:050:D7#", SetSpeed{50}},
+    {"LOGI:SP:080:DA#", SetSpeed{80}},
+    {"LOGI:GS:001:CA#", SetStation{1}},
+    {"LOGI:GS:002:CB#", SetStation{2}},
+    {"LOGI:ST:RUN:3B#", SetRun{true}},
+    {"LOGI:ST:STOP:8C#", SetRun{false}},
+    {"LOGI:MV:FWD:23#", Move{Direction::fwd}},
+    {"LOGI:MV:BWD:1F#", Move{Direction::bwd}},
+    {"LOGI:MV:LEFT:6D#", Move{Direction::left}},
+    {"LOGI:MV:RIGHT:C0#", Move{Direction::right}},
+    {"LOGI:MV:LF:D4#", Move{Direction::lf}},
+    {"LOGI:MV:RF:DA#", Move{Direction::rf}},
+    {"LOGI:MV:LB:D0#", Move{Direction::lb}},
+    {"LOGI:MV:RB:D6#", Move{Direction::rb}},
+    {"LOGI:MV:CW:DC#", Move{Direction::cw}},
+    {"LOGI:MV:CCW:1F#", Move{Direction::ccw}},
+    {"LOGI:MV:STOP:88#", Move{Direction::stop}},
+};
+
+TEST(LogiVectors, ThereAreTwentySpecFrames) { EXPECT_EQ(std::size(kSpecFrames), 20u); }
+
+TEST(LogiVectors, EncodeReproducesEverySpecFrame) {
+  for (const auto& v : kSpecFrames) EXPECT_EQ(encode_text(v.message), v.frame) << describe(v.message);
+}
+
+TEST(LogiVectors, DecodeGivesBackEverySpecMessage) {
+  for (const auto& v : kSpecFrames) {
+    const auto item = decode_frame(to_bytes(v.frame));
+    const auto* frame = std::get_if<Frame<Message>>(&item);
+    ASSERT_NE(frame, nullptr) << v.frame << ": " << std::get<DecodeError>(item).detail;
+    EXPECT_EQ(frame->message, v.message) << v.frame;
+    EXPECT_EQ(to_string(frame->raw), v.frame);
+    EXPECT_FALSE(frame->tolerated);
+  }
+}
+
+TEST(LogiVectors, ChecksumIsLowByteOfAsciiSum) {
+  // 'L'+'O'+'G'+'I'+':'+'S'+'P'+':'+'0'+'5'+'0' = 0x2D7
+  EXPECT_EQ(checksum("LOGI:SP:050"), 0xD7);
+  EXPECT_EQ(checksum(""), 0x00);
+}
+
+TEST(LogiVectors, StatusRoundTripsWithEveryField) {
+  Status s;
+  s.speed_percent = 50;
+  s.station = 2;
+  s.running = true;
+  s.mode = Mode::automatic;
+  s.manual = Direction::stop;
+  s.distance_cm = 123;
+  s.track_mask = 0b0110;
+  s.deviation = -3;
+  s.obstacle = false;
+  s.rpm = {120, 121, -119, 0};
+  const std::string text = encode_text(s);
+  EXPECT_EQ(text.substr(0, text.size() - 4),
+            "LOGI:STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,"
+            "RPM:120:121:-119:0");
+  const auto item = decode_frame(to_bytes(text));
+  ASSERT_TRUE(std::holds_alternative<Frame<Message>>(item));
+  EXPECT_EQ(std::get<Frame<Message>>(item).message, Message{s});
+}
+
+TEST(LogiVectors, FeedbackFrames) {
+  EXPECT_EQ(payload_of(Feedback{Command::sp, true}), "FB:SP:1");
+  EXPECT_EQ(payload_of(Feedback{Command::gs, false}), "FB:GS:0");
+  EXPECT_EQ(payload_of(Feedback{Command::mv, false}), "FB:MV:0");
+}
+
+TEST(LogiVectors, EncodeRefusesValuesTheProtocolCannotCarry) {
+  EXPECT_THROW(encode(SetSpeed{101}), std::invalid_argument);
+  EXPECT_THROW(encode(SetStation{1000}), std::invalid_argument);
+  Status s;
+  s.extra = {{"BAT", "7,4"}};
+  EXPECT_THROW(encode(s), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hil::protocol::logi
