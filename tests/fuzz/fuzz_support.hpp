@@ -1,0 +1,65 @@
+#pragma once
+// Shared by the decoder fuzz targets: split the fuzzer's input into a
+// chunking plan and a byte stream, and check the decoder contract.
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <span>
+#include <variant>
+#include <vector>
+
+#include "protocol/common/decode.hpp"
+
+namespace hil::fuzz {
+
+/// Aborts (which the fuzzer reports as a crash) when a contract is broken.
+inline void check(bool ok, const char* what) {
+  if (!ok) {
+    std::fprintf(stderr, "decoder contract broken: %s\n", what);
+    std::abort();
+  }
+}
+
+/// Feeds `stream` in pieces whose sizes come from `plan` (cycled), checks
+/// that the decoder never holds more than `bound` bytes and that every input
+/// byte comes out in exactly one item, in order. Returns the items.
+template <class Decoder, class Message>
+std::vector<protocol::DecodeItem<Message>> feed_and_check(Decoder& decoder, std::span<const std::uint8_t> plan,
+                                                          std::span<const std::uint8_t> stream, std::size_t bound) {
+  std::vector<protocol::DecodeItem<Message>> items;
+  std::size_t pos = 0;
+  std::size_t i = 0;
+  while (pos < stream.size()) {
+    std::size_t n = plan.empty() ? stream.size() : std::size_t{plan[i++ % plan.size()]} + 1;
+    if (n > stream.size() - pos) n = stream.size() - pos;
+    decoder.feed(stream.subspan(pos, n), items);
+    pos += n;
+    check(decoder.buffered() <= bound, "buffer exceeds its bound");
+  }
+  decoder.finish(items);
+  check(decoder.buffered() == 0, "finish() left bytes behind");
+  std::vector<std::uint8_t> joined;
+  for (const auto& item : items) {
+    const auto& raw = std::holds_alternative<protocol::DecodeError>(item)
+                          ? std::get<protocol::DecodeError>(item).raw
+                          : std::get<protocol::Frame<Message>>(item).raw;
+    joined.insert(joined.end(), raw.begin(), raw.end());
+  }
+  check(joined.size() == stream.size() && std::equal(joined.begin(), joined.end(), stream.begin()),
+        "item bytes differ from the input stream");
+  return items;
+}
+
+/// The first input byte gives the length of the chunking plan.
+struct Split {
+  std::span<const std::uint8_t> plan;
+  std::span<const std::uint8_t> stream;
+};
+inline Split split_input(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return {};
+  const std::size_t plan_len = std::min<std::size_t>(data[0] % 16, size - 1);
+  return Split{{data + 1, plan_len}, {data + 1 + plan_len, size - 1 - plan_len}};
+}
+
+}  // namespace hil::fuzz
