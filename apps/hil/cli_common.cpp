@@ -10,8 +10,14 @@ void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary) {
                  binary ? "Frame bytes as hex, e.g. 2A 2B 2C 2D 01 70 70 (spaces optional)"
                         : "Frames as text (use --hex to give them as hex)");
   cmd.add_option("-f,--file", input.file, "Decode a raw byte stream read from a file ('-' for stdin)");
-  if (!binary) cmd.add_flag("--hex", input.hex, "Command-line frames are hex bytes, not text");
+  cmd.add_flag("--hex", input.hex,
+               binary ? "The --file holds hex text (e.g. a pasted capture), not raw bytes"
+                      : "The frames (and --file) are hex text, not raw bytes");
   cmd.add_flag("!--no-raw", input.show_raw, "Do not print the raw bytes of decoded frames");
+  cmd.add_flag("--summary", input.summary, "End with the number of frames and of errors by kind");
+  cmd.footer(
+      "Prints one line per frame or error with its byte offset; errors show the raw bytes.\n"
+      "Exit status: 0 all frames valid, 1 some error found, 2 bad arguments or no input.");
 }
 
 protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {
@@ -23,6 +29,11 @@ protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {
       std::ifstream in(input.file, std::ios::binary);
       if (!in) throw CLI::ValidationError("--file", "cannot open '" + input.file + "'");
       bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    if (input.hex) {
+      const auto parsed = protocol::parse_hex(protocol::to_string(bytes));
+      if (!parsed) throw CLI::ValidationError("--file", "'" + input.file + "' is not hex text (pairs of 0-9 A-F)");
+      bytes = *parsed;
     }
   }
   for (std::size_t i = 0; i < input.frames.size(); ++i) {

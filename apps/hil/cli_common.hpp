@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <map>
 #include <iostream>
 #include <string>
 #include <variant>
@@ -18,8 +19,9 @@ namespace hil::apps {
 struct DecodeInput {
   std::vector<std::string> frames;  ///< frames on the command line (joined, in order)
   std::string file;                 ///< a raw byte stream from a file, "-" for stdin
-  bool hex = false;                 ///< command-line frames are hex (always so for binary protocols)
+  bool hex = false;                 ///< the file / command-line frames are hex text, not raw bytes
   bool show_raw = true;             ///< print each frame's raw bytes too
+  bool summary = false;             ///< end with a count of frames and errors by kind
 };
 
 /// Adds the positional frames and --file/--hex/--no-raw options.
@@ -60,6 +62,21 @@ int print_items(Decoder decoder, protocol::ByteView bytes, bool binary, const De
     }
   }
   if (items.empty()) out << "no bytes to decode\n";
+  if (input.summary) {
+    std::map<std::string_view, std::size_t> errors;
+    std::size_t frames = 0;
+    for (const auto& item : items) {
+      if (const auto* e = std::get_if<protocol::DecodeError>(&item)) {
+        ++errors[protocol::to_string(e->kind)];
+      } else {
+        ++frames;
+      }
+    }
+    out << "summary: " << offset << " bytes, " << frames << " frame(s), " << (items.size() - frames)
+        << " error(s)";
+    for (const auto& [kind, n] : errors) out << ", " << n << ' ' << kind;
+    out << '\n';
+  }
   return status;
 }
 

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hil 0.1.0");
   app.footer(
       "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, binary).\n"
-      "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for each protocol's forms.");
+      "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for each protocol's forms.\n");
 
   auto* encode = app.add_subcommand("encode", "Print the frame for a message (binary frames as hex)");
   encode->require_subcommand(1);
@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     return run ? run() : 0;
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; any usage error exits 2 after saying what was wrong.
+    return app.exit(e) == 0 ? 0 : 2;
   }
 }

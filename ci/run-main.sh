@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Sets up this machine (Debian 12), builds hil, and runs its main job.
+# Today the main job decodes the recorded wire captures in scenarios/captures/
+# with the protocol calculator, printing every frame and every error; it
+# grows into the scenario suite as the harness does.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash ci/install-deps.sh
+cmake --preset default >/dev/null
+cmake --build --preset default --target hil
+
+hil=build/apps/hil/hil
+status=0
+for capture in scenarios/captures/*; do
+  name=$(basename "$capture")
+  protocol=${name%%-*}
+  args=(decode "$protocol" --file "$capture" --no-raw --summary)
+  case "$name" in *.hex) args+=(--hex) ;; esac
+  echo "== $name ($protocol)"
+  rc=0
+  "$hil" "${args[@]}" || rc=$?
+  # 1 means the capture holds bad frames, which these captures are meant to show.
+  if [ "$rc" -gt 1 ]; then
+    echo "hil exited with $rc on $capture"
+    status=1
+  fi
+done
+exit "$status"

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Sets up this machine (Debian 12) and runs every test hil has:
+#   1. the default RelWithDebInfo build and its CTest suite,
+#   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer,
+#   3. a short smoke run of every libFuzzer target (ci/fuzz-smoke.sh).
+# Set HIL_SKIP_ASAN=1 or HIL_SKIP_FUZZ=1 to leave a stage out locally.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash ci/install-deps.sh
+
+echo "== default build and tests"
+cmake --preset default
+cmake --build --preset default
+ctest --preset default
+
+if [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
+  echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
+  cmake --preset asan
+  cmake --build --preset asan
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --preset asan
+fi
+
+if [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
+  echo "== fuzz smoke run"
+  bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}"
+fi

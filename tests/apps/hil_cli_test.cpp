@@ -1,0 +1,97 @@
+// The protocol calculator as QA uses it: examples from the README and the
+// protocol documents, and the errors a mistyped command gets.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace hil::test {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(HilCli, EncodesLogiFromPayload) {
+  const auto r = run_hil("encode logi SP:050");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.output, "LOGI:SP:050:D7#\n");
+}
+
+TEST(HilCli, EncodesLogiStatus) {
+  const auto r = run_hil(
+      "encode logi STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,RPM:1:2:3:4");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("LOGI:STAT:SP:050,STA:002"));
+}
+
+TEST(HilCli, RefusesAnInvalidLogiPayloadAndSaysWhy) {
+  const auto r = run_hil("encode logi SP:101");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("speed percent 000..100"));
+  EXPECT_THAT(r.output, HasSubstr("--raw"));
+}
+
+TEST(HilCli, RawFramesAnyLogiPayload) {
+  const auto r = run_hil("encode logi --raw SP:5");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.output, "LOGI:SP:5:77#\n");
+}
+
+TEST(HilCli, DecodesLogiFramesAndReportsErrors) {
+  const auto ok = run_hil("decode logi 'LOGI:SP:050:D7#'");
+  EXPECT_EQ(ok.exit_code, 0);
+  EXPECT_THAT(ok.output, HasSubstr("SetSpeed percent=50"));
+
+  const auto bad = run_hil("decode logi 'LOGI:SP:050:D8#'");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output, HasSubstr("bad_checksum: checksum D8, computed D7"));
+  EXPECT_THAT(bad.output, HasSubstr("raw: LOGI:SP:050:D8#"));
+}
+
+TEST(HilCli, LenientLogiDecodeToleratesLowercaseChecksum) {
+  const auto strict = run_hil("decode logi 'LOGI:SP:050:d7#'");
+  EXPECT_EQ(strict.exit_code, 1);
+  EXPECT_THAT(strict.output, HasSubstr("lowercase_checksum"));
+  const auto lenient = run_hil("decode logi --lenient 'LOGI:SP:050:d7#'");
+  EXPECT_EQ(lenient.exit_code, 0);
+  EXPECT_THAT(lenient.output, HasSubstr("tolerated: lowercase_checksum"));
+}
+
+TEST(HilCli, DecodesAStreamFromAFileWithSummary) {
+  const auto r = run_hil(std::string("decode logi --no-raw --summary --file ") + HIL_SOURCE_DIR +
+                         "/scenarios/captures/logi-session.txt");
+  EXPECT_EQ(r.exit_code, 1);  // the capture holds deliberate errors
+  EXPECT_THAT(r.output, HasSubstr("summary: 739 bytes, 13 frame(s), 4 error(s)"));
+}
+
+TEST(HilCli, DecodesHexInput) {
+  const auto r = run_hil("decode logi --hex '4C 4F 47 49 3A 53 50 3A 30 35 30 3A 44 37 23'");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("SetSpeed percent=50"));
+}
+
+TEST(HilCli, BadArgumentsExitTwoWithAMessage) {
+  const auto missing = run_hil("encode logi");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.output, HasSubstr("payload is required"));
+
+  const auto no_file = run_hil("decode logi --file /nonexistent/capture");
+  EXPECT_EQ(no_file.exit_code, 2);
+  EXPECT_THAT(no_file.output, HasSubstr("cannot open '/nonexistent/capture'"));
+
+  const auto bad_hex = run_hil("decode logi --hex 'GG'");
+  EXPECT_EQ(bad_hex.exit_code, 2);
+  EXPECT_THAT(bad_hex.output, HasSubstr("is not hex bytes"));
+
+  const auto unknown = run_hil("encode nosuchcar X");
+  EXPECT_EQ(unknown.exit_code, 2);
+}
+
+TEST(HilCli, HelpListsEveryProtocol) {
+  const auto r = run_hil("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* p : {"logi", "wr8", "arduino", "leka"}) EXPECT_THAT(r.output, HasSubstr(p));
+}
+
+}  // namespace
+}  // namespace hil::test
