@@ -9,20 +9,32 @@ cd "$(dirname "$0")/.."
 
 bash ci/install-deps.sh
 
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+# Number of tests CTest ran, from its closing line ("... out of N").
+ran() { sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$log" | tail -1; }
+passed=0
+
 echo "== default build and tests"
 cmake --preset default
 cmake --build --preset default
-ctest --preset default
+ctest --preset default | tee "$log"
+passed=$((passed + $(ran)))
 
 if [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
   echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
   cmake --preset asan
   cmake --build --preset asan
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --preset asan
+    ctest --preset asan | tee "$log"
+  passed=$((passed + $(ran)))
 fi
 
 if [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
   echo "== fuzz smoke run"
-  bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}"
+  bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}" | tee "$log"
+  passed=$((passed + $(sed -n 's/^fuzz smoke: \([0-9]*\) target.*/\1/p' "$log")))
 fi
+
+# Reached only when every stage passed (set -e, pipefail).
+echo "hil: $passed passed, 0 failed"
