@@ -1,0 +1,259 @@
+#include "protocol/leka/message.hpp"
+
+#include <cstdio>
+
+#include "protocol/common/overloaded.hpp"
+
+namespace hil::protocol::leka {
+
+const std::array<CommandSpec, 15> kCommandSpecs = {{
+    {CommandId::info, "info", 0, ""},
+    {CommandId::stop_led, "stop.led", 0, ""},
+    {CommandId::stop_motor, "stop.motor", 0, ""},
+    {CommandId::stop_robot, "stop.robot", 0, ""},
+    {CommandId::led_ear_all, "led.ear.all", 3, "R G B"},
+    {CommandId::led_ear_single, "led.ear.single", 4, "ID(0..1) R G B"},
+    {CommandId::led_belt_all, "led.belt.all", 3, "R G B"},
+    {CommandId::led_belt_range, "led.belt.range", 5, "FIRST LAST R G B"},
+    {CommandId::led_belt_single, "led.belt.single", 4, "ID R G B"},
+    {CommandId::motor_all, "motor.all", 2, "DIRECTION(0|1) SPEED"},
+    {CommandId::motor_duo, "motor.duo", 4, "LEFT_SPIN(0|1) LEFT_SPEED RIGHT_SPIN(0|1) RIGHT_SPEED"},
+    {CommandId::motor_left, "motor.left", 2, "SPIN(0|1) SPEED"},
+    {CommandId::motor_right, "motor.right", 2, "SPIN(0|1) SPEED"},
+    {CommandId::motivator, "motivator", 1, "ID(0x51..0x55)"},
+    {CommandId::guidance, "guidance", 1, "ID(0x41..0x4F)"},
+}};
+
+namespace {
+
+CommandId id_of(const Command& c) {
+  return std::visit(Overloaded{[](const Info&) { return CommandId::info; },
+                               [](const StopLed&) { return CommandId::stop_led; },
+                               [](const StopMotor&) { return CommandId::stop_motor; },
+                               [](const StopRobot&) { return CommandId::stop_robot; },
+                               [](const EarAll&) { return CommandId::led_ear_all; },
+                               [](const EarSingle&) { return CommandId::led_ear_single; },
+                               [](const BeltAll&) { return CommandId::led_belt_all; },
+                               [](const BeltRange&) { return CommandId::led_belt_range; },
+                               [](const BeltSingle&) { return CommandId::led_belt_single; },
+                               [](const MotorAll&) { return CommandId::motor_all; },
+                               [](const MotorDuo&) { return CommandId::motor_duo; },
+                               [](const MotorLeft&) { return CommandId::motor_left; },
+                               [](const MotorRight&) { return CommandId::motor_right; },
+                               [](const Motivator&) { return CommandId::motivator; },
+                               [](const Guidance&) { return CommandId::guidance; }},
+                    c);
+}
+
+Rgb rgb_at(ByteView d, std::size_t i) {
+  return Rgb{d[i], d[i + 1], d[i + 2]};
+}
+
+std::string hex_byte(std::uint8_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(v));
+  return buf;
+}
+
+std::string rgb_text(const Rgb& c) {
+  return "rgb=(" + std::to_string(c.red) + "," + std::to_string(c.green) + "," +
+         std::to_string(c.blue) + ")";
+}
+
+std::string spin_text(std::uint8_t spin) {
+  if (spin == kSpinForward) return "forward";
+  if (spin == kSpinBackward) return "backward";
+  return "spin?" + hex_byte(spin);
+}
+
+std::optional<std::string> check_spin(std::uint8_t spin, const char* field) {
+  if (spin <= kSpinBackward) return std::nullopt;
+  return std::string(field) + " " + hex_byte(spin) + " is neither 0 (forward) nor 1 (backward)";
+}
+
+std::optional<std::string> check_belt(std::uint8_t led, const char* field, const ValueLimits& l) {
+  if (led <= l.max_belt_led_id) return std::nullopt;
+  return std::string(field) + " " + hex_byte(led) + " outside 0x00.." + hex_byte(l.max_belt_led_id);
+}
+
+}  // namespace
+
+const CommandSpec* find_spec(std::uint8_t id) {
+  for (const auto& s : kCommandSpecs) {
+    if (static_cast<std::uint8_t>(s.id) == id) return &s;
+  }
+  return nullptr;
+}
+
+const CommandSpec* find_spec(std::string_view name) {
+  for (const auto& s : kCommandSpecs) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
+
+const CommandSpec& spec_of(const Command& c) {
+  // Every alternative of Command has a row in the table.
+  return *find_spec(static_cast<std::uint8_t>(id_of(c)));
+}
+
+Bytes data_of(const Command& c) {
+  const auto rgb = [](const Rgb& v) { return Bytes{v.red, v.green, v.blue}; };
+  return std::visit(
+      Overloaded{[](const Info&) { return Bytes{}; }, [](const StopLed&) { return Bytes{}; },
+                 [](const StopMotor&) { return Bytes{}; }, [](const StopRobot&) { return Bytes{}; },
+                 [&](const EarAll& v) { return rgb(v.color); },
+                 [](const EarSingle& v) {
+                   return Bytes{v.led, v.color.red, v.color.green, v.color.blue};
+                 },
+                 [&](const BeltAll& v) { return rgb(v.color); },
+                 [](const BeltRange& v) {
+                   return Bytes{v.first, v.last, v.color.red, v.color.green, v.color.blue};
+                 },
+                 [](const BeltSingle& v) {
+                   return Bytes{v.led, v.color.red, v.color.green, v.color.blue};
+                 },
+                 [](const MotorAll& v) {
+                   return Bytes{v.direction, v.speed};
+                 },
+                 [](const MotorDuo& v) {
+                   return Bytes{v.left_spin, v.left_speed, v.right_spin, v.right_speed};
+                 },
+                 [](const MotorLeft& v) {
+                   return Bytes{v.spin, v.speed};
+                 },
+                 [](const MotorRight& v) {
+                   return Bytes{v.spin, v.speed};
+                 },
+                 [](const Motivator& v) { return Bytes{v.id}; },
+                 [](const Guidance& v) { return Bytes{v.id}; }},
+      c);
+}
+
+std::optional<Command> make_command(const CommandSpec& spec, ByteView d) {
+  if (d.size() != spec.data_bytes) return std::nullopt;
+  switch (spec.id) {
+    case CommandId::info:
+      return Info{};
+    case CommandId::stop_led:
+      return StopLed{};
+    case CommandId::stop_motor:
+      return StopMotor{};
+    case CommandId::stop_robot:
+      return StopRobot{};
+    case CommandId::led_ear_all:
+      return EarAll{rgb_at(d, 0)};
+    case CommandId::led_ear_single:
+      return EarSingle{d[0], rgb_at(d, 1)};
+    case CommandId::led_belt_all:
+      return BeltAll{rgb_at(d, 0)};
+    case CommandId::led_belt_range:
+      return BeltRange{d[0], d[1], rgb_at(d, 2)};
+    case CommandId::led_belt_single:
+      return BeltSingle{d[0], rgb_at(d, 1)};
+    case CommandId::motor_all:
+      return MotorAll{d[0], d[1]};
+    case CommandId::motor_duo:
+      return MotorDuo{d[0], d[1], d[2], d[3]};
+    case CommandId::motor_left:
+      return MotorLeft{d[0], d[1]};
+    case CommandId::motor_right:
+      return MotorRight{d[0], d[1]};
+    case CommandId::motivator:
+      return Motivator{d[0]};
+    case CommandId::guidance:
+      return Guidance{d[0]};
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> range_problem(const Command& c, const ValueLimits& limits) {
+  using R = std::optional<std::string>;
+  return std::visit(
+      Overloaded{[](const Info&) -> R { return std::nullopt; },
+                 [](const StopLed&) -> R { return std::nullopt; },
+                 [](const StopMotor&) -> R { return std::nullopt; },
+                 [](const StopRobot&) -> R { return std::nullopt; },
+                 [](const EarAll&) -> R { return std::nullopt; },
+                 [](const EarSingle& v) -> R {
+                   if (v.led <= 1) return std::nullopt;
+                   return "ear LED id " + hex_byte(v.led) + " outside 0x00..0x01";
+                 },
+                 [](const BeltAll&) -> R { return std::nullopt; },
+                 [&](const BeltRange& v) -> R {
+                   if (auto p = check_belt(v.first, "first belt LED id", limits)) return p;
+                   if (auto p = check_belt(v.last, "last belt LED id", limits)) return p;
+                   // A robot walking first..last would light nothing: surely a mistake.
+                   if (v.first > v.last) {
+                     return "first belt LED id " + hex_byte(v.first) + " is after last " +
+                            hex_byte(v.last);
+                   }
+                   return std::nullopt;
+                 },
+                 [&](const BeltSingle& v) -> R { return check_belt(v.led, "belt LED id", limits); },
+                 [](const MotorAll& v) -> R { return check_spin(v.direction, "direction"); },
+                 [](const MotorDuo& v) -> R {
+                   if (auto p = check_spin(v.left_spin, "left spin")) return p;
+                   return check_spin(v.right_spin, "right spin");
+                 },
+                 [](const MotorLeft& v) -> R { return check_spin(v.spin, "spin"); },
+                 [](const MotorRight& v) -> R { return check_spin(v.spin, "spin"); },
+                 [](const Motivator& v) -> R {
+                   if (v.id >= 0x51 && v.id <= 0x55) return std::nullopt;
+                   return "motivator id " + hex_byte(v.id) + " outside 0x51..0x55";
+                 },
+                 [](const Guidance& v) -> R {
+                   if (v.id >= 0x41 && v.id <= 0x4F) return std::nullopt;
+                   return "guidance id " + hex_byte(v.id) + " outside 0x41..0x4F";
+                 }},
+      c);
+}
+
+std::string describe(const Command& c) {
+  std::string out(spec_of(c).name);
+  const auto add = [&](const std::string& text) { out += ' ' + text; };
+  std::visit(
+      Overloaded{
+          [](const Info&) {}, [](const StopLed&) {}, [](const StopMotor&) {},
+          [](const StopRobot&) {}, [&](const EarAll& v) { add(rgb_text(v.color)); },
+          [&](const EarSingle& v) {
+            add("led=" + std::to_string(v.led));
+            add(rgb_text(v.color));
+          },
+          [&](const BeltAll& v) { add(rgb_text(v.color)); },
+          [&](const BeltRange& v) {
+            add("leds=" + std::to_string(v.first) + ".." + std::to_string(v.last));
+            add(rgb_text(v.color));
+          },
+          [&](const BeltSingle& v) {
+            add("led=" + std::to_string(v.led));
+            add(rgb_text(v.color));
+          },
+          [&](const MotorAll& v) {
+            add(spin_text(v.direction) + " speed=" + std::to_string(v.speed));
+          },
+          [&](const MotorDuo& v) {
+            add("left=" + spin_text(v.left_spin) + "/" + std::to_string(v.left_speed));
+            add("right=" + spin_text(v.right_spin) + "/" + std::to_string(v.right_speed));
+          },
+          [&](const MotorLeft& v) { add(spin_text(v.spin) + " speed=" + std::to_string(v.speed)); },
+          [&](const MotorRight& v) {
+            add(spin_text(v.spin) + " speed=" + std::to_string(v.speed));
+          },
+          [&](const Motivator& v) { add("id=" + hex_byte(v.id)); },
+          [&](const Guidance& v) { add("id=" + hex_byte(v.id)); }},
+      c);
+  return out;
+}
+
+std::string describe(const CommandGroup& g) {
+  if (g.commands.empty()) return "(empty command group)";
+  std::string out;
+  for (std::size_t i = 0; i < g.commands.size(); ++i) {
+    if (i != 0) out += " + ";
+    out += describe(g.commands[i]);
+  }
+  return out;
+}
+
+}  // namespace hil::protocol::leka
