@@ -1,0 +1,138 @@
+#pragma once
+// Arduino serial frames ^SEQ|CMD|PAYLOAD*CS$: encode, incremental decode, and
+// the error-to-NACK mapping the mock firmware answers with.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "protocol/arduino/message.hpp"
+#include "protocol/common/bytes.hpp"
+#include "protocol/common/decode.hpp"
+#include "protocol/common/delimited_framer.hpp"
+
+namespace hil::protocol::arduino {
+
+inline constexpr std::uint8_t kStart = '^';
+inline constexpr std::uint8_t kEnd = '$';
+inline constexpr char kFieldSeparator = '|';
+inline constexpr char kChecksumSeparator = '*';
+
+/// The PC side's receive guard: a frame (markers included) longer than this
+/// is dropped. It is also the most a default decoder ever holds.
+inline constexpr std::size_t kMaxFrameBytes = 256;
+/// The firmware's own receive buffer: the longest frame it can take in,
+/// markers included. DecoderOptions::firmware() decodes with this bound.
+inline constexpr std::size_t kFirmwareMaxFrameBytes = 96;
+/// The shortest well-formed frame, "^00|S|*00$"; a smaller bound is refused.
+inline constexpr std::size_t kMinFrameBytes = 10;
+
+/// Signed M/R arguments are the firmware's 16-bit int.
+inline constexpr int kMinSignedArg = -32768;
+inline constexpr int kMaxSignedArg = 32767;
+inline constexpr int kMaxPwm = 255;
+
+/// XOR of every byte of `body` (the text between '^' and '*': SEQ|CMD|PAYLOAD).
+std::uint8_t checksum(std::string_view body);
+
+/// A frame's three fields before any typing: the generic layer under Message.
+struct Envelope {
+  std::uint8_t seq = 0;
+  std::string cmd;
+  std::string payload;
+  friend bool operator==(const Envelope&, const Envelope&) = default;
+};
+
+/// True for characters a CMD or PAYLOAD field may hold: printable ASCII
+/// except the markers and separators ^ $ * |.
+bool is_field_char(char c);
+
+/// "^" + body + "*" + CS + "$" with the correct uppercase checksum. `body` is
+/// taken as is (it need not be SEQ|CMD|PAYLOAD): for deliberately odd frames.
+std::string frame_body(std::string_view body);
+
+/// The frame for an envelope's fields, unchecked (any cmd/payload text is
+/// framed, for fault injection and QA). SEQ is written as two uppercase hex digits.
+std::string frame_text(const Envelope& envelope);
+
+/// The fields of a message. Throws std::invalid_argument for a value the
+/// protocol cannot carry: V outside 0..255, M/R outside the 16-bit range, ACK
+/// or NACK text with a character that is not a field character.
+Envelope to_envelope(const Message& m);
+
+/// A complete frame, e.g. "^02|V|160*63$". Throws like to_envelope, and also
+/// when the frame would exceed kMaxFrameBytes (no receiver would take it).
+std::string encode_text(const Message& m);
+Bytes encode(const Message& m);
+
+/// Why an envelope does not make a typed message.
+struct PayloadError {
+  ErrorKind kind;  ///< bad_format, bad_value or unknown_code
+  std::string detail;
+  std::string context;  ///< the CMD token
+};
+
+/// Types an envelope's CMD and PAYLOAD (the SEQ is copied).
+std::variant<Message, PayloadError> to_message(const Envelope& envelope);
+
+struct DecoderOptions {
+  /// Longest frame, markers included; also the most the decoder holds.
+  /// At least kMinFrameBytes.
+  std::size_t max_frame_bytes = kMaxFrameBytes;
+  /// The protocol does not say whether checksum hex is upper or lower case.
+  /// When true, a lowercase checksum is accepted and the frame comes out with
+  /// `tolerated = lowercase_checksum`; when false it is a lowercase_checksum
+  /// error (which the firmware answers with NACK BAD_CS).
+  bool accept_lowercase_checksum = true;
+
+  /// The firmware's view: frames over kFirmwareMaxFrameBytes are oversized.
+  static DecoderOptions firmware() {
+    return DecoderOptions{.max_frame_bytes = kFirmwareMaxFrameBytes};
+  }
+};
+
+using Item = DecodeItem<Message>;
+
+/// Checks framing, checksum, field count and SEQ of one complete candidate
+/// frame ('^' through '$'), without looking at CMD or PAYLOAD meaning.
+/// A frame's `tolerated` is set as decode_frame would set it.
+DecodeItem<Envelope> parse_envelope(ByteView raw, const DecoderOptions& options = {});
+
+/// parse_envelope, then to_message.
+Item decode_frame(ByteView raw, const DecoderOptions& options = {});
+
+/// The NACK code the firmware answers a decode error with; nullopt when there
+/// is no complete frame to answer (garbage, oversized, truncated, or a frame
+/// cut short by the next '^').
+std::optional<NackCode> nack_for(const DecodeError& error);
+
+/// The SEQ of a frame's raw bytes when it starts "^HH|" with two hex digits,
+/// so a NACK can carry the sequence number of the request it refuses.
+std::optional<std::uint8_t> sequence_of(ByteView raw);
+
+/// Incremental stream decoder for either direction: any chunking of the
+/// stream yields the same items in the same order. Never throws on input.
+/// Holds at most `max_frame_bytes` bytes: 256 by default (the PC's receive
+/// guard), 96 with DecoderOptions::firmware() (the firmware's buffer).
+class Decoder {
+ public:
+  /// Throws std::invalid_argument when max_frame_bytes < kMinFrameBytes.
+  explicit Decoder(DecoderOptions options = {});
+
+  void feed(ByteView bytes, std::vector<Item>& out);
+  /// End of stream: a partial frame comes out as ErrorKind::truncated.
+  void finish(std::vector<Item>& out);
+  std::size_t buffered() const { return framer_.buffered(); }
+
+ private:
+  void convert(std::vector<Item>& out);
+
+  DecoderOptions options_;
+  DelimitedFramer framer_;
+  std::vector<DelimitedFramer::Event> events_;
+};
+
+}  // namespace hil::protocol::arduino
