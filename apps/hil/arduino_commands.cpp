@@ -1,9 +1,252 @@
 // hil encode arduino / hil decode arduino.
 
+#include <cctype>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
 #include "apps/hil/cli_common.hpp"
+#include "protocol/arduino/codec.hpp"
+#include "protocol/common/text.hpp"
 
 namespace hil::apps {
+namespace {
 
-void register_arduino(CommandSet& /*commands*/) {}
+namespace ard = protocol::arduino;
+
+constexpr const char* kEncodeFooter = R"(Forms (SEQ is --seq, default 1):
+  hil encode arduino [--seq N] CMD [PAYLOAD...]     typed, checked: V 0..255, M/R -32768..32767
+  hil encode arduino [--seq N] CMD:PAYLOAD          the same as one token, like the robot CLI (V:160)
+  hil encode arduino [--seq N] --raw CMD [PAYLOAD]  any CMD/PAYLOAD text, unchecked (fault injection)
+  hil encode arduino --body 'TEXT'                  frame TEXT as the whole part between ^ and *
+  add --checksum XX to any form to write XX instead of the computed checksum
+Commands: PING STATUS V <pwm> M <cm> R <deg> S B I HELP (lowercase accepted),
+  responses ACK [info text] and NACK <BAD_CS|BAD_FMT|BAD_SEQ|BAD_CMD|BAD_V|other text>.
+  Several PAYLOAD words are joined with single spaces (ACK moved 25 cm).
+--seq takes decimal 0..255 or hex with a 0x prefix (0x00..0xFF): --seq 31 and --seq 0x1F agree.
+Examples:
+  hil encode arduino --seq 2 V 160            ^02|V|160*63$
+  hil encode arduino --seq 4 R -90            ^04|R|-90*72$
+  hil encode arduino --seq 8 STATUS           ^08|STATUS|*1C$
+  hil encode arduino --seq 1 ACK OK           ^01|ACK|OK*4C$
+  hil encode arduino --seq 4 NACK BAD_CS      ^04|NACK|BAD_CS*0B$
+  hil encode arduino --seq 9 --raw JUMP HIGH  ^09|JUMP|HIGH*05$
+  hil encode arduino --body 'G1|PING|'        ^G1|PING|*66$
+  hil encode arduino --seq 2 V 160 --checksum 00   ^02|V|160*00$)";
+
+constexpr const char* kDecodeFooter =
+    R"(Frames on the command line are joined in order and decoded as one stream;
+quote them, the shell treats ^ $ | * specially. Exit status: 0 all frames, 1 any error, 2 no bytes.
+Examples:
+  hil decode arduino '^02|V|160*63$'
+  hil decode arduino '^01|PING|*11$^01|ACK|OK*4C$'
+  hil decode arduino --nack '^2A|S|*00$'       also print the NACK the firmware answers
+  hil decode arduino --firmware -f capture.bin  the firmware's 96-byte frame bound
+  hil decode arduino --hex '5E 30 37 7C 53 7C 2A 35 34 24')";
+
+// Decimal 0..255, or 0x00..0xFF.
+std::optional<std::uint8_t> parse_seq(const std::string& text) {
+  if (text.empty() || text.size() > 4) return std::nullopt;
+  int base = 10;
+  std::string digits = text;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    base = 16;
+    digits = text.substr(2);
+  }
+  int value = 0;
+  for (const char c : digits) {
+    int d = 0;
+    if (c >= '0' && c <= '9') {
+      d = c - '0';
+    } else if (base == 16 && c >= 'a' && c <= 'f') {
+      d = c - 'a' + 10;
+    } else if (base == 16 && c >= 'A' && c <= 'F') {
+      d = c - 'A' + 10;
+    } else {
+      return std::nullopt;
+    }
+    value = value * base + d;
+  }
+  if (value > 255) return std::nullopt;
+  return static_cast<std::uint8_t>(value);
+}
+
+std::string upper(std::string text) {
+  for (char& c : text)
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return text;
+}
+
+struct EncodeArgs {
+  std::string seq = "1";
+  std::vector<std::string> words;
+  bool raw = false;
+  std::string body;
+  std::string checksum;
+};
+
+int fail(const std::string& what) {
+  std::cerr << "hil encode arduino: " << what << '\n';
+  return 1;
+}
+
+// CMD and PAYLOAD from the words: "V 160", "V:160", "ACK moved 25 cm".
+std::pair<std::string, std::string> split_words(const std::vector<std::string>& words) {
+  std::string cmd = words.front();
+  std::string payload;
+  if (words.size() == 1) {
+    const auto colon = cmd.find(':');
+    if (colon != std::string::npos) {
+      payload = cmd.substr(colon + 1);
+      cmd.resize(colon);
+    }
+  }
+  for (std::size_t i = 1; i < words.size(); ++i) {
+    if (i > 1) payload.push_back(' ');
+    payload += words[i];
+  }
+  return {cmd, payload};
+}
+
+int run_encode(const EncodeArgs& args, bool body_given, bool seq_given) {
+  if (!args.checksum.empty() && args.checksum.size() != 2) {
+    return fail("--checksum '" + args.checksum + "' is not exactly two characters");
+  }
+  std::string frame;
+  if (body_given) {
+    if (!args.words.empty() || seq_given || args.raw) {
+      return fail("--body frames its text alone; drop the CMD/PAYLOAD words, --seq and --raw");
+    }
+    frame = ard::frame_body(args.body);
+  } else {
+    if (args.words.empty()) {
+      return fail("give a command, e.g. 'V 160', 'V:160', 'ACK OK' (see --help)");
+    }
+    const auto seq = parse_seq(args.seq);
+    if (!seq) {
+      return fail("--seq '" + args.seq + "' is not 0..255 in decimal or 0x00..0xFF in hex");
+    }
+    auto [cmd, payload] = split_words(args.words);
+    if (args.raw) {
+      frame = ard::frame_text(ard::Envelope{*seq, cmd, payload});
+    } else {
+      const ard::Envelope envelope{*seq, upper(cmd), payload};
+      auto typed = ard::to_message(envelope);
+      if (const auto* e = std::get_if<ard::PayloadError>(&typed)) {
+        return fail(std::string(protocol::to_string(e->kind)) + ": " + e->detail +
+                    "\n(use --raw to frame it anyway)");
+      }
+      try {
+        frame = ard::encode_text(std::get<ard::Message>(typed));
+      } catch (const std::invalid_argument& e) {
+        return fail(std::string(e.what()) + "\n(use --raw to frame it anyway)");
+      }
+    }
+  }
+  if (!args.checksum.empty()) {
+    // Replace the two digits between the last '*' and the '$'.
+    frame.replace(frame.size() - 3, 2, args.checksum);
+  }
+  std::cout << frame << '\n';
+  return 0;
+}
+
+struct DecodeArgs {
+  DecodeInput input;
+  bool firmware = false;
+  bool strict_checksum = false;
+  std::string max_frame_bytes;
+  bool nack = false;
+};
+
+int run_decode(const DecodeArgs& args) {
+  protocol::Bytes bytes;
+  try {
+    bytes = read_decode_input(args.input, false);
+  } catch (const CLI::Error& e) {
+    std::cerr << "hil decode arduino: " << e.what() << '\n';
+    return 1;
+  }
+  ard::DecoderOptions options =
+      args.firmware ? ard::DecoderOptions::firmware() : ard::DecoderOptions{};
+  if (!args.max_frame_bytes.empty()) {
+    const auto bound = protocol::parse_decimal(args.max_frame_bytes, false, false, 7);
+    if (!bound || *bound < static_cast<long long>(ard::kMinFrameBytes)) {
+      std::cerr << "hil decode arduino: --max-frame-bytes '" << args.max_frame_bytes
+                << "' is not a whole number of at least " << ard::kMinFrameBytes
+                << " (the shortest frame, ^00|S|*00$)\n";
+      return 1;
+    }
+    options.max_frame_bytes = static_cast<std::size_t>(*bound);
+  }
+  options.accept_lowercase_checksum = !args.strict_checksum;
+  const int status =
+      print_items<ard::Message>(ard::Decoder(options), bytes, false, args.input,
+                                [](const ard::Message& m) { return ard::describe(m); });
+  if (args.nack) {
+    // The answers the mock firmware gives: one NACK per complete frame that
+    // failed to decode, in stream order.
+    ard::Decoder decoder(options);
+    std::vector<ard::Item> items;
+    decoder.feed(bytes, items);
+    decoder.finish(items);
+    std::size_t offset = 0;
+    for (const auto& item : items) {
+      if (const auto* e = std::get_if<protocol::DecodeError>(&item)) {
+        if (const auto answer = ard::nack_response(*e)) {
+          std::cout << "nack for error @" << offset << ": " << ard::encode_text(*answer) << '\n';
+        }
+        offset += e->raw.size();
+      } else {
+        offset += std::get<protocol::Frame<ard::Message>>(item).raw.size();
+      }
+    }
+  }
+  return status;
+}
+
+}  // namespace
+
+void register_arduino(CommandSet& commands) {
+  auto encode_args = std::make_shared<EncodeArgs>();
+  auto decode_args = std::make_shared<DecodeArgs>();
+
+  auto* enc = commands.encode.add_subcommand(
+      "arduino", "Arduino robot frame ^SEQ|CMD|PAYLOAD*CS$, e.g. --seq 2 V 160 or ACK OK");
+  enc->add_option("words", encode_args->words,
+                  "CMD then PAYLOAD words (V 160), or one CMD:PAYLOAD token (V:160)");
+  auto* seq = enc->add_option("--seq", encode_args->seq,
+                              "Sequence number: decimal 0..255 or hex 0x00..0xFF (default 1)");
+  enc->add_flag("--raw", encode_args->raw,
+                "Frame CMD and PAYLOAD as given, without checking them (for odd frames)");
+  auto* body = enc->add_option("--body", encode_args->body,
+                               "Frame this text as everything between ^ and * (e.g. 'G1|PING|')");
+  enc->add_option("--checksum", encode_args->checksum,
+                  "Write these two characters instead of the computed checksum (fault injection)");
+  enc->footer(kEncodeFooter);
+  enc->callback([&run = commands.run, encode_args, body, seq] {
+    run = [encode_args, body = body->count() > 0, seq = seq->count() > 0]() {
+      return run_encode(*encode_args, body, seq);
+    };
+  });
+
+  auto* dec =
+      commands.decode.add_subcommand("arduino", "Decode Arduino robot frames or a byte stream");
+  add_decode_input(*dec, decode_args->input, false);
+  dec->add_flag("--firmware", decode_args->firmware,
+                "Use the firmware's 96-byte frame bound instead of the PC's 256-byte guard");
+  dec->add_option("--max-frame-bytes", decode_args->max_frame_bytes,
+                  "Frame bound in bytes, markers included (default 256, 96 with --firmware)");
+  dec->add_flag("--strict-checksum", decode_args->strict_checksum,
+                "Lowercase checksum hex is an error (default: accepted, shown as tolerated)");
+  dec->add_flag("--nack", decode_args->nack,
+                "Also print the NACK frame the firmware answers each bad frame with");
+  dec->footer(kDecodeFooter);
+  dec->callback([&run = commands.run, decode_args] {
+    run = [decode_args]() { return run_decode(*decode_args); };
+  });
+}
 
 }  // namespace hil::apps

@@ -13,6 +13,9 @@ constexpr char kHex[] = "0123456789ABCDEF";
 // A CMD longer than this is not echoed as an error's context: the known
 // tokens are at most six characters, and a context is meant to be short.
 constexpr std::size_t kMaxContextChars = 16;
+// Enough digits that any long number is reported as out of range rather than
+// as not a number, and few enough that it cannot overflow a long long.
+constexpr std::size_t kMaxDigits = 18;
 
 std::string hex_byte(std::uint8_t v) {
   return {kHex[v >> 4], kHex[v & 0x0F]};
@@ -175,7 +178,7 @@ std::variant<Message, PayloadError> to_message(const Envelope& envelope) {
   if (cmd == "V") {
     // The firmware answers both a non-number and an out-of-range speed with
     // BAD_V, so both are bad_value here.
-    const auto v = parse_decimal(payload, true, true);
+    const auto v = parse_decimal(payload, true, true, kMaxDigits);
     if (!v) {
       return fail(ErrorKind::bad_value,
                   "V payload '" + std::string(payload) + "' is not a whole number 0..255", cmd);
@@ -187,7 +190,7 @@ std::variant<Message, PayloadError> to_message(const Envelope& envelope) {
   }
   if (cmd == "M" || cmd == "R") {
     const char* what = cmd == "M" ? "distance in cm" : "angle in degrees";
-    const auto v = parse_decimal(payload, true, true);
+    const auto v = parse_decimal(payload, true, true, kMaxDigits);
     if (!v) {
       return fail(ErrorKind::bad_format,
                   std::string(cmd) + " payload '" + std::string(payload) +
@@ -342,6 +345,12 @@ std::optional<std::uint8_t> sequence_of(ByteView raw) {
   }
   const std::string_view digits(reinterpret_cast<const char*>(raw.data()) + 1, 2);
   return parse_hex_byte(digits);
+}
+
+std::optional<Message> nack_response(const DecodeError& error) {
+  const auto code = nack_for(error);
+  if (!code) return std::nullopt;
+  return Message{sequence_of(error.raw).value_or(0), Nack{*code}};
 }
 
 Decoder::Decoder(DecoderOptions options)

@@ -113,6 +113,11 @@ std::optional<NackCode> nack_for(const DecodeError& error);
 /// so a NACK can carry the sequence number of the request it refuses.
 std::optional<std::uint8_t> sequence_of(ByteView raw);
 
+/// The NACK the firmware answers a decode error with: the code from nack_for,
+/// with the request's SEQ from sequence_of, or SEQ 00 when the SEQ cannot be
+/// read (the protocol leaves that case open). nullopt when nack_for is.
+std::optional<Message> nack_response(const DecodeError& error);
+
 /// Incremental stream decoder for either direction: any chunking of the
 /// stream yields the same items in the same order. Never throws on input.
 /// Holds at most `max_frame_bytes` bytes: 256 by default (the PC's receive

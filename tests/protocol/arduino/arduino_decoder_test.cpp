@@ -254,6 +254,20 @@ TEST(ArduinoDecoder, GarbageComesOutInBoundedChunks) {
   EXPECT_EQ(total, noise.size());
 }
 
+TEST(ArduinoDecoder, NackResponseCarriesTheRequestSeq) {
+  const auto cs = nack_response(single_error("^2A|S|*00$"));
+  ASSERT_TRUE(cs);
+  EXPECT_EQ(encode_text(*cs), "^2A|NACK|BAD_CS*7C$");
+  const auto v = nack_response(single_error(frame_body("02|V|999")));
+  ASSERT_TRUE(v);
+  EXPECT_EQ(*v, (Message{0x02, Nack{NackCode::bad_v}}));
+  // An unreadable SEQ is answered with SEQ 00.
+  const auto seq = nack_response(single_error(frame_body("G1|PING|")));
+  ASSERT_TRUE(seq);
+  EXPECT_EQ(*seq, (Message{0x00, Nack{NackCode::bad_seq}}));
+  EXPECT_FALSE(nack_response(single_error("noise")));
+}
+
 TEST(ArduinoDecoder, SequenceOfReadsOnlyAWellFormedSeqField) {
   EXPECT_EQ(sequence_of(to_bytes("^1F|PING|*00$")), 0x1F);
   EXPECT_EQ(sequence_of(to_bytes("^1f|")), 0x1F);
