@@ -1,9 +1,226 @@
 // hil encode leka / hil decode leka.
 
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
 #include "apps/hil/cli_common.hpp"
+#include "protocol/leka/codec.hpp"
 
 namespace hil::apps {
+namespace {
 
-void register_leka(CommandSet& /*commands*/) {}
+namespace leka = protocol::leka;
+
+const char* const kEncodeFooter = R"(Forms:
+  hil encode leka COMMAND [VALUE...] [+ COMMAND [VALUE...]]...
+      One frame whose command group holds the commands in order ('+' between
+      commands). VALUEs are bytes 0..255, decimal or 0x hex.
+  hil encode leka --group HEX
+      Frames any group bytes as given (start sequence, length, group, checksum),
+      unchecked: for odd or broken frames (unknown ids, cut-short commands, an
+      empty or oversized group).
+
+Commands (id, values):
+  info             0x70  -
+  stop.led         0xFD  -
+  stop.motor       0xFE  -
+  stop.robot       0xFF  -
+  led.ear.all      0x11  R G B
+  led.ear.single   0x12  ID(0..1) R G B
+  led.belt.all     0x13  R G B
+  led.belt.range   0x14  FIRST LAST R G B     (FIRST <= LAST)
+  led.belt.single  0x15  ID R G B             (ID 0..19, see --max-belt-id)
+  motor.all        0x21  DIRECTION SPEED      (0 forward, 1 backward; speed 0..255)
+  motor.duo        0x22  LEFT_SPIN LEFT_SPEED RIGHT_SPIN RIGHT_SPEED
+  motor.left       0x23  SPIN SPEED
+  motor.right      0x24  SPIN SPEED
+  motivator        0x50  ID(0x51..0x55)
+  guidance         0x40  ID(0x41..0x4F)
+
+Examples:
+  hil encode leka info                          -> 2A 2B 2C 2D 01 70 70
+  hil encode leka led.belt.single 0 255 0 0     -> 2A 2B 2C 2D 05 15 00 FF 00 00 41
+  hil encode leka led.ear.all 255 0 0 + motor.all 1 200
+  hil encode leka motivator 0x52
+  hil encode leka --unchecked led.ear.single 2 0 0 255
+  hil encode leka --group "99 01 02"
+)";
+
+const char* const kDecodeFooter = R"(Examples:
+  hil decode leka 2A 2B 2C 2D 01 70 70
+  hil decode leka "2A2B2C2D0515 00FF000041"
+  hil decode leka --file capture.bin --no-raw
+  hil decode leka --lenient 2A 2B 2C 2D 05 12 02 00 00 FF 00
+
+Exit status: 0 every item is a frame, 1 some error was found, 2 nothing to decode.
+Errors: garbage, bad_checksum, bad_format (length 0, command cut short),
+bad_value (id or spin out of range), oversized (length over the frame bound),
+unknown_code (unknown command id), truncated (stream ended inside a frame).
+)";
+
+// A byte written in decimal or 0x hex.
+std::optional<std::uint8_t> parse_byte(const std::string& text) {
+  if (text.empty() || text.size() > 5) return std::nullopt;
+  int base = 10;
+  std::string_view digits = text;
+  if (digits.size() > 2 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
+    base = 16;
+    digits.remove_prefix(2);
+  }
+  unsigned value = 0;
+  for (const char c : digits) {
+    unsigned d = 0;
+    if (c >= '0' && c <= '9') {
+      d = static_cast<unsigned>(c - '0');
+    } else if (base == 16 && c >= 'a' && c <= 'f') {
+      d = static_cast<unsigned>(c - 'a' + 10);
+    } else if (base == 16 && c >= 'A' && c <= 'F') {
+      d = static_cast<unsigned>(c - 'A' + 10);
+    } else {
+      return std::nullopt;
+    }
+    value = value * static_cast<unsigned>(base) + d;
+  }
+  if (value > 255) return std::nullopt;
+  return static_cast<std::uint8_t>(value);
+}
+
+// The words of the command line as a command group; throws
+// std::invalid_argument with a message for the user.
+leka::CommandGroup parse_words(const std::vector<std::string>& words) {
+  leka::CommandGroup group;
+  std::size_t i = 0;
+  while (i <= words.size()) {
+    const std::size_t number = group.commands.size() + 1;
+    if (i == words.size() || words[i] == "+") {
+      throw std::invalid_argument("command " + std::to_string(number) +
+                                  " is missing (nothing before or after a '+')");
+    }
+    const leka::CommandSpec* spec = leka::find_spec(words[i]);
+    if (spec == nullptr) {
+      std::string known;
+      for (const auto& s : leka::kCommandSpecs)
+        known += (known.empty() ? "" : ", ") + std::string(s.name);
+      throw std::invalid_argument("unknown command '" + words[i] + "'; known commands: " + known);
+    }
+    std::size_t end = i + 1;
+    while (end < words.size() && words[end] != "+")
+      ++end;
+    const std::size_t given = end - i - 1;
+    if (given != spec->data_bytes) {
+      throw std::invalid_argument(
+          std::string(spec->name) + " takes " + std::to_string(spec->data_bytes) + " value(s)" +
+          (spec->data_bytes == 0 ? std::string() : " (" + std::string(spec->data_help) + ")") +
+          ", got " + std::to_string(given));
+    }
+    protocol::Bytes data;
+    for (std::size_t k = i + 1; k < end; ++k) {
+      const auto b = parse_byte(words[k]);
+      if (!b) {
+        throw std::invalid_argument(std::string(spec->name) + " value " + std::to_string(k - i) +
+                                    " '" + words[k] + "' is not a byte 0..255 (decimal or 0x hex)");
+      }
+      data.push_back(*b);
+    }
+    group.commands.push_back(*leka::make_command(*spec, data));
+    if (end == words.size()) break;
+    i = end + 1;
+  }
+  return group;
+}
+
+}  // namespace
+
+void register_leka(CommandSet& commands) {
+  struct Args {
+    std::vector<std::string> words;
+    std::string group_hex;
+    bool unchecked = false;
+    int max_belt_id = 0x13;
+    bool lenient = false;
+    std::size_t max_frame_bytes = leka::kMaxFrameBytes;
+    DecodeInput input;
+  };
+  auto args = std::make_shared<Args>();
+
+  auto* enc = commands.encode.add_subcommand(
+      "leka",
+      "Leka Alpha frame from commands, e.g. 'led.belt.single 0 255 0 0' or 'info + stop.motor'");
+  enc->add_option("command", args->words, "COMMAND [VALUE...], several joined by '+' (see below)");
+  enc->add_option("--group", args->group_hex,
+                  "Frame these command-group bytes (hex) unchecked instead of commands");
+  enc->add_flag("--unchecked", args->unchecked,
+                "Do not check ids, spins and the 122-byte group bound (for odd frames)");
+  enc->add_option("--max-belt-id", args->max_belt_id,
+                  "Highest belt LED id accepted (default 19 = 0x13; the seed table says 0x19)")
+      ->check(CLI::Range(0, 255));
+  enc->footer(kEncodeFooter);
+  enc->callback([&run = commands.run, args] {
+    run = [args]() -> int {
+      try {
+        if (!args->group_hex.empty() && !args->words.empty()) {
+          throw std::invalid_argument("give either commands or --group, not both");
+        }
+        if (!args->group_hex.empty()) {
+          const auto group = protocol::parse_hex(args->group_hex);
+          if (!group)
+            throw std::invalid_argument("--group '" + args->group_hex + "' is not hex bytes");
+          std::cout << protocol::to_hex(leka::frame_group(*group)) << '\n';
+          return 0;
+        }
+        if (args->words.empty()) {
+          throw std::invalid_argument("no command given (try 'hil encode leka --help')");
+        }
+        const auto group = parse_words(args->words);
+        if (args->unchecked) {
+          std::cout << protocol::to_hex(leka::frame_group(leka::group_bytes(group))) << '\n';
+          return 0;
+        }
+        const leka::ValueLimits limits{static_cast<std::uint8_t>(args->max_belt_id)};
+        std::cout << protocol::to_hex(leka::encode(group, limits)) << '\n';
+        return 0;
+      } catch (const std::invalid_argument& e) {
+        std::string what = e.what();
+        if (what.rfind("Leka encode: ", 0) == 0) {
+          what = what.substr(13) + "\n(use --unchecked or --group to send it anyway)";
+        }
+        std::cerr << "hil encode leka: " << what << '\n';
+        return 1;
+      }
+    };
+  });
+
+  auto* dec = commands.decode.add_subcommand("leka", "Decode Leka Alpha frames or a byte stream");
+  add_decode_input(*dec, args->input, true);
+  dec->add_flag("--lenient", args->lenient,
+                "Accept ids and spins out of range (frame reported as tolerated bad_value)");
+  dec->add_option("--max-belt-id", args->max_belt_id,
+                  "Highest belt LED id accepted (default 19 = 0x13)")
+      ->check(CLI::Range(0, 255));
+  dec->add_option("--max-frame-bytes", args->max_frame_bytes,
+                  "Frame bound in bytes (default 128, the robot's serial buffer)")
+      ->check(CLI::Range(7, 261));
+  dec->footer(kDecodeFooter);
+  dec->callback([&run = commands.run, args] {
+    run = [args]() -> int {
+      protocol::Bytes bytes;
+      try {
+        bytes = read_decode_input(args->input, true);
+      } catch (const CLI::ValidationError& e) {
+        std::cerr << "hil decode leka: " << e.what() << '\n';
+        return 1;
+      }
+      leka::DecoderOptions options;
+      options.max_frame_bytes = args->max_frame_bytes;
+      options.limits.max_belt_led_id = static_cast<std::uint8_t>(args->max_belt_id);
+      options.accept_out_of_range = args->lenient;
+      return print_items<leka::Message>(leka::Decoder(options), bytes, true, args->input,
+                                        [](const leka::Message& m) { return leka::describe(m); });
+    };
+  });
+}
 
 }  // namespace hil::apps

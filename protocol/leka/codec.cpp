@@ -20,8 +20,8 @@ std::string hex_byte(std::uint8_t v) {
 }
 
 std::string where(std::size_t group_index) {
-  return "group byte " + std::to_string(group_index) + " (frame byte " +
-         std::to_string(group_index + kHeaderBytes) + ")";
+  return "group byte " + std::to_string(group_index) + ", frame byte " +
+         std::to_string(group_index + kHeaderBytes);
 }
 
 // Name of the group's first command, when its id is known: the context of

@@ -174,7 +174,7 @@ TEST(LekaDecoder, UnknownCommandIdIsUnknownCodeWithTheWholeFrame) {
   EXPECT_EQ(e.kind, ErrorKind::unknown_code);
   EXPECT_EQ(e.raw, frame);
   EXPECT_EQ(e.context, "0x99");
-  EXPECT_NE(e.detail.find("unknown command id 0x99 at group byte 1 (frame byte 6) (command 2)"),
+  EXPECT_NE(e.detail.find("unknown command id 0x99 at group byte 1, frame byte 6 (command 2)"),
             std::string::npos)
       << e.detail;
 }
@@ -226,7 +226,7 @@ TEST(LekaDecoder, ValuesOutOfRangeAreBadValueUnlessTolerated) {
 
 TEST(LekaDecoder, BadValueNamesTheCommandItIsIn) {
   const auto items = decode_all(frame_group(hex("70 12 01 00 00 00 12 05 00 00 00")));
-  EXPECT_NE(error_at(items, 0).detail.find("command 3, group byte 6 (frame byte 11)"),
+  EXPECT_NE(error_at(items, 0).detail.find("command 3, group byte 6, frame byte 11"),
             std::string::npos)
       << error_at(items, 0).detail;
 }
