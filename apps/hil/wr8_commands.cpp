@@ -1,9 +1,370 @@
 // hil encode wr8 / hil decode wr8.
 
+#include <charconv>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <variant>
+#include <vector>
+
 #include "apps/hil/cli_common.hpp"
+#include "protocol/wr8/codec.hpp"
 
 namespace hil::apps {
+namespace {
 
-void register_wr8(CommandSet& /*commands*/) {}
+namespace wr8 = protocol::wr8;
+
+const char* const kEncodeFooter = R"(Forms (prints the packet as spaced hex):
+  hil encode wr8 empty
+  hil encode wr8 auth [TEXT]               TEXT: exactly 10 characters (default: the
+                                           profile string HIL-WR8-01)
+  hil encode wr8 auth --text-hex HEX       any 10 bytes as hex
+  hil encode wr8 auth-reply DEVICE_CODE DEVICE_ID STATE
+  hil encode wr8 task COI TASK [VALUE...]  TASK: check | drive DISTANCE_CM | turn ANGLE_DEG
+                                           | blink | get-settings   (or 0..4)
+  hil encode wr8 settings COI NAME=VALUE...  NAME: p | i | d | servo-zero (or 0..3)
+  hil encode wr8 response COI CODE         CODE: error | started | completed (or 0..2)
+  hil encode wr8 data STATE TIMESTAMP_MS [NAME=VALUE...] [--unparsed HEX]
+                                           NAME: odometry (cm, int) | speed (m/s, float)
+                                           | wheel-angle or angle (deg, float)
+                                           | battery (percent, 0..255)   (or the code 0..3)
+  hil encode wr8 packet CODE [HEX...]      CODE then the bytes as given, no checks
+
+  STATE: fault | run | stop | wait (or 0..3). COI, DEVICE_CODE, DEVICE_ID, CODE: 0..255.
+  A VALUE is read as the profile types it (P, I, D floats; distance, angle, servo
+  zero integers); 0x followed by hex digits gives the exact bits instead.
+  Put '--' before the form when a value is negative and looks like an option.
+
+Examples:
+  hil encode wr8 auth                         01 48 49 4C 2D 57 52 38 2D 30 31
+  hil encode wr8 task 1 drive 100             03 01 01 04 64 00 00 00
+  hil encode wr8 task 2 turn -15              03 02 02 04 F1 FF FF FF
+  hil encode wr8 settings 5 p=1.5 servo-zero=90
+  hil encode wr8 response 1 completed         05 01 02
+  hil encode wr8 data run 1500 odometry=120 speed=0.5 angle=-10 battery=87
+  hil encode wr8 --big-endian task 1 drive 100
+  hil encode wr8 --unchecked task 1 drive     (a drive task with no distance)
+  hil encode wr8 packet 3 01 01 06 00 00 00 00 00 00   (a size byte not a multiple of 4)
+)";
+
+const char* const kDecodeFooter = R"(Prints one line per packet or error, with the stream offset.
+Examples:
+  hil decode wr8 03 01 01 04 64 00 00 00
+  hil decode wr8 --sender vehicle 06 01 DC 05 00 00 07 00 78 00 00 00 03 57
+  hil decode wr8 --block-unit entries 03 01 01 01 64 00 00 00
+  hil decode wr8 --file capture.bin
+Exit status: 0 all packets decoded, 1 an error was reported, 2 nothing to decode.
+)";
+
+struct ProfileArgs {
+  bool big_endian = false;
+  std::string block_unit = "bytes";
+};
+
+void add_profile_options(CLI::App& cmd, ProfileArgs& args) {
+  cmd.add_flag("--big-endian", args.big_endian,
+               "Multi-byte values most significant byte first (default: little-endian)");
+  cmd.add_option("--block-unit", args.block_unit,
+                 "What TASK/SETTINGS/DATA size bytes count: bytes (default) or entries")
+      ->check(CLI::IsMember({"bytes", "entries"}));
+}
+
+wr8::Profile profile_of(const ProfileArgs& args) {
+  wr8::Profile p;
+  p.byte_order = args.big_endian ? wr8::ByteOrder::big : wr8::ByteOrder::little;
+  p.block_unit =
+      args.block_unit == "entries" ? wr8::BlockSizeUnit::entries : wr8::BlockSizeUnit::bytes;
+  return p;
+}
+
+// What was wrong with the command line, for stderr.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::uint32_t parse_unsigned(std::string_view text, std::uint32_t max, std::string_view what) {
+  std::uint32_t value = 0;
+  int base = 10;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    text.remove_prefix(2);
+    base = 16;
+  }
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value, base);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size() || value > max) {
+    throw UsageError(std::string(what) + " '" + std::string(text) + "' is not a number 0.." +
+                     std::to_string(max));
+  }
+  return value;
+}
+
+std::uint8_t parse_byte(std::string_view text, std::string_view what) {
+  return static_cast<std::uint8_t>(parse_unsigned(text, 255, what));
+}
+
+wr8::State parse_state_arg(std::string_view text) {
+  const auto s = wr8::parse_state(text);
+  if (!s)
+    throw UsageError("state '" + std::string(text) + "': expected fault, run, stop, wait or 0..3");
+  return *s;
+}
+
+wr8::Word parse_word(std::string_view text, wr8::ValueType type, std::size_t size,
+                     std::string_view what) {
+  const auto w = wr8::parse_value(text, type, size);
+  if (!w) {
+    const char* expected = type == wr8::ValueType::float32      ? "a number"
+                           : type == wr8::ValueType::signed_int ? "a whole number"
+                                                                : "a whole number >= 0";
+    throw UsageError(std::string(what) + " value '" + std::string(text) + "': expected " +
+                     expected + " that fits " + std::to_string(size) +
+                     " byte(s), or 0x and hex digits");
+  }
+  return *w;
+}
+
+std::pair<std::string_view, std::string_view> split_assignment(std::string_view arg) {
+  const auto eq = arg.find('=');
+  if (eq == std::string_view::npos || eq == 0) {
+    throw UsageError("'" + std::string(arg) + "' is not NAME=VALUE");
+  }
+  return {arg.substr(0, eq), arg.substr(eq + 1)};
+}
+
+std::string normalised(std::string_view name) {
+  std::string out(name);
+  for (char& c : out) {
+    if (c == '-') c = '_';
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return out;
+}
+
+protocol::Bytes parse_hex_arg(std::string_view text, std::string_view what) {
+  const auto bytes = protocol::parse_hex(text);
+  if (!bytes) throw UsageError(std::string(what) + " '" + std::string(text) + "' is not hex bytes");
+  return *bytes;
+}
+
+struct EncodeArgs {
+  std::vector<std::string> words;
+  ProfileArgs profile;
+  bool unchecked = false;
+  std::string text_hex;
+  std::string unparsed;
+};
+
+void expect_count(const std::vector<std::string>& w, std::size_t min, std::size_t max,
+                  std::string_view usage) {
+  if (w.size() - 1 < min || w.size() - 1 > max) {
+    throw UsageError(w[0] + " takes " + std::string(usage));
+  }
+}
+
+// Builds the packet the words describe; throws UsageError for bad words.
+protocol::Bytes build_packet(const EncodeArgs& a, const wr8::Profile& profile) {
+  const auto& w = a.words;
+  const std::string form = normalised(w[0]);
+  const auto encode = [&](const wr8::Message& m) {
+    return a.unchecked ? wr8::encode_unchecked(m, profile) : wr8::encode(m, profile);
+  };
+  if (form == "empty") {
+    expect_count(w, 0, 0, "no arguments");
+    return encode(wr8::Empty{});
+  }
+  if (form == "auth") {
+    expect_count(w, 0, 1, "[TEXT] (10 characters) or --text-hex HEX");
+    wr8::Auth m{profile.auth_text};
+    if (!a.text_hex.empty() && w.size() > 1)
+      throw UsageError("auth takes TEXT or --text-hex, not both");
+    protocol::Bytes text;
+    if (!a.text_hex.empty()) text = parse_hex_arg(a.text_hex, "--text-hex");
+    if (w.size() > 1) text = protocol::to_bytes(w[1]);
+    if (!a.text_hex.empty() || w.size() > 1) {
+      if (text.size() != wr8::kAuthTextBytes) {
+        throw UsageError("the authentication string must be exactly 10 bytes, got " +
+                         std::to_string(text.size()));
+      }
+      std::copy(text.begin(), text.end(), m.text.begin());
+    }
+    return encode(m);
+  }
+  if (form == "auth_reply") {
+    expect_count(w, 3, 3, "DEVICE_CODE DEVICE_ID STATE");
+    return encode(wr8::AuthReply{parse_byte(w[1], "device code"), parse_byte(w[2], "device id"),
+                                 parse_state_arg(w[3])});
+  }
+  if (form == "task") {
+    expect_count(w, 2, 255, "COI TASK [VALUE...]");
+    wr8::Task m;
+    m.coi = parse_byte(w[1], "COI");
+    const auto t = wr8::parse_task(w[2]);
+    if (t) {
+      m.task = *t;
+    } else if (a.unchecked) {
+      m.task = static_cast<wr8::TaskCode>(parse_byte(w[2], "task code"));
+    } else {
+      throw UsageError("task '" + w[2] +
+                       "': expected check, drive, turn, blink, get-settings or 0..4");
+    }
+    const auto index = static_cast<std::size_t>(m.task);
+    const auto type =
+        index < wr8::kTaskCount ? profile.task_value_type[index] : wr8::ValueType::signed_int;
+    for (std::size_t i = 3; i < w.size(); ++i)
+      m.params.push_back(parse_word(w[i], type, 4, "task"));
+    if (!a.unchecked && index < wr8::kTaskCount &&
+        m.params.size() != profile.task_parameter_count[index]) {
+      throw UsageError("task " + std::string(wr8::to_string(m.task)) + " takes " +
+                       std::to_string(profile.task_parameter_count[index]) + " value(s), got " +
+                       std::to_string(m.params.size()) + " (--unchecked sends it anyway)");
+    }
+    return encode(m);
+  }
+  if (form == "settings") {
+    expect_count(w, 1, 255, "COI NAME=VALUE...");
+    wr8::Settings m;
+    m.coi = parse_byte(w[1], "COI");
+    for (std::size_t i = 2; i < w.size(); ++i) {
+      const auto [name, value] = split_assignment(w[i]);
+      auto code = wr8::parse_setting(name);
+      if (!code && a.unchecked)
+        code = static_cast<wr8::SettingCode>(parse_byte(name, "setting type"));
+      if (!code)
+        throw UsageError("setting '" + std::string(name) +
+                         "': expected p, i, d, servo-zero or 0..3");
+      const auto index = static_cast<std::size_t>(*code);
+      const auto type = index < wr8::kSettingCount ? profile.setting_value_type[index]
+                                                   : wr8::ValueType::signed_int;
+      m.params.push_back(wr8::Setting{*code, parse_word(value, type, 4, name)});
+    }
+    return encode(m);
+  }
+  if (form == "response") {
+    expect_count(w, 2, 2, "COI CODE");
+    wr8::Response m;
+    m.coi = parse_byte(w[1], "COI");
+    const auto code = wr8::parse_response(w[2]);
+    if (code) {
+      m.code = *code;
+    } else if (a.unchecked) {
+      m.code = static_cast<wr8::ResponseCode>(parse_byte(w[2], "response code"));
+    } else {
+      throw UsageError("response code '" + w[2] + "': expected error, started, completed or 0..2");
+    }
+    return encode(m);
+  }
+  if (form == "data") {
+    expect_count(w, 2, 257, "STATE TIMESTAMP_MS [NAME=VALUE...]");
+    wr8::Data m;
+    m.state = parse_state_arg(w[1]);
+    m.timestamp_ms = parse_unsigned(w[2], 0xFFFFFFFFu, "timestamp");
+    for (std::size_t i = 3; i < w.size(); ++i) {
+      const auto [name, value] = split_assignment(w[i]);
+      std::string key = normalised(name);
+      if (key == "angle") key = "wheel_angle";
+      const wr8::DataParameter* p = profile.data_parameter(key);
+      if (p == nullptr && !key.empty() && key[0] >= '0' && key[0] <= '9') {
+        p = profile.data_parameter(parse_byte(key, "DATA code"));
+      }
+      if (p == nullptr) {
+        throw UsageError(
+            "DATA parameter '" + std::string(name) +
+            "': expected odometry, speed, wheel-angle, battery or a code the profile sizes");
+      }
+      m.values.push_back(
+          wr8::DataValue{p->code, parse_word(value, p->type, p->size_bytes, p->name)});
+    }
+    if (!a.unparsed.empty()) m.unparsed = parse_hex_arg(a.unparsed, "--unparsed");
+    return encode(m);
+  }
+  if (form == "packet") {
+    expect_count(w, 1, 100000, "CODE [HEX...]");
+    protocol::Bytes body;
+    for (std::size_t i = 2; i < w.size(); ++i) {
+      const auto b = parse_hex_arg(w[i], "packet byte(s)");
+      body.insert(body.end(), b.begin(), b.end());
+    }
+    return wr8::raw_packet(parse_byte(w[1], "packet code"), body);
+  }
+  throw UsageError("unknown form '" + w[0] +
+                   "': expected empty, auth, auth-reply, task, settings, response, data or packet "
+                   "(see --help)");
+}
+
+}  // namespace
+
+void register_wr8(CommandSet& commands) {
+  auto enc_args = std::make_shared<EncodeArgs>();
+  auto* enc = commands.encode.add_subcommand(
+      "wr8", "WR8 packet from a form and its fields, e.g. task 1 drive 100");
+  enc->add_option("form", enc_args->words, "FORM [ARGS...]: see the forms below")->required();
+  add_profile_options(*enc, enc_args->profile);
+  enc->add_flag(
+      "--unchecked", enc_args->unchecked,
+      "Skip the profile's checks (parameter counts, codes outside the tables): fault injection");
+  enc->add_option("--text-hex", enc_args->text_hex, "auth: the 10 bytes of the string as hex");
+  enc->add_option(
+      "--unparsed", enc_args->unparsed,
+      "data: bytes appended to the block after the values (start with an unknown code)");
+  enc->footer(kEncodeFooter);
+  enc->callback([&run = commands.run, enc_args] {
+    run = [enc_args]() -> int {
+      try {
+        const auto packet = build_packet(*enc_args, profile_of(enc_args->profile));
+        std::cout << protocol::to_hex(packet) << '\n';
+        return 0;
+      } catch (const UsageError& e) {
+        std::cerr << "hil encode wr8: " << e.what() << '\n';
+      } catch (const std::invalid_argument& e) {
+        // The codec's own words; its "WR8 encode: " prefix repeats ours.
+        std::string_view what = e.what();
+        if (what.starts_with("WR8 encode: ")) what.remove_prefix(12);
+        std::cerr << "hil encode wr8: " << what << '\n';
+      }
+      return 1;
+    };
+  });
+
+  struct DecodeArgs {
+    DecodeInput input;
+    ProfileArgs profile;
+    std::string sender = "any";
+    std::size_t max_packet = 0;
+  };
+  auto dec_args = std::make_shared<DecodeArgs>();
+  auto* dec = commands.decode.add_subcommand("wr8", "Decode WR8 packets or a WR8 byte stream");
+  add_decode_input(*dec, dec_args->input, true);
+  add_profile_options(*dec, dec_args->profile);
+  dec->add_option("--sender", dec_args->sender,
+                  "Whose packets to expect: any (default), gui or vehicle; the other side's codes "
+                  "are reported as unknown_code")
+      ->check(CLI::IsMember({"any", "gui", "vehicle"}));
+  dec->add_option("--max-packet", dec_args->max_packet,
+                  "Longest packet in bytes (at least 16); longer ones are reported as oversized. "
+                  "Default: the longest the profile can declare");
+  dec->footer(kDecodeFooter);
+  dec->callback([&run = commands.run, dec_args] {
+    run = [dec_args]() -> int {
+      const auto bytes = read_decode_input(dec_args->input, true);
+      wr8::DecoderOptions options;
+      options.profile = profile_of(dec_args->profile);
+      options.sender = dec_args->sender == "gui"       ? wr8::Sender::gui
+                       : dec_args->sender == "vehicle" ? wr8::Sender::vehicle
+                                                       : wr8::Sender::any;
+      options.max_packet_bytes = dec_args->max_packet;
+      if (options.max_packet_bytes != 0 && options.max_packet_bytes < wr8::kMinPacketLimit) {
+        std::cerr << "hil decode wr8: --max-packet " << options.max_packet_bytes << " is below "
+                  << wr8::kMinPacketLimit << " (an AUTH packet alone is 11 bytes)\n";
+        return 1;
+      }
+      const wr8::Profile profile = options.profile;
+      return print_items<wr8::Message>(
+          wr8::Decoder(std::move(options)), bytes, true, dec_args->input,
+          [profile](const wr8::Message& m) { return wr8::describe(m, profile); });
+    };
+  });
+}
 
 }  // namespace hil::apps

@@ -367,8 +367,8 @@ void Decoder::flush_run(std::vector<Item>& out) {
   DecodeError e;
   e.kind = run_kind_;
   if (run_kind_ == ErrorKind::garbage) {
-    e.detail = plural(buf_.size(), "byte") + " that are no packet code (0..6) skipped, first " +
-               hex_byte(buf_.front());
+    e.detail = plural(buf_.size(), "byte") +
+               " skipped: not a packet code (codes are 0..6), first " + hex_byte(buf_.front());
   } else {
     e.context = std::string(to_string(static_cast<PacketCode>(buf_.front())));
     e.detail = plural(buf_.size(), "packet code byte") + " skipped: the " +
