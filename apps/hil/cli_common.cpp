@@ -17,7 +17,8 @@ void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary) {
   cmd.add_flag("--summary", input.summary, "End with the number of frames and of errors by kind");
   cmd.footer(
       "Prints one line per frame or error with its byte offset; errors show the raw bytes.\n"
-      "Exit status: 0 all frames valid, 1 some error found, 2 bad arguments or no input.");
+      "Exit status: 0 every frame valid; 1 an error found, or input that cannot be read;\n"
+      "2 a malformed command line.");
 }
 
 protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {

@@ -36,14 +36,14 @@ protocol::Bytes read_decode_input(const DecodeInput& input, bool binary);
 std::string render_bytes(protocol::ByteView bytes, bool binary);
 
 /// Prints one line per decoded item; returns the exit status: 0 when every
-/// item is a frame, 1 when any error was found, 2 when there was nothing.
+/// item is a frame, 1 when any error was found or there was nothing to decode.
 template <class Message, class Decoder>
 int print_items(Decoder decoder, protocol::ByteView bytes, bool binary, const DecodeInput& input,
                 const std::function<std::string(const Message&)>& describe, std::ostream& out = std::cout) {
   std::vector<protocol::DecodeItem<Message>> items;
   decoder.feed(bytes, items);
   decoder.finish(items);
-  int status = items.empty() ? 2 : 0;
+  int status = items.empty() ? 1 : 0;
   std::size_t offset = 0;
   for (const auto& item : items) {
     if (const auto* f = std::get_if<protocol::Frame<Message>>(&item)) {

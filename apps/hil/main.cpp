@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <iostream>
+#include <string_view>
 
 #include "apps/hil/cli_common.hpp"
 
@@ -28,11 +29,28 @@ int main(int argc, char** argv) {
   hil::apps::register_arduino(commands);
   hil::apps::register_leka(commands);
 
+  // CLI11 would only say "A subcommand is required"; name the protocols instead.
+  if (argc >= 3 && (std::string_view(argv[1]) == "encode" || std::string_view(argv[1]) == "decode") &&
+      argv[2][0] != '-') {
+    const std::string_view protocol = argv[2];
+    if (protocol != "logi" && protocol != "wr8" && protocol != "arduino" && protocol != "leka") {
+      std::cerr << "hil " << argv[1] << ": unknown protocol '" << protocol
+                << "' (expected logi, wr8, arduino or leka)\n";
+      return 2;
+    }
+  }
+
   try {
     app.parse(argc, argv);
-    return run ? run() : 0;
   } catch (const CLI::ParseError& e) {
-    // --help and --version exit 0; any usage error exits 2 after saying what was wrong.
+    // --help and --version exit 0; a malformed command line exits 2.
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    return run ? run() : 0;
+  } catch (const CLI::Error& e) {
+    // Well-formed command, unusable input (unreadable file, bad hex, ...).
+    std::cerr << "hil: " << e.what() << '\n';
+    return 1;
   }
 }

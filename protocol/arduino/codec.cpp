@@ -363,19 +363,7 @@ Decoder::Decoder(DecoderOptions options)
 
 void Decoder::convert(std::vector<Item>& out) {
   for (auto& event : events_) {
-    if (event.kind == DelimitedFramer::Kind::frame &&
-        event.bytes.size() > options_.max_frame_bytes) {
-      // The shared framer checks the bound only after a byte that is not the
-      // end marker, so it lets through a frame one byte over the bound; the
-      // receive guard this models drops that frame too.
-      const std::size_t n = event.bytes.size();
-      out.emplace_back(DecodeError{ErrorKind::oversized,
-                                   std::move(event.bytes),
-                                   "frame of " + std::to_string(n) + " bytes exceeds the " +
-                                       std::to_string(options_.max_frame_bytes) +
-                                       "-byte frame bound",
-                                   {}});
-    } else if (event.kind == DelimitedFramer::Kind::frame) {
+    if (event.kind == DelimitedFramer::Kind::frame) {
       out.push_back(decode_frame(event.bytes, options_));
     } else {
       out.emplace_back(framing_error(std::move(event), options_.max_frame_bytes));

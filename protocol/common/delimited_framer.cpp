@@ -27,7 +27,8 @@ void DelimitedFramer::feed(ByteView bytes, std::vector<Event>& out) {
   for (const std::uint8_t b : bytes) {
     buf_.push_back(b);
     if (in_frame_ && b == terminator_) {
-      emit(Kind::frame, buf_.size(), out);
+      // The bound counts the terminator too: one byte over it is oversized.
+      emit(buf_.size() <= max_frame_bytes_ ? Kind::frame : Kind::oversized, buf_.size(), out);
       in_frame_ = false;
       header_.reset();
       continue;

@@ -26,9 +26,9 @@ class DelimitedFramer {
     Bytes bytes;
   };
 
-  /// `max_frame_bytes` bounds a frame including header and terminator; the
-  /// framer never holds more than that many bytes (garbage is passed on in
-  /// chunks of at most the same size).
+  /// `max_frame_bytes` bounds a frame including header and terminator.
+  /// Between feeds the framer holds at most that many bytes; garbage and
+  /// oversized runs are passed on in pieces of at most max_frame_bytes + 1.
   DelimitedFramer(std::string_view header, std::uint8_t terminator, std::size_t max_frame_bytes);
 
   void feed(ByteView bytes, std::vector<Event>& out);

@@ -70,21 +70,28 @@ TEST(HilCli, DecodesHexInput) {
   EXPECT_THAT(r.output, HasSubstr("SetSpeed percent=50"));
 }
 
-TEST(HilCli, BadArgumentsExitTwoWithAMessage) {
+TEST(HilCli, MalformedCommandLinesExitTwoWithAMessage) {
   const auto missing = run_hil("encode logi");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_THAT(missing.output, HasSubstr("payload is required"));
 
+  const auto unknown = run_hil("encode nosuchcar X");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.output, HasSubstr("nosuchcar"));
+}
+
+TEST(HilCli, UnreadableInputExitsOneWithAMessage) {
   const auto no_file = run_hil("decode logi --file /nonexistent/capture");
-  EXPECT_EQ(no_file.exit_code, 2);
+  EXPECT_EQ(no_file.exit_code, 1);
   EXPECT_THAT(no_file.output, HasSubstr("cannot open '/nonexistent/capture'"));
 
   const auto bad_hex = run_hil("decode logi --hex 'GG'");
-  EXPECT_EQ(bad_hex.exit_code, 2);
+  EXPECT_EQ(bad_hex.exit_code, 1);
   EXPECT_THAT(bad_hex.output, HasSubstr("is not hex bytes"));
 
-  const auto unknown = run_hil("encode nosuchcar X");
-  EXPECT_EQ(unknown.exit_code, 2);
+  const auto nothing = run_hil("decode logi");
+  EXPECT_EQ(nothing.exit_code, 1);
+  EXPECT_THAT(nothing.output, HasSubstr("no bytes to decode"));
 }
 
 TEST(HilCli, HelpListsEveryProtocol) {

@@ -62,6 +62,16 @@ TEST(DelimitedFramer, OversizedFrameIsCutAtTheBound) {
   EXPECT_EQ(to_string(events.back().bytes), "AB:1#");
 }
 
+TEST(DelimitedFramer, BoundIncludesTheTerminator) {
+  const auto fits = run("AB:12345#", 9);
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_EQ(fits[0].kind, Kind::frame);
+  const auto over = run("AB:123456#", 9);
+  ASSERT_EQ(over.size(), 1u);
+  EXPECT_EQ(over[0].kind, Kind::oversized);
+  EXPECT_EQ(to_string(over[0].bytes), "AB:123456#");
+}
+
 TEST(DelimitedFramer, NeverHoldsMoreThanItsBound) {
   DelimitedFramer framer("AB:", '#', 16);
   std::vector<DelimitedFramer::Event> out;
