@@ -12,7 +12,7 @@ cmake --build --preset default --target hil
 
 hil=build/apps/hil/hil
 status=0
-for capture in scenarios/captures/*; do
+for capture in scenarios/captures/*.txt scenarios/captures/*.hex; do
   name=$(basename "$capture")
   protocol=${name%%-*}
   args=(decode "$protocol" --file "$capture" --no-raw --summary)

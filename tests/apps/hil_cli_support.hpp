@@ -15,8 +15,10 @@ struct CommandResult {
 };
 
 /// `args` is appended to the hil binary path as shell words (quote them).
+/// Runs in the source tree, so paths like scenarios/... work as in the docs.
 inline CommandResult run_hil(const std::string& args) {
-  const std::string command = std::string(HIL_BINARY) + " " + args + " 2>&1";
+  const std::string command =
+      std::string("cd '") + HIL_SOURCE_DIR + "' && '" + HIL_BINARY + "' " + args + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;

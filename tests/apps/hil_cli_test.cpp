@@ -58,8 +58,7 @@ TEST(HilCli, LenientLogiDecodeToleratesLowercaseChecksum) {
 }
 
 TEST(HilCli, DecodesAStreamFromAFileWithSummary) {
-  const auto r = run_hil(std::string("decode logi --no-raw --summary --file ") + HIL_SOURCE_DIR +
-                         "/scenarios/captures/logi-session.txt");
+  const auto r = run_hil("decode logi --no-raw --summary --file scenarios/captures/logi-session.txt");
   EXPECT_EQ(r.exit_code, 1);  // the capture holds deliberate errors
   EXPECT_THAT(r.output, HasSubstr("summary: 739 bytes, 13 frame(s), 4 error(s)"));
 }
@@ -92,6 +91,71 @@ TEST(HilCli, UnreadableInputExitsOneWithAMessage) {
   const auto nothing = run_hil("decode logi");
   EXPECT_EQ(nothing.exit_code, 1);
   EXPECT_THAT(nothing.output, HasSubstr("no bytes to decode"));
+}
+
+TEST(HilCli, EncodesArduinoWithSequenceNumber) {
+  const auto r = run_hil("encode arduino --seq 2 V 160");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.output, "^02|V|160*63$\n");
+  EXPECT_EQ(run_hil("encode arduino --seq 4 R -90").output, "^04|R|-90*72$\n");
+  EXPECT_EQ(run_hil("encode arduino --seq 8 STATUS").output, "^08|STATUS|*1C$\n");
+  EXPECT_EQ(run_hil("encode arduino --seq 2 V:160").output, "^02|V|160*63$\n");
+}
+
+TEST(HilCli, RefusesArduinoSpeedOutOfRange) {
+  const auto r = run_hil("encode arduino --seq 2 V 300");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("0..255"));
+}
+
+TEST(HilCli, DecodesArduinoRequest) {
+  const auto r = run_hil("decode arduino '^02|V|160*63$'");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("SetSpeed seq=02 pwm=160"));
+}
+
+TEST(HilCli, EncodesLekaFramesAsSpacedHex) {
+  EXPECT_EQ(run_hil("encode leka info").output, "2A 2B 2C 2D 01 70 70\n");
+  EXPECT_EQ(run_hil("encode leka led.belt.single 0 255 0 0").output, "2A 2B 2C 2D 05 15 00 FF 00 00 41\n");
+  const auto group = run_hil("encode leka led.ear.all 255 0 0 + motor.all 1 200");
+  EXPECT_EQ(group.exit_code, 0);
+  EXPECT_THAT(group.output, HasSubstr("2A 2B 2C 2D 07 11 FF 00 00 21 01 C8"));
+}
+
+TEST(HilCli, DecodesLekaFrame) {
+  const auto r = run_hil("decode leka 2A 2B 2C 2D 05 15 00 FF 00 00 41");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("led.belt.single"));
+  const auto bad = run_hil("decode leka 2A 2B 2C 2D 05 15 00 FF 00 00 42");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output, HasSubstr("bad_checksum"));
+}
+
+TEST(HilCli, EncodesAndDecodesWr8) {
+  EXPECT_EQ(run_hil("encode wr8 task 1 drive 100").output, "03 01 01 04 64 00 00 00\n");
+  EXPECT_EQ(run_hil("encode wr8 response 1 completed").output, "05 01 02\n");
+  const auto r = run_hil("decode wr8 03 01 01 04 64 00 00 00");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("Task"));
+  EXPECT_THAT(r.output, HasSubstr("100"));
+}
+
+TEST(HilCli, EveryCaptureDecodesWithTheErrorsItWasMadeWith) {
+  struct Capture {
+    const char* args;
+    const char* summary;
+  };
+  for (const Capture& c : {
+           Capture{"arduino --file scenarios/captures/arduino-session.txt",
+                   "summary: 243 bytes, 15 frame(s), 4 error(s), 1 bad_checksum, 1 bad_format, 1 bad_value, 1 garbage"},
+           Capture{"wr8 --hex --file scenarios/captures/wr8-vehicle.hex",
+                   "summary: 165 bytes, 12 frame(s), 1 error(s), 1 garbage"},
+           Capture{"leka --hex --file scenarios/captures/leka-master.hex",
+                   "summary: 86 bytes, 6 frame(s), 3 error(s), 1 bad_checksum, 1 bad_value, 1 truncated"},
+       }) {
+    const auto r = run_hil(std::string("decode ") + c.args + " --summary --no-raw");
+    EXPECT_THAT(r.output, HasSubstr(c.summary)) << c.args;
+  }
 }
 
 TEST(HilCli, HelpListsEveryProtocol) {
