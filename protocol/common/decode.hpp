@@ -50,6 +50,13 @@ struct Frame {
 template <class Message>
 using DecodeItem = std::variant<Frame<Message>, DecodeError>;
 
+/// The exact bytes an item was made from, frame or error.
+template <class Message>
+const Bytes& raw_of(const DecodeItem<Message>& item) {
+  if (const auto* e = std::get_if<DecodeError>(&item)) return e->raw;
+  return std::get<Frame<Message>>(item).raw;
+}
+
 /// Incremental matcher for a fixed start sequence (a frame header), fed one
 /// byte at a time. Keeps the length of the longest header prefix that ends at
 /// the last byte, so a header split across reads or preceded by a partial

@@ -41,9 +41,7 @@ std::vector<protocol::DecodeItem<Message>> feed_and_check(Decoder& decoder, std:
   check(decoder.buffered() == 0, "finish() left bytes behind");
   std::vector<std::uint8_t> joined;
   for (const auto& item : items) {
-    const auto& raw = std::holds_alternative<protocol::DecodeError>(item)
-                          ? std::get<protocol::DecodeError>(item).raw
-                          : std::get<protocol::Frame<Message>>(item).raw;
+    const auto& raw = protocol::raw_of(item);
     joined.insert(joined.end(), raw.begin(), raw.end());
   }
   check(joined.size() == stream.size() && std::equal(joined.begin(), joined.end(), stream.begin()),

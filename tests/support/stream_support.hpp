@@ -53,6 +53,18 @@ std::vector<Message> messages_of(const std::vector<protocol::DecodeItem<Message>
   return out;
 }
 
+/// The raw bytes of all items, joined: equals the input when every byte is
+/// accounted for exactly once.
+template <class Message>
+Bytes raw_of_all(const std::vector<protocol::DecodeItem<Message>>& items) {
+  Bytes out;
+  for (const auto& item : items) {
+    const Bytes& raw = protocol::raw_of(item);
+    out.insert(out.end(), raw.begin(), raw.end());
+  }
+  return out;
+}
+
 /// Number of error items of a kind.
 template <class Message>
 std::size_t count_errors(const std::vector<protocol::DecodeItem<Message>>& items, protocol::ErrorKind kind) {

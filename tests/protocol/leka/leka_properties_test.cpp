@@ -14,17 +14,7 @@ using test::concat;
 using test::decode_chunked;
 using test::decode_whole;
 using test::messages_of;
-
-Bytes raw_of_all(const std::vector<Item>& items) {
-  Bytes out;
-  for (const auto& item : items) {
-    const Bytes& raw = std::holds_alternative<DecodeError>(item)
-                           ? std::get<DecodeError>(item).raw
-                           : std::get<Frame<Message>>(item).raw;
-    out.insert(out.end(), raw.begin(), raw.end());
-  }
-  return out;
-}
+using test::raw_of_all;
 
 bool contains_start(const Bytes& b) {
   return std::search(b.begin(), b.end(), kStartSequence.begin(), kStartSequence.end()) != b.end();
