@@ -15,7 +15,14 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hil 0.1.0");
   app.footer(
       "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, binary).\n"
-      "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for each protocol's forms.\n");
+      "Examples:\n"
+      "  hil encode logi SP:050                      LOGI:SP:050:D7#\n"
+      "  hil encode wr8 task 1 drive 100             03 01 01 04 64 00 00 00\n"
+      "  hil encode arduino --seq 2 V 160            ^02|V|160*63$\n"
+      "  hil encode leka led.belt.single 0 255 0 0   2A 2B 2C 2D 05 15 00 FF 00 00 41\n"
+      "  hil decode logi 'LOGI:SP:050:D7#'\n"
+      "  hil decode leka --hex --file capture.hex --summary\n"
+      "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode = app.add_subcommand("encode", "Print the frame for a message (binary frames as hex)");
   encode->require_subcommand(1);
