@@ -1,0 +1,216 @@
+#include "link/capture/wire_log.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <fstream>
+#include <stdexcept>
+#include <utility>
+
+namespace hil::link {
+
+namespace {
+
+constexpr std::size_t kSent = 0;
+constexpr std::size_t kDelivered = 1;
+constexpr const char* kKindNames[2] = {"sent", "delivered"};
+
+std::size_t index_of(Direction d) {
+  return static_cast<std::size_t>(d);
+}
+
+// Milliseconds rounded to whole microseconds, so a log never shows float
+// noise below the precision it promises.
+double ms_with_us_precision(Time at) {
+  const auto us = std::chrono::round<std::chrono::microseconds>(at).count();
+  return static_cast<double>(us) / 1000.0;
+}
+
+bool is_text_byte(std::uint8_t b) {
+  return (b >= 0x20 && b <= 0x7E) || b == '\t' || b == '\r' || b == '\n';
+}
+
+nlohmann::json frames_json(const std::vector<WireFrame>& frames) {
+  auto list = nlohmann::json::array();
+  for (const auto& f : frames) {
+    list.push_back({{"kind", f.kind}, {"valid", f.valid}, {"text", f.text}});
+  }
+  return list;
+}
+
+}  // namespace
+
+void put_bytes(nlohmann::json& record, protocol::ByteView bytes) {
+  record["bytes"] = bytes.size();
+  bool text = true;
+  for (auto b : bytes) {
+    if (!is_text_byte(b)) {
+      text = false;
+      break;
+    }
+  }
+  if (text) {
+    record["text"] = protocol::to_string(bytes);
+  } else {
+    record["hex"] = protocol::to_hex(bytes);
+  }
+}
+
+protocol::Bytes bytes_of(const nlohmann::json& record) {
+  if (auto it = record.find("text"); it != record.end() && it->is_string()) {
+    return protocol::to_bytes(it->get<std::string>());
+  }
+  if (auto it = record.find("hex"); it != record.end() && it->is_string()) {
+    return protocol::parse_hex(it->get<std::string>()).value_or(protocol::Bytes{});
+  }
+  return {};
+}
+
+std::shared_ptr<WireLog> WireLog::open(const std::filesystem::path& path, WireLogOptions options,
+                                       std::error_code& ec) {
+  ec.clear();
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    ec.assign(errno, std::generic_category());
+    return nullptr;
+  }
+  return std::shared_ptr<WireLog>(new WireLog(path, fd, std::move(options)));
+}
+
+WireLog::WireLog(std::filesystem::path path, int fd, WireLogOptions options)
+    : path_(std::move(path)), fd_(fd), options_(std::move(options)) {
+  if (!options_.wall_clock_us) options_.wall_clock_us = [] { return wall_time_us(); };
+  if (options_.protocol) {
+    for (auto& kind : splitters_) {
+      for (auto& s : kind)
+        s = options_.protocol->splitter();
+    }
+  }
+}
+
+WireLog::~WireLog() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+nlohmann::json WireLog::record(const char* event, Time at) const {
+  nlohmann::json r;
+  r["link"] = options_.link_id;
+  r["event"] = event;
+  r["t_ms"] = ms_with_us_precision(at);
+  r["wall_us"] = options_.wall_clock_us();
+  return r;
+}
+
+void WireLog::on_open(Time at, const std::string& client, const std::string& car) {
+  auto r = record("open", at);
+  r["client"] = client;
+  r["car"] = car;
+  r["protocol"] = options_.protocol ? std::string(options_.protocol->name()) : std::string("raw");
+  write_line(r);
+}
+
+void WireLog::on_sent(Time at, Direction d, protocol::ByteView bytes) {
+  on_bytes(kKindNames[kSent], kSent, at, d, bytes);
+}
+
+void WireLog::on_delivered(Time at, Direction d, protocol::ByteView bytes) {
+  on_bytes(kKindNames[kDelivered], kDelivered, at, d, bytes);
+}
+
+void WireLog::on_bytes(const char* event, std::size_t kind_index, Time at, Direction d,
+                       protocol::ByteView bytes) {
+  auto r = record(event, at);
+  r["dir"] = std::string(to_string(d));
+  put_bytes(r, bytes);
+  if (auto& splitter = splitters_[kind_index][index_of(d)]) {
+    std::vector<WireFrame> frames;
+    splitter->feed(bytes, frames);
+    r["frames"] = frames_json(frames);
+    r["held"] = splitter->buffered();
+  }
+  write_line(r);
+}
+
+void WireLog::on_fault(const FaultEvent& event) {
+  auto r = record("fault", event.at);
+  r["dir"] = std::string(to_string(event.direction));
+  r["kind"] = event.kind;
+  r["rule"] = event.rule;
+  r["detail"] = event.detail;
+  nlohmann::json before;
+  nlohmann::json after;
+  put_bytes(before, event.before);
+  put_bytes(after, event.after);
+  r["before"] = std::move(before);
+  r["after"] = std::move(after);
+  write_line(r);
+}
+
+void WireLog::on_close(Time at, const std::string& reason) {
+  auto r = record("close", at);
+  r["reason"] = reason;
+  // A partial frame still held at close is the last thing a reader of the
+  // log wants to miss ("the car cut the STAT frame in half"): list it.
+  auto leftovers = nlohmann::json::array();
+  for (std::size_t kind = 0; kind < 2; ++kind) {
+    for (std::size_t dir = 0; dir < 2; ++dir) {
+      auto& splitter = splitters_[kind][dir];
+      if (!splitter) continue;
+      std::vector<WireFrame> frames;
+      splitter->finish(frames);
+      if (frames.empty()) continue;
+      leftovers.push_back({{"event", kKindNames[kind]},
+                           {"dir", std::string(to_string(static_cast<Direction>(dir)))},
+                           {"frames", frames_json(frames)}});
+    }
+  }
+  if (!leftovers.empty()) r["unfinished"] = std::move(leftovers);
+  write_line(r);
+}
+
+void WireLog::write_line(const nlohmann::json& record) {
+  // Invalid UTF-8 cannot reach here (text is ASCII only, the rest is hex),
+  // but frame texts come from decoders: replace rather than throw.
+  std::string line = record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  line.push_back('\n');
+  // One write(2) per line on an O_APPEND descriptor: no user-space buffer
+  // to lose in a crash, and the kernel appends the whole line at the end of
+  // the file even when other links log to the same path.
+  const char* data = line.data();
+  std::size_t left = line.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd_, data, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (!error_) error_.assign(errno, std::generic_category());
+      return;
+    }
+    data += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  ++records_written_;
+}
+
+std::vector<nlohmann::json> read_wire_log(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open the wire log");
+  std::vector<nlohmann::json> records;
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const bool complete = !in.eof();  // getline stopped at a newline
+    if (line.empty()) continue;
+    auto parsed = nlohmann::json::parse(line, nullptr, false);
+    if (parsed.is_discarded() || !parsed.is_object()) {
+      if (!complete) break;
+      throw std::runtime_error(path.string() + ":" + std::to_string(line_no) +
+                               ": expected one JSON object per line");
+    }
+    records.push_back(std::move(parsed));
+  }
+  return records;
+}
+
+}  // namespace hil::link
