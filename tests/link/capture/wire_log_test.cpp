@@ -1,0 +1,321 @@
+#include "link/capture/wire_log.hpp"
+
+#include <cstdlib>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "tests/link/capture/capture_support.hpp"
+
+namespace hil::link {
+namespace {
+
+using protocol::to_bytes;
+using test::ScratchFile;
+
+constexpr std::int64_t kWallUs = 1'700'000'000'123'456;
+
+struct LogFixture : ::testing::Test {
+  ScratchFile file{".ndjson"};
+  std::int64_t wall_us = kWallUs;
+
+  std::shared_ptr<WireLog> make(
+      std::shared_ptr<const ProtocolAdapter> protocol = protocol_adapter("logi"),
+      std::string link_id = "car0") {
+    WireLogOptions options;
+    options.link_id = std::move(link_id);
+    options.protocol = std::move(protocol);
+    options.wall_clock_us = [this] { return wall_us; };
+    std::error_code ec;
+    auto log = WireLog::open(file.path(), std::move(options), ec);
+    EXPECT_FALSE(ec) << ec.message();
+    return log;
+  }
+  std::vector<nlohmann::json> records() const { return read_wire_log(file.path()); }
+};
+
+using WireLogTest = LogFixture;
+
+TEST_F(WireLogTest, OpenRecordCarriesTimesSidesAndProtocol) {
+  auto log = make();
+  log->on_open(milliseconds(5), "tcp 127.0.0.1:9000 <- 127.0.0.1:53422", "mem car0");
+  const auto r = records();
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0]["event"], "open");
+  EXPECT_EQ(r[0]["link"], "car0");
+  EXPECT_EQ(r[0]["t_ms"], 5.0);
+  EXPECT_EQ(r[0]["wall_us"], kWallUs);
+  EXPECT_EQ(r[0]["client"], "tcp 127.0.0.1:9000 <- 127.0.0.1:53422");
+  EXPECT_EQ(r[0]["car"], "mem car0");
+  EXPECT_EQ(r[0]["protocol"], "logi");
+}
+
+TEST_F(WireLogTest, LinkTimeIsMillisecondsRoundedToMicroseconds) {
+  auto log = make(nullptr);
+  log->on_sent(Time{12'345'678}, Direction::to_car, to_bytes("a"));
+  log->on_sent(seconds(90), Direction::to_car, to_bytes("b"));
+  log->on_sent(Time{999}, Direction::to_car, to_bytes("c"));
+  const auto r = records();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0]["t_ms"].get<double>(), 12.346);
+  EXPECT_EQ(r[1]["t_ms"].get<double>(), 90000.0);
+  EXPECT_EQ(r[2]["t_ms"].get<double>(), 0.001);
+  // The number is written as a person would read it, with no float noise.
+  EXPECT_NE(file.contents().find("\"t_ms\":12.346,"), std::string::npos) << file.contents();
+}
+
+TEST_F(WireLogTest, PrintableBytesAreTextAndAnythingElseIsHex) {
+  auto log = make(nullptr);
+  log->on_sent(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+  log->on_sent(milliseconds(2), Direction::to_client, protocol::Bytes{0x2A, 0x2B, 0x00, 0xFF});
+  log->on_sent(milliseconds(3), Direction::to_client, to_bytes("OK\r\n\t\"q\"\\"));
+  const auto r = records();
+  ASSERT_EQ(r.size(), 3u);
+
+  EXPECT_EQ(r[0]["event"], "sent");
+  EXPECT_EQ(r[0]["dir"], "to_car");
+  EXPECT_EQ(r[0]["bytes"], 15);
+  EXPECT_EQ(r[0]["text"], "LOGI:SP:050:D7#");
+  EXPECT_FALSE(r[0].contains("hex"));
+
+  EXPECT_EQ(r[1]["dir"], "to_client");
+  EXPECT_EQ(r[1]["bytes"], 4);
+  EXPECT_EQ(r[1]["hex"], "2A 2B 00 FF");
+  EXPECT_FALSE(r[1].contains("text"));
+
+  // CR, LF and tab stay text: JSON escapes them exactly.
+  EXPECT_EQ(r[2]["text"], "OK\r\n\t\"q\"\\");
+  EXPECT_EQ(bytes_of(r[2]), to_bytes("OK\r\n\t\"q\"\\"));
+  EXPECT_EQ(bytes_of(r[1]), (protocol::Bytes{0x2A, 0x2B, 0x00, 0xFF}));
+}
+
+TEST_F(WireLogTest, WithoutAProtocolNoFramesAreWritten) {
+  auto log = make(nullptr);
+  log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+  const auto r = records();
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0]["event"], "delivered");
+  EXPECT_FALSE(r[0].contains("frames"));
+}
+
+TEST_F(WireLogTest, LogiFrameSplitAcrossTwoDeliveriesIsDecodedWhenItCompletes) {
+  auto log = make();
+  log->on_sent(milliseconds(10), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+  log->on_delivered(milliseconds(11), Direction::to_car, to_bytes("LOGI:SP:0"));
+  log->on_delivered(milliseconds(14), Direction::to_car, to_bytes("50:D7#LOGI:"));
+  const auto r = records();
+  ASSERT_EQ(r.size(), 3u);
+
+  // What the client wrote was one whole frame.
+  ASSERT_EQ(r[0]["frames"].size(), 1u);
+  EXPECT_EQ(r[0]["frames"][0]["kind"], "SP");
+  EXPECT_EQ(r[0]["frames"][0]["valid"], true);
+  EXPECT_EQ(r[0]["held"], 0);
+
+  // The car got it in two pieces: no frame yet, then the frame, with the
+  // start of the next one held.
+  EXPECT_EQ(r[1]["frames"].size(), 0u);
+  EXPECT_EQ(r[1]["held"], 9);
+  ASSERT_EQ(r[2]["frames"].size(), 1u);
+  EXPECT_EQ(r[2]["frames"][0]["kind"], "SP");
+  EXPECT_EQ(r[2]["frames"][0]["valid"], true);
+  EXPECT_FALSE(r[2]["frames"][0]["text"].get<std::string>().empty());
+  EXPECT_EQ(r[2]["held"], 5);
+}
+
+TEST_F(WireLogTest, DirectionsAndSentVersusDeliveredAreSplitSeparately) {
+  auto log = make();
+  // Half a frame each way, then the rest: had one splitter served both
+  // directions, the halves would glue into garbage.
+  log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:"));
+  log->on_delivered(milliseconds(1), Direction::to_client, to_bytes("LOGI:FB:"));
+  log->on_sent(milliseconds(1), Direction::to_car, to_bytes("LOGI:"));
+  log->on_delivered(milliseconds(2), Direction::to_car, to_bytes("050:D7#"));
+  log->on_delivered(milliseconds(2), Direction::to_client, to_bytes("SP:1:35#"));
+  const auto r = records();
+  ASSERT_EQ(r.size(), 5u);
+  ASSERT_EQ(r[3]["frames"].size(), 1u);
+  EXPECT_EQ(r[3]["frames"][0]["valid"], true);
+  EXPECT_EQ(r[3]["frames"][0]["kind"], "SP");
+  ASSERT_EQ(r[4]["frames"].size(), 1u);
+  EXPECT_EQ(r[4]["frames"][0]["valid"], true);
+  EXPECT_EQ(r[4]["frames"][0]["kind"].get<std::string>().rfind("FB", 0), 0u) << r[4].dump();
+}
+
+TEST_F(WireLogTest, CorruptedFrameIsLoggedAsInvalid) {
+  auto log = make();
+  log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D8#"));
+  const auto r = records();
+  ASSERT_EQ(r[0]["frames"].size(), 1u);
+  EXPECT_EQ(r[0]["frames"][0]["valid"], false);
+  EXPECT_FALSE(r[0]["frames"][0]["text"].get<std::string>().empty());
+}
+
+TEST_F(WireLogTest, FaultRecordShowsRuleAndBytesBeforeAndAfter) {
+  auto log = make();
+  FaultEvent e;
+  e.at = Time{2'500'000};
+  e.direction = Direction::to_client;
+  e.kind = "corrupt";
+  e.rule = "flip-checksum";
+  e.before = to_bytes("LOGI:FB:SP:1:35#");
+  e.after = protocol::Bytes{'L', 'O', 0x00};
+  e.detail = "checksum field flipped";
+  log->on_fault(e);
+  const auto r = records();
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0]["event"], "fault");
+  EXPECT_EQ(r[0]["t_ms"], 2.5);
+  EXPECT_EQ(r[0]["wall_us"], kWallUs);
+  EXPECT_EQ(r[0]["dir"], "to_client");
+  EXPECT_EQ(r[0]["kind"], "corrupt");
+  EXPECT_EQ(r[0]["rule"], "flip-checksum");
+  EXPECT_EQ(r[0]["detail"], "checksum field flipped");
+  EXPECT_EQ(r[0]["before"]["bytes"], 16);
+  EXPECT_EQ(r[0]["before"]["text"], "LOGI:FB:SP:1:35#");
+  EXPECT_EQ(r[0]["after"]["bytes"], 3);
+  EXPECT_EQ(r[0]["after"]["hex"], "4C 4F 00");
+}
+
+TEST_F(WireLogTest, DropFaultHasEmptyAfter) {
+  auto log = make();
+  FaultEvent e;
+  e.kind = "drop";
+  e.before = to_bytes("LOGI:SP:050:D7#");
+  log->on_fault(e);
+  const auto r = records();
+  EXPECT_EQ(r[0]["after"]["bytes"], 0);
+  EXPECT_EQ(r[0]["after"]["text"], "");
+}
+
+TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
+  auto log = make();
+  log->on_delivered(milliseconds(1), Direction::to_client, to_bytes("LOGI:STAT:1:"));
+  wall_us = kWallUs + 7;
+  log->on_close(milliseconds(3), "car closed");
+  const auto r = records();
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1]["event"], "close");
+  EXPECT_EQ(r[1]["reason"], "car closed");
+  EXPECT_EQ(r[1]["t_ms"], 3.0);
+  EXPECT_EQ(r[1]["wall_us"], kWallUs + 7);
+  ASSERT_EQ(r[1]["unfinished"].size(), 1u);
+  EXPECT_EQ(r[1]["unfinished"][0]["event"], "delivered");
+  EXPECT_EQ(r[1]["unfinished"][0]["dir"], "to_client");
+  ASSERT_EQ(r[1]["unfinished"][0]["frames"].size(), 1u);
+  EXPECT_EQ(r[1]["unfinished"][0]["frames"][0]["valid"], false);
+}
+
+TEST_F(WireLogTest, CleanCloseHasNoUnfinishedField) {
+  auto log = make();
+  log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+  log->on_close(milliseconds(3), "closed by hil");
+  EXPECT_FALSE(records().back().contains("unfinished"));
+}
+
+TEST_F(WireLogTest, EveryRecordIsOnDiskWhenTheCallReturns) {
+  auto log = make();
+  log->on_open(Time{0}, "client", "car");
+  for (int i = 1; i <= 20; ++i) {
+    log->on_sent(milliseconds(i), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+    // Read back through a separate descriptor, the writer still open.
+    const auto text = file.contents();
+    ASSERT_FALSE(text.empty());
+    EXPECT_EQ(text.back(), '\n');
+    const auto r = records();
+    ASSERT_EQ(r.size(), static_cast<std::size_t>(i + 1));
+    EXPECT_EQ(r.back()["t_ms"], static_cast<double>(i));
+  }
+  EXPECT_EQ(log->records_written(), 21u);
+  EXPECT_FALSE(log->error());
+}
+
+TEST_F(WireLogTest, ACrashLosesNothingAlreadyLogged) {
+  auto log = make();
+  // A forked child logs and aborts: no destructor, no flush, no close.
+  EXPECT_DEATH(
+      {
+        log->on_open(Time{0}, "client", "car");
+        log->on_sent(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+        log->on_delivered(milliseconds(2), Direction::to_car, to_bytes("LOGI:SP:0"));
+        std::abort();
+      },
+      "");
+  const auto r = records();
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[2]["text"], "LOGI:SP:0");
+}
+
+TEST_F(WireLogTest, SeveralLinksShareOneFileLineByLine) {
+  auto a = make(protocol_adapter("logi"), "a");
+  auto b = make(nullptr, "b");
+  for (int i = 0; i < 50; ++i) {
+    a->on_sent(milliseconds(i), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+    b->on_sent(milliseconds(i), Direction::to_client, protocol::Bytes(300, 0xAB));
+  }
+  const auto r = records();
+  ASSERT_EQ(r.size(), 100u);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    EXPECT_EQ(r[i]["link"], i % 2 == 0 ? "a" : "b");
+  }
+  EXPECT_EQ(bytes_of(r[1]), protocol::Bytes(300, 0xAB));
+}
+
+TEST_F(WireLogTest, AppendsToAnExistingLog) {
+  make()->on_open(Time{0}, "c", "k");
+  make()->on_open(Time{0}, "c", "k");
+  EXPECT_EQ(records().size(), 2u);
+}
+
+TEST(WireLogOpen, UnwritablePathGivesAnErrorNotAnException) {
+  std::error_code ec;
+  auto log = WireLog::open("/nonexistent-dir/for/hil/wire.ndjson", {}, ec);
+  EXPECT_EQ(log, nullptr);
+  EXPECT_EQ(ec, std::errc::no_such_file_or_directory);
+}
+
+TEST(ReadWireLog, FinalPartialLineIsSkipped) {
+  ScratchFile file(".ndjson");
+  {
+    std::ofstream out(file.path());
+    out << R"({"event":"open","link":"a"})" << '\n'
+        << R"({"event":"sent","link":"a","text":"LOGI"})" << '\n'
+        << R"({"event":"sent","li)";
+  }
+  const auto r = read_wire_log(file.path());
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1]["text"], "LOGI");
+}
+
+TEST(ReadWireLog, FinalLineWithoutNewlineThatParsesIsKept) {
+  ScratchFile file(".ndjson");
+  {
+    std::ofstream out(file.path());
+    out << R"({"event":"open"})" << '\n' << R"({"event":"close"})";
+  }
+  EXPECT_EQ(read_wire_log(file.path()).size(), 2u);
+}
+
+TEST(ReadWireLog, BrokenLineInTheMiddleNamesFileAndLine) {
+  ScratchFile file(".ndjson");
+  {
+    std::ofstream out(file.path());
+    out << R"({"event":"open"})" << '\n'
+        << "not json\n"
+        << R"({"event":"close"})" << '\n';
+  }
+  try {
+    read_wire_log(file.path());
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(file.path().string() + ":2:"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ReadWireLog, MissingFileThrows) {
+  EXPECT_THROW(read_wire_log("/nonexistent-dir/wire.ndjson"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace hil::link
