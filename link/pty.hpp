@@ -1,0 +1,118 @@
+#pragma once
+// Pseudo-terminal transport for the real-time driver: hil plays the serial
+// device behind a pty whose slave side a client opens through a stable
+// symlink (e.g. /tmp/hil-arduino0), with serial pacing and the Arduino
+// "reset on open" quirk.
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <asio/io_context.hpp>
+
+#include "link/byte_pipe.hpp"
+#include "link/endpoint.hpp"
+#include "link/executor.hpp"
+
+namespace hil::link {
+
+/// Releases bytes at a serial line's rate: 8N1 framing, 10 bits per byte, so
+/// byte k of a burst is complete at start + (k + 1) * 10 / baud seconds
+/// (9600 baud: 1.0417 ms per byte). Bytes are handed to the sink in the
+/// chunks that are due when a timer fires; a timer fires at most once per
+/// `min_tick`, so high rates do not cost one timer per byte.
+class SerialPacer {
+ public:
+  using Sink = std::function<void(ByteView)>;
+
+  SerialPacer(Executor& executor, unsigned baud, Sink sink, Duration min_tick = milliseconds(1));
+  ~SerialPacer();
+  SerialPacer(const SerialPacer&) = delete;
+  SerialPacer& operator=(const SerialPacer&) = delete;
+
+  void push(ByteView bytes);
+  /// Drops what has not been released yet.
+  void clear();
+  std::size_t queued() const { return queue_.size(); }
+  /// Runs `done` once everything pushed so far has been released (at once
+  /// if nothing is queued).
+  void when_drained(std::function<void()> done);
+
+  /// Time on the line of one byte at `baud` (8N1), rounded down to 1 ns.
+  static Duration byte_time(unsigned baud);
+
+ private:
+  Time completion(std::uint64_t k) const;
+  void schedule();
+  void release();
+
+  Executor& executor_;
+  unsigned baud_;
+  Sink sink_;
+  Duration min_tick_;
+  std::deque<std::uint8_t> queue_;
+  Time burst_start_{0};
+  std::uint64_t released_ = 0;  // bytes of this burst already released
+  Executor::TimerId timer_ = 0;
+  Time last_release_{0};
+  std::function<void()> on_drained_;
+  std::shared_ptr<int> alive_ = std::make_shared<int>(0);
+};
+
+/// Serial behaviour of a pty, from the endpoint's options.
+struct PtyOptions {
+  unsigned baud = 0;                       ///< 0: bytes pass as fast as the pty takes them
+  Duration reset_on_open{0};               ///< client bytes within this long after open are lost
+  Duration poll_period{milliseconds(10)};  ///< how often the slave's open/close is checked
+  /// Told about what the client cannot see (bytes lost to reset_on_open);
+  /// null means silent.
+  std::function<void(const std::string&)> log;
+};
+
+/// The device side of a pty. "Listening" creates the pty, puts it in raw
+/// mode and points the symlink at its slave; each time a client opens the
+/// slave, on_accept gets a BytePipe for that session, and the pipe closes
+/// with eof when the client closes the port. One session at a time.
+///
+/// Linux tells the master nothing when the slave is opened: the master sees
+/// POLLHUP while no process holds the slave open, so the listener polls
+/// every poll_period. A client's open is noticed up to one poll_period late
+/// (its bytes wait in the pty meanwhile; the reset_on_open window counts
+/// from the moment the open is noticed); a close is noticed at once while
+/// a session reads.
+class PtyListener final : public Listener {
+ public:
+  /// Creates the pty and the symlink at once. Throws std::system_error
+  /// naming the path when the pty cannot be made or the path is taken by
+  /// something other than a symlink.
+  PtyListener(asio::io_context& io, Executor& executor, const std::string& path,
+              PtyOptions options = {});
+  PtyListener(asio::io_context& io, Executor& executor, const PtyEndpoint& endpoint);
+  ~PtyListener() override;
+
+  void start(std::function<void(BytePipePtr)> on_accept) override;
+  /// Ends the session (the client sees a hang-up), closes the pty and
+  /// removes the symlink.
+  void close() override;
+  std::string address() const override;
+
+  /// The pty's slave device, e.g. /dev/pts/3.
+  std::string slave_path() const;
+  /// Bytes the client wrote inside a reset_on_open window, over all sessions.
+  std::uint64_t bytes_lost_to_reset() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+/// Opens a serial port or pty slave as a client would (O_NOCTTY, raw mode,
+/// the endpoint's baud set on the line when it is a standard rate). No
+/// software pacing on this side: a real port is paced by its hardware and
+/// a hil pty by the listener. The handler runs as a task on `executor`.
+void pty_connect(asio::io_context& io, Executor& executor, const PtyEndpoint& endpoint,
+                 ConnectHandler handler);
+
+}  // namespace hil::link
