@@ -31,17 +31,16 @@ bool is_text_byte(std::uint8_t b) {
   return (b >= 0x20 && b <= 0x7E) || b == '\t' || b == '\r' || b == '\n';
 }
 
-nlohmann::json frames_json(const std::vector<WireFrame>& frames) {
-  auto list = nlohmann::json::array();
+nlohmann::ordered_json frames_json(const std::vector<WireFrame>& frames) {
+  auto list = nlohmann::ordered_json::array();
   for (const auto& f : frames) {
     list.push_back({{"kind", f.kind}, {"valid", f.valid}, {"text", f.text}});
   }
   return list;
 }
 
-}  // namespace
-
-void put_bytes(nlohmann::json& record, protocol::ByteView bytes) {
+template <class Json>
+void put_bytes_into(Json& record, protocol::ByteView bytes) {
   record["bytes"] = bytes.size();
   bool text = true;
   for (auto b : bytes) {
@@ -55,6 +54,15 @@ void put_bytes(nlohmann::json& record, protocol::ByteView bytes) {
   } else {
     record["hex"] = protocol::to_hex(bytes);
   }
+}
+
+}  // namespace
+
+void put_bytes(nlohmann::json& record, protocol::ByteView bytes) {
+  put_bytes_into(record, bytes);
+}
+void put_bytes(nlohmann::ordered_json& record, protocol::ByteView bytes) {
+  put_bytes_into(record, bytes);
 }
 
 protocol::Bytes bytes_of(const nlohmann::json& record) {
@@ -93,8 +101,8 @@ WireLog::~WireLog() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-nlohmann::json WireLog::record(const char* event, Time at) const {
-  nlohmann::json r;
+nlohmann::ordered_json WireLog::record(const char* event, Time at) const {
+  nlohmann::ordered_json r;
   r["link"] = options_.link_id;
   r["event"] = event;
   r["t_ms"] = ms_with_us_precision(at);
@@ -138,8 +146,8 @@ void WireLog::on_fault(const FaultEvent& event) {
   r["kind"] = event.kind;
   r["rule"] = event.rule;
   r["detail"] = event.detail;
-  nlohmann::json before;
-  nlohmann::json after;
+  nlohmann::ordered_json before;
+  nlohmann::ordered_json after;
   put_bytes(before, event.before);
   put_bytes(after, event.after);
   r["before"] = std::move(before);
@@ -152,7 +160,7 @@ void WireLog::on_close(Time at, const std::string& reason) {
   r["reason"] = reason;
   // A partial frame still held at close is the last thing a reader of the
   // log wants to miss ("the car cut the STAT frame in half"): list it.
-  auto leftovers = nlohmann::json::array();
+  auto leftovers = nlohmann::ordered_json::array();
   for (std::size_t kind = 0; kind < 2; ++kind) {
     for (std::size_t dir = 0; dir < 2; ++dir) {
       auto& splitter = splitters_[kind][dir];
@@ -169,7 +177,7 @@ void WireLog::on_close(Time at, const std::string& reason) {
   write_line(r);
 }
 
-void WireLog::write_line(const nlohmann::json& record) {
+void WireLog::write_line(const nlohmann::ordered_json& record) {
   // Invalid UTF-8 cannot reach here (text is ASCII only, the rest is hex),
   // but frame texts come from decoders: replace rather than throw.
   std::string line = record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);

@@ -55,10 +55,11 @@ class WireLog final : public LinkObserver {
 
  private:
   WireLog(std::filesystem::path path, int fd, WireLogOptions options);
-  nlohmann::json record(const char* event, Time at) const;
+  // Ordered, so every line reads link, event, t_ms, wall_us first.
+  nlohmann::ordered_json record(const char* event, Time at) const;
   void on_bytes(const char* event, std::size_t kind_index, Time at, Direction d,
                 protocol::ByteView bytes);
-  void write_line(const nlohmann::json& record);
+  void write_line(const nlohmann::ordered_json& record);
 
   std::filesystem::path path_;
   int fd_ = -1;
@@ -75,6 +76,7 @@ class WireLog final : public LinkObserver {
 /// every byte is printable ASCII, tab, CR or LF (the JSON string holds them
 /// exactly), else "hex" (spaced uppercase). Shared with reports.
 void put_bytes(nlohmann::json& record, protocol::ByteView bytes);
+void put_bytes(nlohmann::ordered_json& record, protocol::ByteView bytes);
 
 /// The bytes a record's "text" or "hex" field holds; empty when it has
 /// neither.
