@@ -1,0 +1,127 @@
+// The capture observers on a real Link in virtual time: mem pipes, the LOGI
+// adapter and a fragment fault, so every record and packet time is exact.
+
+#include <gtest/gtest.h>
+
+#include "link/capture/pcap.hpp"
+#include "link/capture/wire_log.hpp"
+#include "link/mem_pipe.hpp"
+#include "tests/link/capture/capture_support.hpp"
+
+namespace hil::link {
+namespace {
+
+using protocol::to_bytes;
+
+constexpr std::int64_t kWallUs = 1'700'000'000'000'000;
+
+struct Collected {
+  std::string data;
+  BytePipe::Handlers handlers() {
+    return {[this](ByteView b) { data.append(b.begin(), b.end()); }, [](std::error_code) {}};
+  }
+};
+
+struct CaptureLinkTest : ::testing::Test {
+  test::ScratchFile log_file{".ndjson"};
+  test::ScratchFile pcap_file{".pcap"};
+  VirtualExecutor ex;
+  Collected at_client;
+  Collected at_car;
+
+  // The client writes one frame at 10 ms, the car answers at 20 ms, the
+  // client hangs up at 30 ms. to_car bytes are cut into 5-byte pieces 1 ms
+  // apart.
+  void run_exchange() {
+    std::error_code ec;
+    WireLogOptions log_options;
+    log_options.link_id = "logi0";
+    log_options.protocol = protocol_adapter("logi");
+    log_options.wall_clock_us = [] { return kWallUs; };
+    auto log = WireLog::open(log_file.path(), log_options, ec);
+    ASSERT_TRUE(log) << ec.message();
+    PcapOptions pcap_options;
+    pcap_options.wall_clock_us = [] { return kWallUs; };
+    auto pcap = PcapWriter::open(pcap_file.path(), pcap_options, ec);
+    ASSERT_TRUE(pcap) << ec.message();
+
+    FaultRule fragment;
+    fragment.name = "split";
+    fragment.action = Fragment{{5, 5}, {milliseconds(1), milliseconds(1)}};
+    LinkOptions options;
+    options.protocol = protocol_adapter("logi");
+    options.to_car.rules.push_back(fragment);
+    options.observers = {log, pcap};
+
+    auto [client_app, link_client] = make_mem_pipe(ex, "client");
+    auto [link_car, car_app] = make_mem_pipe(ex, "car");
+    auto link = Link::create(ex, link_client, link_car, std::move(options));
+    client_app->start(at_client.handlers());
+    car_app->start(at_car.handlers());
+    link->start();
+
+    ex.run_until(milliseconds(10));
+    client_app->write(to_bytes("LOGI:SP:050:D7#"));
+    ex.run_until(milliseconds(20));
+    car_app->write(to_bytes("LOGI:FB:SP:1:35#"));
+    ex.run_until(milliseconds(30));
+    client_app->close();
+    ex.run_until_idle();
+    EXPECT_FALSE(log->error());
+    EXPECT_FALSE(pcap->error());
+  }
+};
+
+TEST_F(CaptureLinkTest, WireLogShowsSentFaultAndDeliveredPiecesAtVirtualTimes) {
+  run_exchange();
+  ASSERT_EQ(at_car.data, "LOGI:SP:050:D7#");
+  std::vector<std::string> summary;
+  for (const auto& r : read_wire_log(log_file.path())) {
+    EXPECT_EQ(r["link"], "logi0");
+    EXPECT_EQ(r["wall_us"], kWallUs);
+    std::string line = r["event"].get<std::string>() + " " + r["t_ms"].dump();
+    if (r.contains("dir")) line += " " + r["dir"].get<std::string>();
+    if (r["event"] == "fault") line += " " + r["kind"].get<std::string>();
+    if (r.contains("text")) line += " " + r["text"].get<std::string>();
+    if (r.contains("frames")) line += " frames=" + std::to_string(r["frames"].size());
+    if (r.contains("reason")) line += " (" + r["reason"].get<std::string>() + ")";
+    summary.push_back(line);
+  }
+  const std::vector<std::string> expected = {
+      "open 0.0",
+      "sent 10.0 to_car LOGI:SP:050:D7# frames=1",
+      "fault 10.0 to_car fragment",
+      "delivered 10.0 to_car LOGI: frames=0",
+      "delivered 11.0 to_car SP:05 frames=0",
+      "delivered 12.0 to_car 0:D7# frames=1",
+      "sent 20.0 to_client LOGI:FB:SP:1:35# frames=1",
+      "delivered 20.0 to_client LOGI:FB:SP:1:35# frames=1",
+      "close 30.0 (client closed)",
+  };
+  EXPECT_EQ(summary, expected);
+}
+
+TEST_F(CaptureLinkTest, PcapHoldsTheDeliveredPiecesAtWallTimePlusVirtualTime) {
+  if (std::system("command -v tshark >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "tshark is not installed (ci/install-deps.sh installs it)";
+  }
+  run_exchange();
+  const std::string command = "tshark -n -r '" + pcap_file.path().string() +
+                              "' -Y 'tcp.len > 0' -T fields -e frame.time_epoch -e "
+                              "tcp.srcport -e tcp.len 2>/dev/null";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[1024];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe))
+    out.append(buf, n);
+  ASSERT_EQ(::pclose(pipe), 0);
+  EXPECT_EQ(out,
+            "1700000000.010000000\t40000\t5\n"
+            "1700000000.011000000\t40000\t5\n"
+            "1700000000.012000000\t40000\t5\n"
+            "1700000000.020000000\t9000\t16\n");
+}
+
+}  // namespace
+}  // namespace hil::link
