@@ -211,6 +211,11 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
         tx_(executor, options.baud, [this](ByteView b) { to_os(b); }),
         rx_(executor, options.baud, [this](ByteView b) { deliver(b); }) {}
 
+  // A session dropped before start() must still give the pty back.
+  ~PtyPipe() override {
+    if (on_end_) on_end_(false);
+  }
+
   void start(Handlers handlers) override {
     handlers_ = std::move(handlers);
     if (state_ == State::open && !reading_) read();

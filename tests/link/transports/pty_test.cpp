@@ -235,6 +235,21 @@ TEST_F(PtyTest, ClientCloseEndsTheSessionAndANewOpenStartsAFreshOne) {
   EXPECT_EQ(device.sessions.size(), 2u);
 }
 
+TEST_F(PtyTest, ADroppedSessionGivesThePortBackForTheNextClient) {
+  PtyListener listener(io, ex, path);
+  int accepted = 0;
+  listener.start([&](BytePipePtr) { ++accepted; });  // dropped at once, never started
+  {
+    Client first(io, ex, path);
+    ASSERT_TRUE(test::run_until(io, [&] { return accepted == 1; }));
+  }
+  // Long enough for the listener to see the port closed (one poll period);
+  // a reopen faster than that looks like the same client.
+  test::run_for(io, milliseconds(100));
+  Client second(io, ex, path);
+  ASSERT_TRUE(test::run_until(io, [&] { return accepted == 2; }));
+}
+
 TEST_F(PtyTest, GracefulCloseFromTheDeviceFlushesPacedBytes) {
   PtyOptions options;
   options.baud = 19200;
