@@ -12,6 +12,9 @@ packages=(
   libbox2d-dev               # Box2D 2.4
   libcli11-dev               # command-line parsing
   libbenchmark-dev           # Google Benchmark
+  libyaml-cpp-dev            # fault profiles (and, later, scenarios and worlds)
+  nlohmann-json3-dev         # NDJSON wire logs and timelines
+  tshark                     # reads the pcap files hil writes (tested)
 )
 
 if [ "$(id -u)" -ne 0 ]; then

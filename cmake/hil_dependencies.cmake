@@ -10,6 +10,8 @@ target_link_libraries(hil_asio INTERFACE Threads::Threads)
 add_library(hil::asio ALIAS hil_asio)
 
 find_package(box2d 2.4 REQUIRED)
+find_package(yaml-cpp REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 2.1 REQUIRED)
 
 if(HIL_BUILD_TESTS)

@@ -1,0 +1,65 @@
+#pragma once
+// One end of a bidirectional byte stream: a TCP connection, a pty, or an
+// in-memory pipe. Everything above the transports talks to this interface.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <system_error>
+
+#include "protocol/common/bytes.hpp"
+
+namespace hil::link {
+
+using protocol::ByteView;
+using protocol::Bytes;
+
+enum class CloseMode : std::uint8_t {
+  graceful,  ///< flush what is queued, then close (TCP: FIN)
+  reset,     ///< drop what is queued and abort (TCP: RST)
+};
+
+class BytePipe {
+ public:
+  struct Handlers {
+    /// Bytes from the peer, in order, in whatever pieces they arrived.
+    std::function<void(ByteView)> on_data;
+    /// The stream ended: peer closed (error_code is eof or a reset), or
+    /// close() was called here (operation_aborted). Called once.
+    std::function<void(std::error_code)> on_close;
+  };
+
+  virtual ~BytePipe() = default;
+
+  /// Starts delivering. Handlers run on the pipe's executor, never inside
+  /// write() or start() themselves.
+  virtual void start(Handlers handlers) = 0;
+  /// Queues bytes for the peer; never blocks. Ignored once closed.
+  virtual void write(ByteView bytes) = 0;
+  virtual void close(CloseMode mode = CloseMode::graceful) = 0;
+  virtual bool is_open() const = 0;
+  /// Bytes written but not yet handed to the operating system / the peer.
+  virtual std::size_t queued_bytes() const = 0;
+  /// For logs: "tcp 127.0.0.1:9000 <- 127.0.0.1:53422", "mem car0", ...
+  virtual std::string describe() const = 0;
+};
+
+using BytePipePtr = std::shared_ptr<BytePipe>;
+
+/// Accepts connections on an endpoint (a TCP port, a pty path, a mem name).
+class Listener {
+ public:
+  virtual ~Listener() = default;
+  virtual void start(std::function<void(BytePipePtr)> on_accept) = 0;
+  virtual void close() = 0;
+  /// What a peer connects to, as a URI: "tcp://127.0.0.1:9000".
+  virtual std::string address() const = 0;
+};
+
+using ConnectHandler = std::function<void(std::error_code, BytePipePtr)>;
+
+/// The code on_close receives when the peer closed its end normally: Asio's
+/// eof, for every transport (mem pipes included), so callers test one value.
+std::error_code end_of_stream();
+
+}  // namespace hil::link

@@ -1,0 +1,104 @@
+#include "link/endpoint.hpp"
+
+#include <charconv>
+
+#include "protocol/common/overloaded.hpp"
+#include "protocol/common/text.hpp"
+
+namespace hil::link {
+namespace {
+
+[[noreturn]] void fail(std::string_view uri, const std::string& what) {
+  throw EndpointError("endpoint '" + std::string(uri) + "': " + what);
+}
+
+unsigned long long number(std::string_view uri, std::string_view text, const char* what,
+                          unsigned long long max) {
+  unsigned long long v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc{} || end != text.data() + text.size() || v > max) {
+    fail(uri, std::string(what) + " '" + std::string(text) + "' is not a number 0.." + std::to_string(max));
+  }
+  return v;
+}
+
+TcpEndpoint parse_tcp(std::string_view uri, std::string_view rest) {
+  const std::size_t colon = rest.rfind(':');
+  if (colon == std::string_view::npos || colon + 1 == rest.size()) {
+    fail(uri, "expected tcp://HOST:PORT, e.g. tcp://127.0.0.1:9000");
+  }
+  std::string_view host = rest.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  if (host.empty()) fail(uri, "the host is empty (use 127.0.0.1 for this machine only)");
+  TcpEndpoint e;
+  e.host = std::string(host);
+  e.port = static_cast<std::uint16_t>(number(uri, rest.substr(colon + 1), "port", 65535));
+  return e;
+}
+
+PtyEndpoint parse_pty(std::string_view uri, std::string_view rest) {
+  const std::size_t q = rest.find('?');
+  PtyEndpoint e;
+  e.path = std::string(rest.substr(0, q));
+  if (e.path.empty() || e.path.front() != '/') {
+    fail(uri, "expected pty:///ABSOLUTE/PATH (three slashes), e.g. pty:///tmp/hil-arduino0");
+  }
+  if (q == std::string_view::npos) return e;
+  for (const std::string_view option : protocol::split(rest.substr(q + 1), '&')) {
+    const std::size_t eq = option.find('=');
+    const std::string_view key = option.substr(0, eq);
+    const std::string_view value = eq == std::string_view::npos ? std::string_view{} : option.substr(eq + 1);
+    if (key == "baud") {
+      e.baud = static_cast<unsigned>(number(uri, value, "baud", 4'000'000));
+    } else if (key == "reset_ms") {
+      e.reset_on_open = milliseconds(number(uri, value, "reset_ms", 60'000));
+    } else {
+      fail(uri, "unknown option '" + std::string(key) + "' (known: baud, reset_ms)");
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+Endpoint parse_endpoint(std::string_view uri) {
+  const std::size_t sep = uri.find("://");
+  if (sep == std::string_view::npos) {
+    fail(uri, "expected a URI such as tcp://127.0.0.1:9000, pty:///tmp/hil-arduino0 or mem://car0");
+  }
+  const std::string_view scheme = uri.substr(0, sep);
+  const std::string_view rest = uri.substr(sep + 3);
+  if (scheme == "tcp") return parse_tcp(uri, rest);
+  if (scheme == "pty") return parse_pty(uri, rest);
+  if (scheme == "mem") {
+    if (rest.empty()) fail(uri, "expected mem://NAME");
+    return MemEndpoint{std::string(rest)};
+  }
+  fail(uri, "unknown scheme '" + std::string(scheme) + "' (known: tcp, pty, mem)");
+}
+
+std::string to_uri(const Endpoint& endpoint) {
+  return std::visit(
+      protocol::Overloaded{
+          [](const TcpEndpoint& e) {
+            const bool v6 = e.host.find(':') != std::string::npos;
+            return "tcp://" + (v6 ? "[" + e.host + "]" : e.host) + ":" + std::to_string(e.port);
+          },
+          [](const PtyEndpoint& e) {
+            std::string uri = "pty://" + e.path;
+            std::string sep = "?";
+            if (e.baud != 0) {
+              uri += sep + "baud=" + std::to_string(e.baud);
+              sep = "&";
+            }
+            if (e.reset_on_open.count() != 0) {
+              uri += sep + "reset_ms=" +
+                     std::to_string(std::chrono::duration_cast<milliseconds>(e.reset_on_open).count());
+            }
+            return uri;
+          },
+          [](const MemEndpoint& e) { return "mem://" + e.name; }},
+      endpoint);
+}
+
+}  // namespace hil::link

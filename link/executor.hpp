@@ -1,0 +1,62 @@
+#pragma once
+// Where boxes schedule work. The virtual-time driver and the real-time
+// driver are both Executors; code that only uses this interface runs
+// unchanged under either.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <utility>
+
+#include "link/time.hpp"
+
+namespace hil::link {
+
+class Executor : public Clock {
+ public:
+  using Task = std::function<void()>;
+  using TimerId = std::uint64_t;
+
+  /// Runs `task` at time `at` (or now, if `at` has passed). Tasks due at the
+  /// same time run in the order they were scheduled.
+  virtual TimerId call_at(Time at, Task task) = 0;
+  /// Cancels a task that has not run yet; returns whether it was pending.
+  virtual bool cancel(TimerId id) = 0;
+
+  TimerId call_after(Duration delay, Task task) { return call_at(now() + delay, std::move(task)); }
+  /// Runs `task` as soon as possible, after the task that is running now.
+  TimerId post(Task task) { return call_at(now(), std::move(task)); }
+};
+
+/// The virtual-time driver's clock and event queue: time moves only when
+/// the queue is run, jumping from one due task to the next. Deterministic:
+/// the same tasks scheduled in the same order run in the same order.
+class VirtualExecutor final : public Executor {
+ public:
+  Time now() const override { return now_; }
+  TimerId call_at(Time at, Task task) override;
+  bool cancel(TimerId id) override;
+
+  /// Runs every task due at or before `until` (including tasks those tasks
+  /// schedule), then leaves the clock at `until`. Returns the tasks run.
+  std::size_t run_until(Time until);
+  std::size_t run_for(Duration d) { return run_until(now_ + d); }
+  /// Runs the earliest pending task, moving the clock to its time.
+  bool run_one();
+  /// Runs until nothing is pending or `max_tasks` have run (a guard against
+  /// a box that reschedules itself forever). Returns the tasks run.
+  std::size_t run_until_idle(std::size_t max_tasks = 10'000'000);
+
+  std::optional<Time> next_due() const;
+  std::size_t pending() const { return queue_.size(); }
+
+ private:
+  // Key: (time, sequence) so equal times keep scheduling order.
+  std::map<std::pair<Time, TimerId>, Task> queue_;
+  std::map<TimerId, Time> due_;  // for cancel
+  Time now_{0};
+  TimerId next_id_ = 1;
+};
+
+}  // namespace hil::link

@@ -1,0 +1,155 @@
+#include "link/link.hpp"
+
+#include <utility>
+
+namespace hil::link {
+namespace {
+
+constexpr std::size_t index(Direction d) { return static_cast<std::size_t>(d); }
+constexpr Direction kDirections[] = {Direction::to_car, Direction::to_client};
+
+std::string side_name(Direction sender) { return sender == Direction::to_car ? "client" : "car"; }
+
+}  // namespace
+
+std::shared_ptr<Link> Link::create(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options) {
+  return std::shared_ptr<Link>(new Link(executor, std::move(client), std::move(car), std::move(options)));
+}
+
+Link::Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options)
+    : executor_(executor), observers_(std::move(options.observers)) {
+  pipes_[index(Direction::to_car)] = std::move(car);
+  pipes_[index(Direction::to_client)] = std::move(client);
+  auto protocol = options.protocol ? options.protocol : protocol_adapter("raw");
+  const auto sink = [this](const FaultEvent& e) {
+    ++stats_.faults;
+    for (const auto& o : observers_) o->on_fault(e);
+  };
+  injectors_[index(Direction::to_car)] =
+      std::make_unique<FaultInjector>(Direction::to_car, protocol, std::move(options.to_car), options.seed, sink);
+  injectors_[index(Direction::to_client)] = std::make_unique<FaultInjector>(
+      Direction::to_client, protocol, std::move(options.to_client), options.seed, sink);
+}
+
+Link::~Link() {
+  for (const auto d : kDirections) {
+    if (timers_[index(d)] != 0) executor_.cancel(timers_[index(d)]);
+  }
+}
+
+void Link::start() {
+  if (open_) return;
+  open_ = true;
+  const Time now = executor_.now();
+  for (const auto& o : observers_) {
+    o->on_open(now, pipes_[index(Direction::to_client)]->describe(), pipes_[index(Direction::to_car)]->describe());
+  }
+  // Bytes the client sends travel to_car; bytes the car sends travel to_client.
+  for (const auto d : kDirections) {
+    // pipes_ is indexed by the direction a pipe receives; it sends the other.
+    const Direction sender = d == Direction::to_car ? Direction::to_client : Direction::to_car;
+    std::weak_ptr<Link> weak = weak_from_this();
+    pipes_[index(sender)]->start(BytePipe::Handlers{
+        [weak, d](ByteView bytes) {
+          if (auto self = weak.lock()) self->on_bytes(d, bytes);
+        },
+        [weak, d](std::error_code ec) {
+          if (auto self = weak.lock()) self->on_side_closed(d, ec);
+        }});
+  }
+}
+
+void Link::on_bytes(Direction d, ByteView bytes) {
+  if (!open_) return;
+  const Time now = executor_.now();
+  stats_.bytes_sent[index(d)] += bytes.size();
+  for (const auto& o : observers_) o->on_sent(now, d, bytes);
+  injectors_[index(d)]->push(now, bytes);
+  pump(d);
+}
+
+void Link::pump(Direction d) {
+  if (!open_) return;
+  const Time now = executor_.now();
+  scratch_.clear();
+  injectors_[index(d)]->poll(now, scratch_);
+  // Outputs are moved out first: observers or a break may re-enter the link.
+  std::vector<InjectorOutput> outputs;
+  outputs.swap(scratch_);
+  for (auto& output : outputs) {
+    if (auto* delivery = std::get_if<Delivery>(&output)) {
+      stats_.bytes_delivered[index(d)] += delivery->bytes.size();
+      pipes_[index(d)]->write(delivery->bytes);
+      for (const auto& o : observers_) o->on_delivered(now, d, delivery->bytes);
+    } else {
+      const bool reset = std::get<LinkBreak>(output).reset;
+      shut(std::string("fault injected: ") + (reset ? "reset" : "disconnect") + " (" + std::string(to_string(d)) + ")",
+           reset ? CloseMode::reset : CloseMode::graceful);
+      return;
+    }
+  }
+  if (draining_[index(d)] && !injectors_[index(d)]->next_due()) {
+    shut(side_name(d) + " closed", CloseMode::graceful);
+    return;
+  }
+  schedule(d);
+}
+
+void Link::schedule(Direction d) {
+  const auto next = injectors_[index(d)]->next_due();
+  auto& timer = timers_[index(d)];
+  if (next && timer != 0 && timer_due_[index(d)] == *next) return;
+  if (timer != 0) {
+    executor_.cancel(timer);
+    timer = 0;
+  }
+  if (!next) return;
+  timer_due_[index(d)] = *next;
+  std::weak_ptr<Link> weak = weak_from_this();
+  timer = executor_.call_at(*next, [weak, d] {
+    if (auto self = weak.lock()) {
+      self->timers_[index(d)] = 0;
+      self->pump(d);
+    }
+  });
+}
+
+void Link::on_side_closed(Direction d, std::error_code ec) {
+  if (!open_) return;
+  if (ec && ec != end_of_stream()) {
+    shut(side_name(d) + " connection failed: " + ec.message(), CloseMode::reset);
+    return;
+  }
+  // The sender is gone; what it sent and the injector still holds (delays,
+  // a partial frame) is delivered before the other side is closed.
+  draining_[index(d)] = true;
+  injectors_[index(d)]->finish(executor_.now());
+  pump(d);
+}
+
+void Link::shut(const std::string& reason, CloseMode mode) {
+  if (!open_) return;
+  open_ = false;
+  for (const auto d : kDirections) {
+    if (timers_[index(d)] != 0) {
+      executor_.cancel(timers_[index(d)]);
+      timers_[index(d)] = 0;
+    }
+    pipes_[index(d)]->close(mode);
+  }
+  const Time now = executor_.now();
+  for (const auto& o : observers_) o->on_close(now, reason);
+}
+
+void Link::close(CloseMode mode) { shut("closed by hil", mode); }
+
+bool Link::is_open() const { return open_; }
+
+void Link::set_profile(Direction direction, FaultProfile profile) {
+  injectors_[index(direction)]->set_profile(std::move(profile));
+  pump(direction);
+}
+
+LinkStats Link::stats() const { return stats_; }
+
+}  // namespace hil::link

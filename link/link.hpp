@@ -1,0 +1,84 @@
+#pragma once
+// A link: a client-side pipe and a car-side pipe joined through one fault
+// injector per direction, with observers (wire capture, timelines) watching
+// every byte. Runs on any Executor, so the same link serves the virtual-time
+// driver (mem pipes) and the real-time driver (TCP, pty).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "link/byte_pipe.hpp"
+#include "link/executor.hpp"
+#include "link/faults/fault_injector.hpp"
+#include "link/protocol_adapter.hpp"
+
+namespace hil::link {
+
+/// Watches a link. Every callback runs on the link's executor.
+class LinkObserver {
+ public:
+  virtual ~LinkObserver() = default;
+  /// The link started joining these two pipes.
+  virtual void on_open(Time /*at*/, const std::string& /*client*/, const std::string& /*car*/) {}
+  /// Bytes one side wrote, before faults.
+  virtual void on_sent(Time /*at*/, Direction /*d*/, protocol::ByteView /*bytes*/) {}
+  /// Bytes handed to the receiving side, after faults.
+  virtual void on_delivered(Time /*at*/, Direction /*d*/, protocol::ByteView /*bytes*/) {}
+  virtual void on_fault(const FaultEvent& /*event*/) {}
+  /// The link closed; `reason` says who closed it and why.
+  virtual void on_close(Time /*at*/, const std::string& /*reason*/) {}
+};
+
+struct LinkOptions {
+  std::shared_ptr<const ProtocolAdapter> protocol;  ///< null means raw
+  FaultProfile to_car;     ///< faults on bytes from the client to the car
+  FaultProfile to_client;  ///< faults on bytes from the car to the client
+  std::uint64_t seed = 0;  ///< each direction derives its own stream from it
+  std::vector<std::shared_ptr<LinkObserver>> observers;
+};
+
+struct LinkStats {
+  std::uint64_t bytes_sent[2] = {0, 0};       ///< indexed by Direction
+  std::uint64_t bytes_delivered[2] = {0, 0};  ///< indexed by Direction
+  std::uint64_t faults = 0;
+};
+
+class Link : public std::enable_shared_from_this<Link> {
+ public:
+  static std::shared_ptr<Link> create(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options);
+  ~Link();
+
+  void start();
+  /// Closes both sides.
+  void close(CloseMode mode = CloseMode::graceful);
+  bool is_open() const;
+
+  /// Replaces one direction's fault rules while the link runs.
+  void set_profile(Direction direction, FaultProfile profile);
+  LinkStats stats() const;
+
+ private:
+  Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options);
+  struct Side;
+  void on_bytes(Direction d, protocol::ByteView bytes);
+  void on_side_closed(Direction from, std::error_code ec);
+  void pump(Direction d);
+  void schedule(Direction d);
+  void shut(const std::string& reason, CloseMode mode);
+
+  Executor& executor_;
+  BytePipePtr pipes_[2];  // [to_car] = car pipe (receives to_car bytes), [to_client] = client pipe
+  std::unique_ptr<FaultInjector> injectors_[2];
+  Executor::TimerId timers_[2] = {0, 0};
+  Time timer_due_[2] = {Time{-1}, Time{-1}};
+  bool draining_[2] = {false, false};  // the sender of that direction has closed
+  std::vector<std::shared_ptr<LinkObserver>> observers_;
+  LinkStats stats_;
+  bool open_ = false;
+  std::vector<InjectorOutput> scratch_;
+};
+
+}  // namespace hil::link

@@ -1,0 +1,62 @@
+#pragma once
+// What the link layer needs to know about a protocol: where frames begin and
+// end in a byte stream, what kind each frame is, and where its checksum and
+// fields are, so faults can act on frames and captures can show messages.
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "protocol/common/bytes.hpp"
+
+namespace hil::link {
+
+/// One frame (or one undecodable run of bytes) cut from a stream.
+struct WireFrame {
+  protocol::Bytes raw;
+  bool valid = false;  ///< decoded cleanly
+  /// Hierarchical kind, ':'-separated, matched by prefix: "FB:ST", "MV:FWD",
+  /// "STAT" (LOGI); "V", "ACK" (Arduino); "TASK", "DATA" (WR8); the first
+  /// command's name (Leka). For invalid bytes, the decoder's context if any.
+  std::string kind;
+  std::string text;  ///< the decoded message or the error, one line
+};
+
+/// Cuts a byte stream into WireFrames. Every input byte lands in exactly one
+/// frame; any chunking gives the same frames.
+class FrameSplitter {
+ public:
+  virtual ~FrameSplitter() = default;
+  virtual void feed(protocol::ByteView bytes, std::vector<WireFrame>& out) = 0;
+  virtual void finish(std::vector<WireFrame>& out) = 0;
+  /// Bytes held that belong to no frame yet.
+  virtual std::size_t buffered() const = 0;
+};
+
+/// Byte range [first, second) within a frame.
+using ByteRange = std::pair<std::size_t, std::size_t>;
+
+class ProtocolAdapter {
+ public:
+  virtual ~ProtocolAdapter() = default;
+  /// "logi", "wr8", "arduino", "leka" or "raw".
+  virtual std::string_view name() const = 0;
+  virtual std::unique_ptr<FrameSplitter> splitter() const = 0;
+  /// Where the checksum is written in a frame; nullopt when the protocol has
+  /// none (WR8, raw) or the frame is not one.
+  virtual std::optional<ByteRange> checksum_field(protocol::ByteView frame) const = 0;
+  /// A named field of a frame (names per protocol, see docs/faults.md).
+  virtual std::optional<ByteRange> field(protocol::ByteView frame, std::string_view name) const = 0;
+  /// The names field() knows.
+  virtual std::vector<std::string> field_names() const = 0;
+};
+
+/// The adapter for a protocol name; throws std::invalid_argument naming the
+/// known protocols for an unknown one.
+std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name);
+
+}  // namespace hil::link

@@ -1,0 +1,55 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "link/endpoint.hpp"
+
+namespace hil::link {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(Endpoint, ParsesTcp) {
+  EXPECT_EQ(parse_endpoint("tcp://127.0.0.1:9000"), (Endpoint{TcpEndpoint{"127.0.0.1", 9000}}));
+  EXPECT_EQ(parse_endpoint("tcp://[::1]:80"), (Endpoint{TcpEndpoint{"::1", 80}}));
+  EXPECT_EQ(parse_endpoint("tcp://localhost:0"), (Endpoint{TcpEndpoint{"localhost", 0}}));
+}
+
+TEST(Endpoint, ParsesPtyWithOptions) {
+  const auto e = std::get<PtyEndpoint>(parse_endpoint("pty:///tmp/hil-arduino0?baud=9600&reset_ms=200"));
+  EXPECT_EQ(e.path, "/tmp/hil-arduino0");
+  EXPECT_EQ(e.baud, 9600u);
+  EXPECT_EQ(e.reset_on_open, milliseconds(200));
+  EXPECT_EQ(std::get<PtyEndpoint>(parse_endpoint("pty:///dev/x")).baud, 0u);
+}
+
+TEST(Endpoint, ParsesMem) { EXPECT_EQ(parse_endpoint("mem://car0"), (Endpoint{MemEndpoint{"car0"}})); }
+
+TEST(Endpoint, RoundTripsThroughText) {
+  for (const char* uri : {"tcp://127.0.0.1:9000", "tcp://[::1]:80", "pty:///tmp/a?baud=9600&reset_ms=200",
+                          "pty:///tmp/b", "mem://x"}) {
+    EXPECT_EQ(to_uri(parse_endpoint(uri)), uri);
+  }
+}
+
+TEST(Endpoint, ErrorsSayWhatWasExpected) {
+  const auto message = [](const char* uri) {
+    try {
+      parse_endpoint(uri);
+    } catch (const EndpointError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(message("127.0.0.1:9000"), HasSubstr("expected a URI such as tcp://"));
+  EXPECT_THAT(message("tcp://127.0.0.1"), HasSubstr("tcp://HOST:PORT"));
+  EXPECT_THAT(message("tcp://127.0.0.1:99999"), HasSubstr("port '99999' is not a number 0..65535"));
+  EXPECT_THAT(message("tcp://:9000"), HasSubstr("host is empty"));
+  EXPECT_THAT(message("pty://tmp/x"), HasSubstr("three slashes"));
+  EXPECT_THAT(message("pty:///tmp/x?speed=9600"), HasSubstr("unknown option 'speed'"));
+  EXPECT_THAT(message("pty:///tmp/x?baud=fast"), HasSubstr("baud 'fast'"));
+  EXPECT_THAT(message("udp://1.2.3.4:5"), HasSubstr("unknown scheme 'udp'"));
+  EXPECT_THAT(message("mem://"), HasSubstr("mem://NAME"));
+}
+
+}  // namespace
+}  // namespace hil::link
