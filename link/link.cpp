@@ -9,8 +9,21 @@ constexpr std::size_t index(Direction d) { return static_cast<std::size_t>(d); }
 constexpr Direction kDirections[] = {Direction::to_car, Direction::to_client};
 
 std::string side_name(Direction sender) { return sender == Direction::to_car ? "client" : "car"; }
+LinkClose::By side_of(Direction sender) {
+  return sender == Direction::to_car ? LinkClose::By::client : LinkClose::By::car;
+}
 
 }  // namespace
+
+std::string_view to_string(LinkClose::By by) {
+  switch (by) {
+    case LinkClose::By::client: return "client";
+    case LinkClose::By::car: return "car";
+    case LinkClose::By::fault: return "fault";
+    case LinkClose::By::hil: return "hil";
+  }
+  return "hil";
+}
 
 std::shared_ptr<Link> Link::create(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options) {
   return std::shared_ptr<Link>(new Link(executor, std::move(client), std::move(car), std::move(options)));
@@ -83,13 +96,14 @@ void Link::pump(Direction d) {
       for (const auto& o : observers_) o->on_delivered(now, d, delivery->bytes);
     } else {
       const bool reset = std::get<LinkBreak>(output).reset;
-      shut(std::string("fault injected: ") + (reset ? "reset" : "disconnect") + " (" + std::string(to_string(d)) + ")",
-           reset ? CloseMode::reset : CloseMode::graceful);
+      shut(LinkClose{LinkClose::By::fault, reset ? CloseMode::reset : CloseMode::graceful,
+                     std::string("fault injected: ") + (reset ? "reset" : "disconnect") + " (" +
+                         std::string(to_string(d)) + ")"});
       return;
     }
   }
   if (draining_[index(d)] && !injectors_[index(d)]->next_due()) {
-    shut(side_name(d) + " closed", CloseMode::graceful);
+    shut(LinkClose{side_of(d), CloseMode::graceful, side_name(d) + " closed"});
     return;
   }
   schedule(d);
@@ -117,7 +131,7 @@ void Link::schedule(Direction d) {
 void Link::on_side_closed(Direction d, std::error_code ec) {
   if (!open_) return;
   if (ec && ec != end_of_stream()) {
-    shut(side_name(d) + " connection failed: " + ec.message(), CloseMode::reset);
+    shut(LinkClose{side_of(d), CloseMode::reset, side_name(d) + " connection failed: " + ec.message()});
     return;
   }
   // The sender is gone; what it sent and the injector still holds (delays,
@@ -127,7 +141,7 @@ void Link::on_side_closed(Direction d, std::error_code ec) {
   pump(d);
 }
 
-void Link::shut(const std::string& reason, CloseMode mode) {
+void Link::shut(LinkClose close) {
   if (!open_) return;
   open_ = false;
   for (const auto d : kDirections) {
@@ -135,13 +149,13 @@ void Link::shut(const std::string& reason, CloseMode mode) {
       executor_.cancel(timers_[index(d)]);
       timers_[index(d)] = 0;
     }
-    pipes_[index(d)]->close(mode);
+    pipes_[index(d)]->close(close.mode);
   }
   const Time now = executor_.now();
-  for (const auto& o : observers_) o->on_close(now, reason);
+  for (const auto& o : observers_) o->on_close(now, close);
 }
 
-void Link::close(CloseMode mode) { shut("closed by hil", mode); }
+void Link::close(CloseMode mode) { shut(LinkClose{LinkClose::By::hil, mode, "closed by hil"}); }
 
 bool Link::is_open() const { return open_; }
 

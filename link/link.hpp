@@ -17,6 +17,20 @@
 
 namespace hil::link {
 
+/// How a link ended.
+struct LinkClose {
+  enum class By : std::uint8_t {
+    client,  ///< the client side closed or failed
+    car,     ///< the car side closed or failed
+    fault,   ///< a disconnect or reset rule broke the link
+    hil,     ///< Link::close() was called
+  };
+  By by = By::hil;
+  CloseMode mode = CloseMode::graceful;  ///< reset: the connection was aborted
+  std::string reason;                    ///< for a person: "car closed", "fault injected: reset (to_car)"
+};
+std::string_view to_string(LinkClose::By by);
+
 /// Watches a link. Every callback runs on the link's executor.
 class LinkObserver {
  public:
@@ -28,8 +42,8 @@ class LinkObserver {
   /// Bytes handed to the receiving side, after faults.
   virtual void on_delivered(Time /*at*/, Direction /*d*/, protocol::ByteView /*bytes*/) {}
   virtual void on_fault(const FaultEvent& /*event*/) {}
-  /// The link closed; `reason` says who closed it and why.
-  virtual void on_close(Time /*at*/, const std::string& /*reason*/) {}
+  /// The link closed: who closed it, how, and why.
+  virtual void on_close(Time /*at*/, const LinkClose& /*close*/) {}
 };
 
 struct LinkOptions {
@@ -67,7 +81,7 @@ class Link : public std::enable_shared_from_this<Link> {
   void on_side_closed(Direction from, std::error_code ec);
   void pump(Direction d);
   void schedule(Direction d);
-  void shut(const std::string& reason, CloseMode mode);
+  void shut(LinkClose close);
 
   Executor& executor_;
   BytePipePtr pipes_[2];  // [to_car] = car pipe (receives to_car bytes), [to_client] = client pipe

@@ -78,13 +78,6 @@ bool parse_ipv4(const std::string& text, std::uint32_t& out) {
   return true;
 }
 
-std::string lowercase(std::string_view text) {
-  std::string lower(text);
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return lower;
-}
-
 }  // namespace
 
 std::shared_ptr<PcapWriter> PcapWriter::open(const std::filesystem::path& path, PcapOptions options,
@@ -170,17 +163,13 @@ void PcapWriter::on_fault(const FaultEvent& event) {
   if (event.kind == "reset") reset_seen_ = true;
 }
 
-void PcapWriter::on_close(Time at, const std::string& reason) {
+void PcapWriter::on_close(Time at, const LinkClose& close) {
   if (!open_) return;
-  // Link reasons start with the side that went away ("car closed", "client
-  // connection failed: ..."); anything else (hil closed it, a fault broke
-  // it) is drawn as the client's doing.
-  const bool by_car = lowercase(reason).starts_with("car");
+  // A link broken by hil or by a fault is drawn as the client's doing.
+  const bool by_car = close.by == LinkClose::By::car;
   Side& closer = by_car ? car_ : client_;
   Side& other = by_car ? client_ : car_;
-  const auto why = lowercase(reason);
-  const bool reset = reset_seen_ || why.find("reset") != std::string::npos ||
-                     why.find("failed") != std::string::npos;
+  const bool reset = reset_seen_ || close.mode == CloseMode::reset;
   if (reset) {
     write_segment(at, closer, other, kRst | kAck, {}, false);
   } else {

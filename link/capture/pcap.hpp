@@ -56,11 +56,10 @@ class PcapWriter final : public LinkObserver {
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override;
   /// Remembers "reset" faults, so the close is written as a reset.
   void on_fault(const FaultEvent& event) override;
-  /// Writes FIN, FIN, ACK; or one RST when the reason mentions a reset or a
-  /// failure, or a "reset" fault was seen. The side that closes is the car
-  /// when the reason starts with "car" (Link's "car closed"), else the
-  /// client.
-  void on_close(Time at, const std::string& reason) override;
+  /// Writes FIN, FIN, ACK; or one RST when the link was reset (or a "reset"
+  /// fault was seen). The car's side closes when the car closed the link,
+  /// the client's side in every other case.
+  void on_close(Time at, const LinkClose& close) override;
 
   /// The first write error, if any.
   std::error_code error() const { return error_; }

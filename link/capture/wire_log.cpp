@@ -155,9 +155,11 @@ void WireLog::on_fault(const FaultEvent& event) {
   write_line(r);
 }
 
-void WireLog::on_close(Time at, const std::string& reason) {
+void WireLog::on_close(Time at, const LinkClose& close) {
   auto r = record("close", at);
-  r["reason"] = reason;
+  r["by"] = std::string(to_string(close.by));
+  r["mode"] = close.mode == CloseMode::reset ? "reset" : "graceful";
+  r["reason"] = close.reason;
   // A partial frame still held at close is the last thing a reader of the
   // log wants to miss ("the car cut the STAT frame in half"): list it.
   auto leftovers = nlohmann::ordered_json::array();

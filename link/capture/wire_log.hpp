@@ -46,7 +46,7 @@ class WireLog final : public LinkObserver {
   void on_sent(Time at, Direction d, protocol::ByteView bytes) override;
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override;
   void on_fault(const FaultEvent& event) override;
-  void on_close(Time at, const std::string& reason) override;
+  void on_close(Time at, const LinkClose& close) override;
 
   /// The first write error, if any; later records are still attempted.
   std::error_code error() const { return error_; }

@@ -78,7 +78,8 @@ struct PcapTest : ::testing::Test {
 
   // A short LOGI exchange: the client sets the speed, the car answers with
   // feedback and a status frame cut in two by a fragment fault.
-  void write_logi_exchange(PcapWriter& w, const std::string& close_reason = "car closed") {
+  void write_logi_exchange(PcapWriter& w,
+                           const LinkClose& close = {LinkClose::By::car, CloseMode::graceful, "car closed"}) {
     w.on_open(seconds(1), "client", "car");
     w.on_sent(seconds(1) + milliseconds(10), Direction::to_car,
               to_bytes("ignored: pcap shows deliveries"));
@@ -87,7 +88,7 @@ struct PcapTest : ::testing::Test {
                    to_bytes("LOGI:FB:SP:1:35#"));
     w.on_delivered(seconds(1) + milliseconds(30), Direction::to_client, to_bytes("LOGI:STAT:SP:0"));
     w.on_delivered(seconds(1) + milliseconds(31), Direction::to_client, to_bytes("50,RUN:1:00#"));
-    w.on_close(seconds(1) + milliseconds(500), close_reason);
+    w.on_close(seconds(1) + milliseconds(500), close);
   }
 };
 
@@ -163,7 +164,7 @@ TEST_F(PcapTest, IpAndTcpChecksumsAreRight) {
 TEST_F(PcapTest, HandshakeDataAndGracefulCloseByTheCar) {
   REQUIRE_TSHARK();
   auto w = make();
-  write_logi_exchange(*w, "car closed");
+  write_logi_exchange(*w, {LinkClose::By::car, CloseMode::graceful, "car closed"});
   const auto rows =
       tshark(file.path(), "-T fields -e tcp.srcport -e tcp.flags -e tcp.seq -e tcp.ack -e tcp.len");
   const std::vector<std::vector<std::string>> expected = {
@@ -184,7 +185,7 @@ TEST_F(PcapTest, HandshakeDataAndGracefulCloseByTheCar) {
 TEST_F(PcapTest, ResetReasonEndsWithOneRst) {
   REQUIRE_TSHARK();
   auto w = make();
-  write_logi_exchange(*w, "fault injected: reset (to_car)");
+  write_logi_exchange(*w, {LinkClose::By::fault, CloseMode::reset, "fault injected: reset (to_car)"});
   const auto rows = tshark(file.path(), "-T fields -e tcp.srcport -e tcp.flags");
   ASSERT_EQ(rows.size(), 8u);
   EXPECT_EQ(rows.back(), (std::vector<std::string>{"40000", "0x0014"}));
@@ -197,7 +198,7 @@ TEST_F(PcapTest, ResetFaultEndsWithRstWhateverTheReason) {
   FaultEvent e;
   e.kind = "reset";
   w->on_fault(e);
-  w->on_close(milliseconds(1), "closed by hil");
+  w->on_close(milliseconds(1), {LinkClose::By::hil, CloseMode::graceful, "closed by hil"});
   const auto rows = tshark(file.path(), "-T fields -e tcp.flags");
   ASSERT_EQ(rows.size(), 4u);
   EXPECT_EQ(rows.back(), std::vector<std::string>{"0x0014"});
@@ -212,7 +213,7 @@ TEST_F(PcapTest, LargeDeliveriesAreSplitIntoFullSizedSegments) {
   w->on_open(Time{0}, "client", "car");
   w->on_delivered(milliseconds(1), Direction::to_car, big);
   w->on_delivered(milliseconds(2), Direction::to_client, to_bytes("ok"));
-  w->on_close(milliseconds(3), "client closed");
+  w->on_close(milliseconds(3), {LinkClose::By::client, CloseMode::graceful, "client closed"});
   const auto rows = tshark(
       file.path(), "-Y 'tcp.len > 0' -T fields -e tcp.len -e tcp.seq -e tcp.ack -e tcp.payload");
   ASSERT_EQ(rows.size(), 4u);
@@ -267,7 +268,7 @@ TEST_F(PcapTest, EachReopenIsANewStreamFromTheNextPort) {
   REQUIRE_TSHARK();
   auto w = make();
   write_logi_exchange(*w);
-  write_logi_exchange(*w, "client closed");
+  write_logi_exchange(*w, {LinkClose::By::client, CloseMode::graceful, "client closed"});
   const auto rows = tshark(file.path(), "-Y 'tcp.len > 0' -T fields -e tcp.stream -e tcp.srcport");
   ASSERT_EQ(rows.size(), 8u);
   EXPECT_EQ(rows[0], (std::vector<std::string>{"0", "40000"}));

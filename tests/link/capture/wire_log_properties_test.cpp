@@ -76,7 +76,7 @@ RC_GTEST_PROP(WireLogProperties, AnyChunkingGivesTheSameBytesAndFrames,
                       protocol::ByteView(stream).subspan(pos, n));
     pos += n;
   }
-  log->on_close(microseconds(t_us + 1), "car closed");
+  log->on_close(microseconds(t_us + 1), {LinkClose::By::car, CloseMode::graceful, "car closed"});
 
   std::vector<WireFrame> expected_frames;
   auto splitter = options.protocol->splitter();

@@ -195,11 +195,13 @@ TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
   auto log = make();
   log->on_delivered(milliseconds(1), Direction::to_client, to_bytes("LOGI:STAT:1:"));
   wall_us = kWallUs + 7;
-  log->on_close(milliseconds(3), "car closed");
+  log->on_close(milliseconds(3), {LinkClose::By::car, CloseMode::graceful, "car closed"});
   const auto r = records();
   ASSERT_EQ(r.size(), 2u);
   EXPECT_EQ(r[1]["event"], "close");
   EXPECT_EQ(r[1]["reason"], "car closed");
+  EXPECT_EQ(r[1]["by"], "car");
+  EXPECT_EQ(r[1]["mode"], "graceful");
   EXPECT_EQ(r[1]["t_ms"], 3.0);
   EXPECT_EQ(r[1]["wall_us"], kWallUs + 7);
   ASSERT_EQ(r[1]["unfinished"].size(), 1u);
@@ -212,7 +214,7 @@ TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
 TEST_F(WireLogTest, CleanCloseHasNoUnfinishedField) {
   auto log = make();
   log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
-  log->on_close(milliseconds(3), "closed by hil");
+  log->on_close(milliseconds(3), {LinkClose::By::hil, CloseMode::graceful, "closed by hil"});
   EXPECT_FALSE(records().back().contains("unfinished"));
 }
 
