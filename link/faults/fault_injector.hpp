@@ -1,0 +1,84 @@
+#pragma once
+// The fault injector for one direction of one link. Sans-I/O: it is given
+// the bytes the sender wrote and the time, and says which bytes to deliver
+// when, and when to break the connection. Seeded: the same profile, seed
+// and input give the same faults, byte for byte.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "link/faults/profile.hpp"
+#include "link/protocol_adapter.hpp"
+#include "link/time.hpp"
+#include "protocol/common/bytes.hpp"
+
+namespace hil::link {
+
+// Direction is defined with the profiles (link/faults/profile.hpp), whose
+// rules filter on it.
+
+/// One injected fault, for the run's timeline.
+struct FaultEvent {
+  Time at{0};
+  Direction direction = Direction::to_car;
+  std::string kind;    ///< "fragment", "drop", "corrupt", ... (the rule's kind)
+  std::string rule;    ///< the rule's name in the profile (or its index)
+  std::uint64_t frame = 0;  ///< the frame acted on (1-based in this direction); 0: none
+  protocol::Bytes before;  ///< the bytes the rule acted on
+  protocol::Bytes after;   ///< what was delivered instead (empty for a drop)
+  std::string detail;      ///< what happened, for a person
+};
+using FaultEventSink = std::function<void(const FaultEvent&)>;
+
+/// Deliver these bytes to the receiver now.
+struct Delivery {
+  protocol::Bytes bytes;
+};
+/// Break the connection (graceful close or reset).
+struct LinkBreak {
+  bool reset = false;
+};
+using InjectorOutput = std::variant<Delivery, LinkBreak>;
+
+class FaultInjector {
+ public:
+  /// `protocol` may be the raw adapter (every write is one frame).
+  FaultInjector(Direction direction, std::shared_ptr<const ProtocolAdapter> protocol, FaultProfile profile,
+                std::uint64_t seed, FaultEventSink sink = {});
+  ~FaultInjector();
+  FaultInjector(FaultInjector&&) noexcept;
+  FaultInjector& operator=(FaultInjector&&) noexcept;
+
+  /// Bytes the sender wrote at `now`.
+  void push(Time now, protocol::ByteView bytes);
+  /// The sender closed: whatever is held (a partial frame) is released.
+  void finish(Time now);
+  /// Appends every output due at or before `now`, in order.
+  void poll(Time now, std::vector<InjectorOutput>& out);
+  /// When poll() next has something to give; nullopt when nothing is held.
+  std::optional<Time> next_due() const;
+
+  /// Replaces the rules while the link runs; the random stream and the frame
+  /// counters carry on.
+  void set_profile(FaultProfile profile);
+  const FaultProfile& profile() const;
+
+  /// Whether a new connection arriving at `now` is to be refused.
+  bool refuse_connection(Time now) const;
+
+  std::uint64_t seed() const;
+  /// Frames seen and faults injected so far.
+  std::uint64_t frames_seen() const;
+  std::uint64_t faults_injected() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace hil::link

@@ -1,0 +1,325 @@
+#include "link/protocol_adapter.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <type_traits>
+#include <variant>
+
+#include "protocol/arduino/codec.hpp"
+#include "protocol/common/overloaded.hpp"
+#include "protocol/leka/codec.hpp"
+#include "protocol/logi/codec.hpp"
+#include "protocol/wr8/codec.hpp"
+
+namespace hil::link {
+namespace {
+
+using protocol::ByteView;
+using protocol::DecodeError;
+
+std::optional<ByteRange> non_empty(std::size_t first, std::size_t last) {
+  if (first >= last) return std::nullopt;
+  return ByteRange{first, last};
+}
+
+std::string error_text(const DecodeError& e) {
+  std::string text(protocol::to_string(e.kind));
+  if (!e.detail.empty()) text += ": " + e.detail;
+  return text;
+}
+
+/// Feeds a protocol's stream decoder and turns each item into a WireFrame;
+/// `describe` gives a valid frame's kind and text.
+template <class Decoder, class Message, class Describe>
+class DecoderSplitter final : public FrameSplitter {
+ public:
+  DecoderSplitter(Decoder decoder, Describe describe)
+      : decoder_(std::move(decoder)), describe_(std::move(describe)) {}
+
+  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
+    items_.clear();
+    decoder_.feed(bytes, items_);
+    convert(out);
+  }
+  void finish(std::vector<WireFrame>& out) override {
+    items_.clear();
+    decoder_.finish(items_);
+    convert(out);
+  }
+  std::size_t buffered() const override { return decoder_.buffered(); }
+
+ private:
+  void convert(std::vector<WireFrame>& out) {
+    for (auto& item : items_) {
+      WireFrame frame;
+      if (auto* f = std::get_if<protocol::Frame<Message>>(&item)) {
+        frame.valid = true;
+        auto [kind, text] = describe_(f->message);
+        frame.kind = std::move(kind);
+        frame.text = std::move(text);
+        frame.raw = std::move(f->raw);
+      } else {
+        auto& e = std::get<DecodeError>(item);
+        frame.kind = e.context;
+        frame.text = error_text(e);
+        frame.raw = std::move(e.raw);
+      }
+      out.push_back(std::move(frame));
+    }
+  }
+
+  Decoder decoder_;
+  Describe describe_;
+  std::vector<protocol::DecodeItem<Message>> items_;
+};
+
+template <class Message, class Decoder, class Describe>
+std::unique_ptr<FrameSplitter> make_splitter(Decoder decoder, Describe describe) {
+  return std::make_unique<DecoderSplitter<Decoder, Message, Describe>>(std::move(decoder),
+                                                                       std::move(describe));
+}
+
+using KindAndText = std::pair<std::string, std::string>;
+
+// ---------------------------------------------------------------- raw
+
+class RawSplitter final : public FrameSplitter {
+ public:
+  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
+    if (bytes.empty()) return;
+    WireFrame frame;
+    frame.raw.assign(bytes.begin(), bytes.end());
+    frame.valid = true;
+    frame.text = protocol::escape(bytes);
+    out.push_back(std::move(frame));
+  }
+  void finish(std::vector<WireFrame>& /*out*/) override {}
+  std::size_t buffered() const override { return 0; }
+};
+
+class RawAdapter final : public ProtocolAdapter {
+ public:
+  std::string_view name() const override { return "raw"; }
+  std::unique_ptr<FrameSplitter> splitter() const override {
+    return std::make_unique<RawSplitter>();
+  }
+  std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
+    return std::nullopt;
+  }
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    if (name == "payload" || name == "body") return non_empty(0, frame.size());
+    return std::nullopt;
+  }
+  std::vector<std::string> field_names() const override { return {"payload", "body"}; }
+};
+
+// ---------------------------------------------------------------- LOGI
+// LOGI:<payload>:<CS>#
+
+class LogiAdapter final : public ProtocolAdapter {
+ public:
+  std::string_view name() const override { return "logi"; }
+
+  std::unique_ptr<FrameSplitter> splitter() const override {
+    namespace logi = protocol::logi;
+    return make_splitter<logi::Message>(logi::Decoder{}, [](const logi::Message& m) {
+      return KindAndText{kind_of(m), logi::describe(m)};
+    });
+  }
+
+  std::optional<ByteRange> checksum_field(ByteView frame) const override {
+    if (!framed(frame)) return std::nullopt;
+    return ByteRange{frame.size() - 3, frame.size() - 1};
+  }
+
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    if (!framed(frame)) return std::nullopt;
+    const std::size_t begin = protocol::logi::kHeader.size();
+    const std::size_t end = frame.size() - 4;  // the ':' before the checksum
+    if (name == "payload" || name == "body") return non_empty(begin, end);
+    const auto* first = frame.data() + begin;
+    const auto* colon = std::find(first, frame.data() + end, ':');
+    const auto split = static_cast<std::size_t>(colon - frame.data());
+    if (name == "code") return non_empty(begin, split);
+    if (name == "value") return split < end ? non_empty(split + 1, end) : std::nullopt;
+    return std::nullopt;
+  }
+
+  std::vector<std::string> field_names() const override {
+    return {"payload", "body", "code", "value"};
+  }
+
+ private:
+  // Shape only: header, ':' before two checksum characters, '#'. A frame
+  // whose checksum is already wrong still has these places.
+  static bool framed(ByteView f) {
+    const auto header = protocol::logi::kHeader;
+    if (f.size() < header.size() + 5) return false;
+    if (!std::equal(header.begin(), header.end(), f.begin())) return false;
+    return f.back() == protocol::logi::kTail && f[f.size() - 4] == ':';
+  }
+
+  static std::string kind_of(const protocol::logi::Message& m) {
+    namespace logi = protocol::logi;
+    return std::visit(
+        protocol::Overloaded{
+            [](const logi::SetSpeed&) -> std::string { return "SP"; },
+            [](const logi::SetRun& v) -> std::string { return v.run ? "ST:RUN" : "ST:STOP"; },
+            [](const logi::SetStation&) -> std::string { return "GS"; },
+            [](const logi::SetMode& v) { return "MD:" + std::string(logi::to_string(v.mode)); },
+            [](const logi::Move& v) { return "MV:" + std::string(logi::to_string(v.direction)); },
+            [](const logi::Status&) -> std::string { return "STAT"; },
+            [](const logi::Feedback& v) { return "FB:" + std::string(logi::to_string(v.command)); },
+        },
+        m);
+  }
+};
+
+// ---------------------------------------------------------------- Arduino
+// ^SEQ|CMD|PAYLOAD*CS$
+
+class ArduinoAdapter final : public ProtocolAdapter {
+ public:
+  std::string_view name() const override { return "arduino"; }
+
+  std::unique_ptr<FrameSplitter> splitter() const override {
+    namespace arduino = protocol::arduino;
+    return make_splitter<arduino::Message>(arduino::Decoder{}, [](const arduino::Message& m) {
+      return KindAndText{std::string(arduino::command_of(m.body)), arduino::describe(m)};
+    });
+  }
+
+  std::optional<ByteRange> checksum_field(ByteView frame) const override {
+    if (!framed(frame)) return std::nullopt;
+    return ByteRange{frame.size() - 3, frame.size() - 1};
+  }
+
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    if (!framed(frame)) return std::nullopt;
+    const std::size_t star = frame.size() - 4;
+    if (name == "body") return non_empty(1, star);
+    // SEQ, CMD and PAYLOAD are found by the separators inside the body.
+    const auto* body = frame.data() + 1;
+    const auto* body_end = frame.data() + star;
+    const auto* bar1 = std::find(body, body_end, '|');
+    const auto* bar2 = bar1 == body_end ? body_end : std::find(bar1 + 1, body_end, '|');
+    const auto at = [&](const std::uint8_t* p) {
+      return static_cast<std::size_t>(p - frame.data());
+    };
+    if (name == "seq") return bar1 == body_end ? std::nullopt : non_empty(1, at(bar1));
+    if (name == "cmd") return bar2 == body_end ? std::nullopt : non_empty(at(bar1) + 1, at(bar2));
+    if (name == "payload") return bar2 == body_end ? std::nullopt : non_empty(at(bar2) + 1, star);
+    return std::nullopt;
+  }
+
+  std::vector<std::string> field_names() const override {
+    return {"body", "seq", "cmd", "payload"};
+  }
+
+ private:
+  static bool framed(ByteView f) {
+    namespace arduino = protocol::arduino;
+    return f.size() >= 5 && f.front() == arduino::kStart && f.back() == arduino::kEnd &&
+           f[f.size() - 4] == static_cast<std::uint8_t>(arduino::kChecksumSeparator);
+  }
+};
+
+// ---------------------------------------------------------------- WR8
+// code byte, then a body whose length follows from the code; no checksum.
+
+class Wr8Adapter final : public ProtocolAdapter {
+ public:
+  std::string_view name() const override { return "wr8"; }
+
+  std::unique_ptr<FrameSplitter> splitter() const override {
+    namespace wr8 = protocol::wr8;
+    return make_splitter<wr8::Message>(wr8::Decoder{}, [](const wr8::Message& m) {
+      std::string kind(wr8::to_string(wr8::code_of(m)));
+      std::replace(kind.begin(), kind.end(), '-', '_');  // AUTH-REPLY -> AUTH_REPLY
+      return KindAndText{std::move(kind), wr8::describe(m)};
+    });
+  }
+
+  std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
+    return std::nullopt;
+  }
+
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    namespace wr8 = protocol::wr8;
+    if (frame.empty()) return std::nullopt;
+    if (name == "code") return ByteRange{0, 1};
+    if (name == "payload" || name == "body") return non_empty(1, frame.size());
+    if (name == "coi") {
+      const auto code = static_cast<wr8::PacketCode>(frame[0]);
+      const bool has_coi = code == wr8::PacketCode::task || code == wr8::PacketCode::settings ||
+                           code == wr8::PacketCode::response;
+      return has_coi ? non_empty(1, std::min<std::size_t>(2, frame.size())) : std::nullopt;
+    }
+    return std::nullopt;
+  }
+
+  std::vector<std::string> field_names() const override {
+    return {"payload", "body", "code", "coi"};
+  }
+};
+
+// ---------------------------------------------------------------- Leka
+// 2A 2B 2C 2D, length, command group, checksum
+
+class LekaAdapter final : public ProtocolAdapter {
+ public:
+  std::string_view name() const override { return "leka"; }
+
+  std::unique_ptr<FrameSplitter> splitter() const override {
+    namespace leka = protocol::leka;
+    return make_splitter<leka::Message>(leka::Decoder{}, [](const leka::Message& m) {
+      std::string kind =
+          m.commands.empty() ? std::string{} : std::string(leka::spec_of(m.commands.front()).name);
+      return KindAndText{std::move(kind), leka::describe(m)};
+    });
+  }
+
+  std::optional<ByteRange> checksum_field(ByteView frame) const override {
+    if (!framed(frame)) return std::nullopt;
+    return ByteRange{frame.size() - 1, frame.size()};
+  }
+
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    if (!framed(frame)) return std::nullopt;
+    const std::size_t length_at = protocol::leka::kStartSequence.size();
+    if (name == "length") return ByteRange{length_at, length_at + 1};
+    if (name == "group" || name == "payload" || name == "body") {
+      return non_empty(length_at + 1, frame.size() - 1);
+    }
+    return std::nullopt;
+  }
+
+  std::vector<std::string> field_names() const override {
+    return {"length", "group", "payload", "body"};
+  }
+
+ private:
+  // Start sequence and a length byte that agrees with the frame's size.
+  static bool framed(ByteView f) {
+    namespace leka = protocol::leka;
+    if (f.size() < leka::kOverheadBytes + 1) return false;
+    if (!std::equal(leka::kStartSequence.begin(), leka::kStartSequence.end(), f.begin())) {
+      return false;
+    }
+    return f[leka::kStartSequence.size()] == f.size() - leka::kOverheadBytes;
+  }
+};
+
+}  // namespace
+
+std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name) {
+  if (name == "logi") return std::make_shared<LogiAdapter>();
+  if (name == "arduino") return std::make_shared<ArduinoAdapter>();
+  if (name == "wr8") return std::make_shared<Wr8Adapter>();
+  if (name == "leka") return std::make_shared<LekaAdapter>();
+  if (name == "raw") return std::make_shared<RawAdapter>();
+  throw std::invalid_argument("unknown protocol '" + std::string(name) +
+                              "' (known: logi, wr8, arduino, leka, raw)");
+}
+
+}  // namespace hil::link
