@@ -1,0 +1,482 @@
+#include "link/faults/profile_yaml.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace hil::link {
+namespace {
+
+using protocol::Bytes;
+
+std::string position(const std::string& source, int line, int column) {
+  std::string text = source;
+  if (line > 0) text += ":" + std::to_string(line) + ":" + std::to_string(column);
+  return text;
+}
+
+[[noreturn]] void fail(const std::string& source, const YAML::Mark& mark,
+                       const std::string& message) {
+  // yaml-cpp counts from 0; a null mark (-1) means no position.
+  const int line = mark.line >= 0 ? mark.line + 1 : 0;
+  const int column = mark.column >= 0 ? mark.column + 1 : 0;
+  throw FaultProfileError(source, line, column, message);
+}
+
+std::optional<std::uint64_t> parse_uint(std::string_view text) {
+  std::uint64_t value = 0;
+  const auto* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc{} || ptr != end || text.empty()) return std::nullopt;
+  return value;
+}
+
+std::optional<double> parse_double(std::string_view text) {
+  double value = 0;
+  const auto* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc{} || ptr != end || text.empty()) return std::nullopt;
+  return value;
+}
+
+const std::set<std::string, std::less<>> kCommonKeys = {"kind",  "name",       "direction", "from",
+                                                        "to",    "match",      "at_frame",  "first",
+                                                        "every", "probability"};
+const std::set<std::string, std::less<>> kTimeKeys = {"kind", "name", "direction",
+                                                      "from", "to",   "at"};
+
+/// Keys a rule of `kind` takes besides the common ones.
+std::set<std::string, std::less<>> keys_of(FaultKind kind) {
+  std::set<std::string, std::less<>> keys;
+  switch (kind) {
+    case FaultKind::fragment:
+      keys = {"sizes", "gap"};
+      break;
+    case FaultKind::coalesce:
+      keys = {"count", "window"};
+      break;
+    case FaultKind::corrupt:
+      keys = {"target", "field", "bits"};
+      break;
+    case FaultKind::drop:
+      keys = {"unit", "count"};
+      break;
+    case FaultKind::duplicate:
+      keys = {"copies"};
+      break;
+    case FaultKind::garbage:
+      keys = {"length", "hex", "text"};
+      break;
+    case FaultKind::delay:
+      keys = {"delay", "jitter"};
+      break;
+    case FaultKind::stall:
+      keys = {"for", "at"};
+      break;
+    case FaultKind::disconnect:
+    case FaultKind::reset:
+      keys = {"at"};
+      break;
+    case FaultKind::bandwidth:
+      // Applies to every write in its window: no frame triggers.
+      return {"kind", "name", "direction", "from", "to", "bytes_per_second", "baud"};
+    case FaultKind::refuse:
+      keys = kTimeKeys;
+      keys.insert("for");
+      return keys;
+  }
+  keys.insert(kCommonKeys.begin(), kCommonKeys.end());
+  return keys;
+}
+
+std::string join(const std::set<std::string, std::less<>>& keys) {
+  std::string text;
+  for (const auto& k : keys)
+    text += (text.empty() ? "" : ", ") + k;
+  return text;
+}
+
+/// Reads one rule map, reporting every problem at the node it is about.
+class RuleReader {
+ public:
+  RuleReader(const std::string& source, const YAML::Node& node, std::size_t index)
+      : source_(source), node_(node), prefix_("rule " + std::to_string(index)) {}
+
+  FaultRule read() {
+    if (!node_.IsMap())
+      fail(source_, node_.Mark(), prefix_ + ": must be a map with at least 'kind'");
+    const YAML::Node kind_node = node_["kind"];
+    if (!kind_node) fail(source_, node_.Mark(), prefix_ + ": 'kind' is missing");
+    const auto kind = parse_fault_kind(scalar(kind_node, "kind"));
+    if (!kind) {
+      fail(source_, kind_node.Mark(),
+           prefix_ + ": unknown kind '" + kind_node.Scalar() +
+               "' (known: fragment, coalesce, corrupt, drop, duplicate, garbage, delay, stall, "
+               "bandwidth, disconnect, reset, refuse)");
+    }
+    prefix_ += " (" + std::string(to_string(*kind)) + ")";
+    check_keys(keys_of(*kind));
+
+    FaultRule rule;
+    rule.action = make_action(*kind);
+    if (auto n = get("name")) rule.name = scalar(*n, "name");
+    if (auto n = get("direction")) rule.direction = direction(*n);
+    if (auto n = get("from")) rule.window.from = duration(*n, "from");
+    if (auto n = get("to")) {
+      rule.window.to = duration(*n, "to");
+      if (*rule.window.to <= rule.window.from)
+        fail(source_, n->Mark(), prefix_ + ": 'to' must be after 'from'");
+    }
+    read_trigger(rule.trigger);
+    read_action(rule.action);
+    if (auto problem = rule_problem(rule)) fail(source_, node_.Mark(), prefix_ + ": " + *problem);
+    return rule;
+  }
+
+ private:
+  std::optional<YAML::Node> get(const char* key) const {
+    YAML::Node n = node_[key];
+    if (!n) return std::nullopt;
+    return n;
+  }
+
+  void check_keys(const std::set<std::string, std::less<>>& allowed) {
+    std::set<std::string, std::less<>> seen;
+    for (auto it = node_.begin(); it != node_.end(); ++it) {
+      const YAML::Node& key = it->first;
+      const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
+      if (!allowed.contains(name)) {
+        fail(source_, key.Mark(),
+             prefix_ + ": unknown key '" + name + "' (this kind takes: " + join(allowed) + ")");
+      }
+      if (!seen.insert(name).second)
+        fail(source_, key.Mark(), prefix_ + ": key '" + name + "' given twice");
+    }
+  }
+
+  [[noreturn]] void bad(const YAML::Node& n, const std::string& what) {
+    fail(source_, n.Mark(), prefix_ + ": " + what);
+  }
+
+  std::string scalar(const YAML::Node& n, const char* key) {
+    if (!n.IsScalar()) bad(n, "'" + std::string(key) + "' must be a single value");
+    return n.Scalar();
+  }
+
+  std::uint64_t count(const YAML::Node& n, const char* key, std::uint64_t min = 1) {
+    const auto v = parse_uint(scalar(n, key));
+    if (!v || *v < min) {
+      bad(n, "'" + std::string(key) + "' must be a whole number >= " + std::to_string(min));
+    }
+    return *v;
+  }
+
+  Duration duration(const YAML::Node& n, const char* key) {
+    const auto d = parse_duration(scalar(n, key));
+    if (!d) {
+      bad(n, "'" + std::string(key) +
+                 "' must be a duration with a unit, like 250ms or 1.5s (units: ns, us, ms, s)");
+    }
+    return *d;
+  }
+
+  ByteCountRange byte_range(const YAML::Node& n, const char* key) {
+    const std::string expected =
+        "'" + std::string(key) + "' must be [min, max] with 1 <= min <= max, or one number";
+    ByteCountRange r;
+    if (n.IsScalar()) {
+      const auto v = parse_uint(n.Scalar());
+      if (!v || *v < 1) bad(n, expected);
+      r.min = r.max = static_cast<std::size_t>(*v);
+      return r;
+    }
+    if (!n.IsSequence() || n.size() != 2) bad(n, expected);
+    std::uint64_t bounds[2] = {0, 0};
+    for (std::size_t k = 0; k < 2; ++k) {
+      const auto v = n[k].IsScalar() ? parse_uint(n[k].Scalar()) : std::nullopt;
+      if (!v) bad(n, expected);
+      bounds[k] = *v;
+    }
+    if (bounds[0] < 1 || bounds[0] > bounds[1]) bad(n, expected);
+    r.min = static_cast<std::size_t>(bounds[0]);
+    r.max = static_cast<std::size_t>(bounds[1]);
+    return r;
+  }
+
+  DurationRange duration_range(const YAML::Node& n, const char* key) {
+    if (n.IsScalar()) {
+      const Duration d = duration(n, key);
+      return DurationRange{d, d};
+    }
+    const std::string expected =
+        "'" + std::string(key) + "' must be a duration or [min, max] durations with min <= max";
+    if (!n.IsSequence() || n.size() != 2) bad(n, expected);
+    const DurationRange r{duration(n[0], key), duration(n[1], key)};
+    if (r.min > r.max) bad(n, expected);
+    return r;
+  }
+
+  DirectionFilter direction(const YAML::Node& n) {
+    const std::string text = scalar(n, "direction");
+    if (text == "to_car") return DirectionFilter::to_car;
+    if (text == "to_client") return DirectionFilter::to_client;
+    if (text == "both") return DirectionFilter::both;
+    bad(n, "'direction' must be to_car, to_client or both");
+  }
+
+  void read_trigger(Trigger& t) {
+    if (auto n = get("match")) t.match = scalar(*n, "match");
+    if (auto n = get("at_frame")) t.at_frame = count(*n, "at_frame");
+    if (auto n = get("first")) t.first = count(*n, "first");
+    if (auto n = get("every")) t.every = count(*n, "every");
+    if (auto n = get("at")) t.at = duration(*n, "at");
+    if (auto n = get("probability")) {
+      const auto p = parse_double(scalar(*n, "probability"));
+      if (!p || !(*p >= 0.0 && *p <= 1.0)) bad(*n, "'probability' must be a number in [0, 1]");
+      t.probability = *p;
+    }
+  }
+
+  static FaultAction make_action(FaultKind kind) {
+    switch (kind) {
+      case FaultKind::fragment:
+        return Fragment{};
+      case FaultKind::coalesce:
+        return Coalesce{};
+      case FaultKind::corrupt:
+        return Corrupt{};
+      case FaultKind::drop:
+        return Drop{};
+      case FaultKind::duplicate:
+        return Duplicate{};
+      case FaultKind::garbage:
+        return Garbage{};
+      case FaultKind::delay:
+        return Delay{};
+      case FaultKind::stall:
+        return Stall{};
+      case FaultKind::bandwidth:
+        return Bandwidth{};
+      case FaultKind::disconnect:
+        return Disconnect{};
+      case FaultKind::reset:
+        return Reset{};
+      case FaultKind::refuse:
+        break;
+    }
+    return Refuse{};
+  }
+
+  void read_action(FaultAction& action) {
+    std::visit([this](auto& a) { read(a); }, action);
+  }
+
+  void read(Fragment& a) {
+    if (auto n = get("sizes")) a.piece_bytes = byte_range(*n, "sizes");
+    if (auto n = get("gap")) a.gap = duration_range(*n, "gap");
+  }
+  void read(Coalesce& a) {
+    if (auto n = get("count")) a.count = static_cast<std::size_t>(count(*n, "count", 2));
+    if (auto n = get("window")) {
+      a.window = duration(*n, "window");
+      if (a.window <= Duration{0}) bad(*n, "'window' must be a positive duration");
+    }
+    if (a.count == 0 && a.window == Duration{0})
+      bad(node_, "needs 'count' (frames) or 'window' (time)");
+  }
+  void read(Corrupt& a) {
+    if (auto n = get("field")) {
+      a.field = scalar(*n, "field");
+      a.target = CorruptTarget::field;
+    }
+    if (auto n = get("target")) {
+      const std::string t = scalar(*n, "target");
+      if (t == "checksum") {
+        a.target = CorruptTarget::checksum;
+      } else if (t == "field") {
+        a.target = CorruptTarget::field;
+      } else if (t == "random") {
+        a.target = CorruptTarget::random;
+      } else {
+        bad(*n, "'target' must be checksum, field or random");
+      }
+      if (a.target == CorruptTarget::field && a.field.empty())
+        bad(*n, "target 'field' needs 'field: NAME'");
+      if (a.target != CorruptTarget::field && !a.field.empty()) {
+        bad(*n, "'field' goes with target 'field' (or leave 'target' out)");
+      }
+    }
+    if (auto n = get("bits")) a.bits = static_cast<std::size_t>(count(*n, "bits"));
+  }
+  void read(Drop& a) {
+    if (auto n = get("unit")) {
+      const std::string u = scalar(*n, "unit");
+      if (u == "frame") {
+        a.unit = DropUnit::frame;
+      } else if (u == "bytes") {
+        a.unit = DropUnit::bytes;
+      } else {
+        bad(*n, "'unit' must be frame or bytes");
+      }
+    }
+    if (auto n = get("count")) {
+      if (a.unit != DropUnit::bytes) bad(*n, "'count' goes with 'unit: bytes'");
+      a.count = byte_range(*n, "count");
+    }
+  }
+  void read(Duplicate& a) {
+    if (auto n = get("copies")) a.copies = static_cast<std::size_t>(count(*n, "copies"));
+  }
+  void read(Garbage& a) {
+    const auto hex = get("hex");
+    const auto text = get("text");
+    const auto length = get("length");
+    if ((hex ? 1 : 0) + (text ? 1 : 0) + (length ? 1 : 0) > 1) {
+      bad(node_, "give one of 'length' (random bytes), 'hex' or 'text'");
+    }
+    if (length) a.length = byte_range(*length, "length");
+    if (hex) {
+      auto bytes = protocol::parse_hex(scalar(*hex, "hex"));
+      if (!bytes || bytes->empty()) bad(*hex, "'hex' must be bytes in hex, like \"DE AD BE EF\"");
+      a.fixed = std::move(*bytes);
+    }
+    if (text) {
+      a.fixed = protocol::to_bytes(scalar(*text, "text"));
+      if (a.fixed.empty()) bad(*text, "'text' must not be empty");
+    }
+  }
+  void read(Delay& a) {
+    const auto n = get("delay");
+    if (!n) bad(node_, "'delay' is missing (the base delay, like 100ms)");
+    a.base = duration(*n, "delay");
+    if (auto j = get("jitter")) a.jitter = duration(*j, "jitter");
+  }
+  void read(Stall& a) { a.duration = required_positive("for"); }
+  void read(Refuse& a) { a.duration = required_positive("for"); }
+  void read(Bandwidth& a) {
+    const auto bps = get("bytes_per_second");
+    const auto baud = get("baud");
+    if (bps && baud) bad(node_, "give 'bytes_per_second' or 'baud', not both");
+    if (!bps && !baud) bad(node_, "needs 'bytes_per_second' or 'baud'");
+    if (bps) a.bytes_per_second = count(*bps, "bytes_per_second");
+    // A serial byte is 10 bits on the wire (start, 8 data, stop: 8N1).
+    if (baud) a.bytes_per_second = std::max<std::uint64_t>(1, count(*baud, "baud", 10) / 10);
+  }
+  void read(Disconnect&) {}
+  void read(Reset&) {}
+
+  Duration required_positive(const char* key) {
+    const auto n = get(key);
+    if (!n) bad(node_, "'" + std::string(key) + "' is missing (how long, like 2s)");
+    const Duration d = duration(*n, key);
+    if (d <= Duration{0}) bad(*n, "'" + std::string(key) + "' must be a positive duration");
+    return d;
+  }
+
+  const std::string& source_;
+  const YAML::Node& node_;
+  std::string prefix_;
+};
+
+}  // namespace
+
+FaultProfileError::FaultProfileError(std::string source, int line, int column,
+                                     const std::string& message)
+    : std::runtime_error(position(source, line, column) + ": " + message),
+      source_(std::move(source)),
+      line_(line),
+      column_(column) {}
+
+std::optional<Duration> parse_duration(std::string_view text) {
+  std::size_t digits_end = 0;
+  while (digits_end < text.size() &&
+         ((text[digits_end] >= '0' && text[digits_end] <= '9') || text[digits_end] == '.')) {
+    ++digits_end;
+  }
+  const std::string_view number = text.substr(0, digits_end);
+  const std::string_view unit = text.substr(digits_end);
+  std::int64_t unit_ns = 0;
+  if (unit == "ns") {
+    unit_ns = 1;
+  } else if (unit == "us") {
+    unit_ns = 1'000;
+  } else if (unit == "ms") {
+    unit_ns = 1'000'000;
+  } else if (unit == "s") {
+    unit_ns = 1'000'000'000;
+  } else {
+    return std::nullopt;
+  }
+  // Whole and fractional parts are read separately so "1.5s" is exactly
+  // 1 500 000 000 ns, with no floating-point rounding.
+  const auto dot = number.find('.');
+  const std::string_view whole = number.substr(0, dot);
+  const std::string_view fraction =
+      dot == std::string_view::npos ? std::string_view{} : number.substr(dot + 1);
+  if (whole.empty() || (dot != std::string_view::npos && fraction.empty())) return std::nullopt;
+  if (fraction.find('.') != std::string_view::npos || fraction.size() > 9) return std::nullopt;
+  const auto w = parse_uint(whole);
+  if (!w || *w > static_cast<std::uint64_t>(INT64_MAX / unit_ns / 2)) return std::nullopt;
+  std::int64_t ns = static_cast<std::int64_t>(*w) * unit_ns;
+  if (!fraction.empty()) {
+    const auto f = parse_uint(fraction);
+    if (!f) return std::nullopt;
+    std::int64_t scale = 1;
+    for (std::size_t i = 0; i < fraction.size(); ++i)
+      scale *= 10;
+    const auto scaled = static_cast<std::int64_t>(*f) * unit_ns;
+    if (scaled % scale != 0) return std::nullopt;  // finer than a nanosecond
+    ns += scaled / scale;
+  }
+  return Duration{ns};
+}
+
+FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& source_name) {
+  YAML::Node rules = node;
+  if (!node || node.IsNull()) return {};
+  if (node.IsMap()) {
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string{};
+      if (key != "rules" && key != "description") {
+        fail(source_name, it->first.Mark(),
+             "unknown key '" + key +
+                 "' (a fault profile has 'rules' and an optional 'description')");
+      }
+    }
+    rules = node["rules"];
+    if (!rules) fail(source_name, node.Mark(), "a fault profile needs 'rules: [...]'");
+    if (rules.IsNull()) return {};
+  }
+  if (!rules.IsSequence()) fail(source_name, rules.Mark(), "'rules' must be a list of rules");
+  FaultProfile profile;
+  for (std::size_t i = 0; i < rules.size(); ++i) {
+    const YAML::Node rule = static_cast<const YAML::Node&>(rules)[i];
+    profile.rules.push_back(RuleReader(source_name, rule, i + 1).read());
+  }
+  return profile;
+}
+
+FaultProfile parse_fault_profile_text(std::string_view yaml, const std::string& source_name) {
+  YAML::Node node;
+  try {
+    node = YAML::Load(std::string(yaml));
+  } catch (const YAML::ParserException& e) {
+    fail(source_name, e.mark, "not valid YAML: " + e.msg);
+  }
+  return parse_fault_profile(node, source_name);
+}
+
+FaultProfile load_fault_profile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FaultProfileError(path, 0, 0, "cannot read the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_fault_profile_text(text.str(), path);
+}
+
+}  // namespace hil::link
