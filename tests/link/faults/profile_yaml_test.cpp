@@ -1,0 +1,229 @@
+#include "link/faults/profile_yaml.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+
+namespace hil::link {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::HasSubstr;
+
+/// The message of the FaultProfileError the text raises ("" if none).
+std::string error_of(const std::string& yaml) {
+  try {
+    parse_fault_profile_text(yaml, "faults.yaml");
+  } catch (const FaultProfileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(FaultProfileYaml, DurationsNeedAUnitAndAreExact) {
+  EXPECT_EQ(parse_duration("250ms"), Duration{250ms});
+  EXPECT_EQ(parse_duration("2s"), Duration{2s});
+  EXPECT_EQ(parse_duration("1.5s"), Duration{1500ms});
+  EXPECT_EQ(parse_duration("0.001s"), Duration{1ms});
+  EXPECT_EQ(parse_duration("500us"), Duration{500us});
+  EXPECT_EQ(parse_duration("7ns"), Duration{7});
+  EXPECT_EQ(parse_duration("0s"), Duration{0});
+  for (const char* bad :
+       {"250", "1.5", "-1s", "ms", "1.s", ".5s", "1.0.0s", "2 s", "1h", "0.5ns"}) {
+    EXPECT_FALSE(parse_duration(bad)) << bad;
+  }
+}
+
+TEST(FaultProfileYaml, ReadsEveryKindWithItsKeys) {
+  const auto p = parse_fault_profile_text(R"(
+description: every kind once
+rules:
+  - kind: fragment
+    name: small pieces
+    sizes: [1, 4]
+    gap: [0ms, 5ms]
+  - kind: coalesce
+    count: 3
+    window: 200ms
+  - kind: corrupt
+    target: checksum
+    direction: to_client
+    probability: 0.1
+  - kind: corrupt
+    field: value
+    at_frame: 4
+  - kind: drop
+    match: "FB:ST"
+    first: 1
+  - kind: drop
+    unit: bytes
+    count: [1, 3]
+    every: 10
+  - kind: duplicate
+    copies: 2
+    from: 1s
+    to: 2.5s
+  - kind: garbage
+    hex: "DE AD"
+  - kind: delay
+    delay: 100ms
+    jitter: 20ms
+  - kind: stall
+    at: 3s
+    for: 500ms
+  - kind: bandwidth
+    baud: 9600
+  - kind: disconnect
+    at: 10s
+  - kind: reset
+    at_frame: 50
+  - kind: refuse
+    at: 0s
+    for: 2s
+)",
+                                          "faults.yaml");
+  ASSERT_EQ(p.rules.size(), 14U);
+  const auto& frag = std::get<Fragment>(p.rules[0].action);
+  EXPECT_EQ(p.rules[0].name, "small pieces");
+  EXPECT_EQ(frag.piece_bytes, (ByteCountRange{1, 4}));
+  EXPECT_EQ(frag.gap, (DurationRange{0ms, 5ms}));
+  EXPECT_EQ(std::get<Coalesce>(p.rules[1].action).count, 3U);
+  EXPECT_EQ(std::get<Coalesce>(p.rules[1].action).window, Duration{200ms});
+  EXPECT_EQ(std::get<Corrupt>(p.rules[2].action).target, CorruptTarget::checksum);
+  EXPECT_EQ(p.rules[2].direction, DirectionFilter::to_client);
+  EXPECT_EQ(p.rules[2].trigger.probability, 0.1);
+  EXPECT_EQ(std::get<Corrupt>(p.rules[3].action).target, CorruptTarget::field);
+  EXPECT_EQ(std::get<Corrupt>(p.rules[3].action).field, "value");
+  EXPECT_EQ(p.rules[3].trigger.at_frame, 4U);
+  EXPECT_EQ(p.rules[4].trigger.match, "FB:ST");
+  EXPECT_EQ(p.rules[4].trigger.first, 1U);
+  EXPECT_EQ(std::get<Drop>(p.rules[5].action).unit, DropUnit::bytes);
+  EXPECT_EQ(std::get<Drop>(p.rules[5].action).count, (ByteCountRange{1, 3}));
+  EXPECT_EQ(p.rules[5].trigger.every, 10U);
+  EXPECT_EQ(std::get<Duplicate>(p.rules[6].action).copies, 2U);
+  EXPECT_EQ(p.rules[6].window.from, Time{1s});
+  EXPECT_EQ(p.rules[6].window.to, Time{2500ms});
+  EXPECT_EQ(std::get<Garbage>(p.rules[7].action).fixed, (protocol::Bytes{0xDE, 0xAD}));
+  EXPECT_EQ(std::get<Delay>(p.rules[8].action).base, Duration{100ms});
+  EXPECT_EQ(std::get<Delay>(p.rules[8].action).jitter, Duration{20ms});
+  EXPECT_EQ(std::get<Stall>(p.rules[9].action).duration, Duration{500ms});
+  EXPECT_EQ(p.rules[9].trigger.at, Time{3s});
+  EXPECT_EQ(std::get<Bandwidth>(p.rules[10].action).bytes_per_second, 960U);
+  EXPECT_EQ(p.rules[11].kind(), FaultKind::disconnect);
+  EXPECT_EQ(p.rules[12].kind(), FaultKind::reset);
+  EXPECT_EQ(std::get<Refuse>(p.rules[13].action).duration, Duration{2s});
+  EXPECT_NO_THROW(validate(p));
+}
+
+TEST(FaultProfileYaml, AListOfRulesOrNothingIsAProfileToo) {
+  EXPECT_EQ(parse_fault_profile_text("- kind: drop\n", "x.yaml").rules.size(), 1U);
+  EXPECT_TRUE(parse_fault_profile_text("rules: []\n", "x.yaml").rules.empty());
+  EXPECT_TRUE(parse_fault_profile_text("", "x.yaml").rules.empty());
+}
+
+TEST(FaultProfileYaml, EmbeddedInAScenarioNode) {
+  const YAML::Node scenario =
+      YAML::Load("name: lost feedback\nfaults:\n  rules:\n    - kind: drop\n      first: 1\n");
+  const auto p = parse_fault_profile(scenario["faults"], "scenario.yaml");
+  ASSERT_EQ(p.rules.size(), 1U);
+  EXPECT_EQ(p.rules[0].trigger.first, 1U);
+}
+
+TEST(FaultProfileYaml, ErrorsNameFileLineColumnAndWhatWasExpected) {
+  EXPECT_EQ(error_of("rules:\n  - kind: drop\n  - kind: fragment\n    sizes: [5, 2]\n"),
+            "faults.yaml:4:12: rule 2 (fragment): 'sizes' must be [min, max] with 1 <= min <= max, "
+            "or one "
+            "number");
+  EXPECT_EQ(error_of("rules:\n  - kind: delay\n    delay: 100\n"),
+            "faults.yaml:3:12: rule 1 (delay): 'delay' must be a duration with a unit, like 250ms "
+            "or 1.5s "
+            "(units: ns, us, ms, s)");
+}
+
+TEST(FaultProfileYaml, UnknownKeysAreErrorsSoTyposCannotDisableAFault) {
+  const auto e = error_of("rules:\n  - kind: drop\n    frist: 1\n");
+  EXPECT_THAT(e, testing::StartsWith("faults.yaml:3:5: rule 1 (drop): unknown key 'frist'"));
+  EXPECT_THAT(e, HasSubstr("first"));
+  EXPECT_THAT(error_of("rule:\n  - kind: drop\n"),
+              testing::StartsWith("faults.yaml:1:1: unknown key 'rule'"));
+  EXPECT_THAT(error_of("- kind: bandwidth\n  baud: 9600\n  first: 3\n"),
+              testing::StartsWith("faults.yaml:3:3: rule 1 (bandwidth): unknown key 'first'"));
+}
+
+TEST(FaultProfileYaml, EachProblemIsReported) {
+  EXPECT_THAT(error_of("- kind: dorp\n"), HasSubstr("1:9: rule 1: unknown kind 'dorp'"));
+  EXPECT_THAT(error_of("- drop\n"), HasSubstr("rule 1: must be a map"));
+  EXPECT_THAT(error_of("- name: x\n"), HasSubstr("'kind' is missing"));
+  EXPECT_THAT(error_of("- kind: drop\n  probability: 1.5\n"),
+              HasSubstr("2:16: rule 1 (drop): 'probability' must be"));
+  EXPECT_THAT(error_of("- kind: drop\n  direction: up\n"),
+              HasSubstr("'direction' must be to_car, to_client or both"));
+  EXPECT_THAT(error_of("- kind: drop\n  first: 0\n"),
+              HasSubstr("'first' must be a whole number >= 1"));
+  EXPECT_THAT(error_of("- kind: drop\n  count: 3\n"), HasSubstr("'count' goes with 'unit: bytes'"));
+  EXPECT_THAT(error_of("- kind: stall\n  for: 1s\n"), HasSubstr("needs 'at' or a frame trigger"));
+  EXPECT_THAT(error_of("- kind: stall\n  at: 1s\n"), HasSubstr("'for' is missing"));
+  EXPECT_THAT(error_of("- kind: coalesce\n"),
+              HasSubstr("needs 'count' (frames) or 'window' (time)"));
+  EXPECT_THAT(error_of("- kind: coalesce\n  count: 1\n"),
+              HasSubstr("'count' must be a whole number >= 2"));
+  EXPECT_THAT(error_of("- kind: corrupt\n  target: field\n"),
+              HasSubstr("target 'field' needs 'field: NAME'"));
+  EXPECT_THAT(error_of("- kind: garbage\n  hex: zz\n"), HasSubstr("'hex' must be bytes in hex"));
+  EXPECT_THAT(error_of("- kind: delay\n  jitter: 5ms\n"), HasSubstr("'delay' is missing"));
+  EXPECT_THAT(error_of("- kind: drop\n  at: 1s\n"), HasSubstr("unknown key 'at'"));
+  EXPECT_THAT(error_of("- kind: drop\n  from: 2s\n  to: 1s\n"),
+              HasSubstr("'to' must be after 'from'"));
+  EXPECT_THAT(error_of("- kind: drop\n  first: 1\n  first: 2\n"), HasSubstr("given twice"));
+  EXPECT_THAT(error_of("- kind: [drop\n"), HasSubstr("not valid YAML"));
+}
+
+TEST(FaultProfileYaml, MissingFileSaysSo) {
+  try {
+    load_fault_profile("/nonexistent/faults.yaml");
+    FAIL();
+  } catch (const FaultProfileError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent/faults.yaml: cannot read the file");
+    EXPECT_EQ(e.line(), 0);
+  }
+}
+
+TEST(FaultProfileYaml, ForDirectionKeepsTheRulesForItAndNamesThemStably) {
+  const auto p = parse_fault_profile_text(R"(
+- kind: drop
+  direction: to_car
+- kind: delay
+  delay: 1ms
+- kind: duplicate
+  name: dup
+  direction: to_client
+)",
+                                          "x.yaml");
+  const auto car = for_direction(p, Direction::to_car);
+  const auto client = for_direction(p, Direction::to_client);
+  ASSERT_EQ(car.rules.size(), 2U);
+  EXPECT_EQ(car.rules[0].name, "#1");
+  EXPECT_EQ(car.rules[1].name, "#2");
+  ASSERT_EQ(client.rules.size(), 2U);
+  EXPECT_EQ(client.rules[0].name, "#2");
+  EXPECT_EQ(client.rules[1].name, "dup");
+}
+
+TEST(FaultProfileYaml, EveryExampleProfileLoads) {
+  const std::filesystem::path dir = std::filesystem::path(HIL_SOURCE_DIR) / "scenarios" / "faults";
+  std::size_t loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    FaultProfile p;
+    EXPECT_NO_THROW(p = load_fault_profile(entry.path().string()));
+    EXPECT_FALSE(p.rules.empty());
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 5U);
+}
+
+}  // namespace
+}  // namespace hil::link
