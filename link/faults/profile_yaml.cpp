@@ -148,7 +148,8 @@ class RuleReader {
   void check_keys(const std::set<std::string, std::less<>>& allowed) {
     std::set<std::string, std::less<>> seen;
     for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const YAML::Node& key = it->first;
+      // A copy: the iterator hands out a temporary pair, so a reference would dangle.
+      const YAML::Node key = it->first;
       const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
       if (!allowed.contains(name)) {
         fail(source_, key.Mark(),
@@ -441,9 +442,10 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
   if (!node || node.IsNull()) return {};
   if (node.IsMap()) {
     for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string{};
+      const YAML::Node key_node = it->first;
+      const std::string key = key_node.IsScalar() ? key_node.Scalar() : std::string{};
       if (key != "rules" && key != "description") {
-        fail(source_name, it->first.Mark(),
+        fail(source_name, key_node.Mark(),
              "unknown key '" + key +
                  "' (a fault profile has 'rules' and an optional 'description')");
       }
