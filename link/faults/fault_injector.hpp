@@ -26,12 +26,12 @@ namespace hil::link {
 struct FaultEvent {
   Time at{0};
   Direction direction = Direction::to_car;
-  std::string kind;    ///< "fragment", "drop", "corrupt", ... (the rule's kind)
-  std::string rule;    ///< the rule's name in the profile (or its index)
+  std::string kind;         ///< "fragment", "drop", "corrupt", ... (the rule's kind)
+  std::string rule;         ///< the rule's name in the profile (or its index)
   std::uint64_t frame = 0;  ///< the frame acted on (1-based in this direction); 0: none
-  protocol::Bytes before;  ///< the bytes the rule acted on
-  protocol::Bytes after;   ///< what was delivered instead (empty for a drop)
-  std::string detail;      ///< what happened, for a person
+  protocol::Bytes before;   ///< the bytes the rule acted on
+  protocol::Bytes after;    ///< what was delivered instead (empty for a drop)
+  std::string detail;       ///< what happened, for a person
 };
 using FaultEventSink = std::function<void(const FaultEvent&)>;
 
@@ -48,8 +48,8 @@ using InjectorOutput = std::variant<Delivery, LinkBreak>;
 class FaultInjector {
  public:
   /// `protocol` may be the raw adapter (every write is one frame).
-  FaultInjector(Direction direction, std::shared_ptr<const ProtocolAdapter> protocol, FaultProfile profile,
-                std::uint64_t seed, FaultEventSink sink = {});
+  FaultInjector(Direction direction, std::shared_ptr<const ProtocolAdapter> protocol,
+                FaultProfile profile, std::uint64_t seed, FaultEventSink sink = {});
   ~FaultInjector();
   FaultInjector(FaultInjector&&) noexcept;
   FaultInjector& operator=(FaultInjector&&) noexcept;
