@@ -33,8 +33,8 @@ std::string error_text(const DecodeError& e) {
 template <class Decoder, class Message, class Describe>
 class DecoderSplitter final : public FrameSplitter {
  public:
-  DecoderSplitter(Decoder decoder, Describe describe)
-      : decoder_(std::move(decoder)), describe_(std::move(describe)) {}
+  DecoderSplitter(Decoder decoder, Describe describe, bool with_text)
+      : decoder_(std::move(decoder)), describe_(std::move(describe)), with_text_(with_text) {}
 
   void feed(ByteView bytes, std::vector<WireFrame>& out) override {
     items_.clear();
@@ -54,7 +54,7 @@ class DecoderSplitter final : public FrameSplitter {
       WireFrame frame;
       if (auto* f = std::get_if<protocol::Frame<Message>>(&item)) {
         frame.valid = true;
-        auto [kind, text] = describe_(f->message);
+        auto [kind, text] = describe_(f->message, with_text_);
         frame.kind = std::move(kind);
         frame.text = std::move(text);
         frame.raw = std::move(f->raw);
@@ -70,13 +70,14 @@ class DecoderSplitter final : public FrameSplitter {
 
   Decoder decoder_;
   Describe describe_;
+  bool with_text_;
   std::vector<protocol::DecodeItem<Message>> items_;
 };
 
 template <class Message, class Decoder, class Describe>
-std::unique_ptr<FrameSplitter> make_splitter(Decoder decoder, Describe describe) {
+std::unique_ptr<FrameSplitter> make_splitter(Decoder decoder, Describe describe, bool with_text) {
   return std::make_unique<DecoderSplitter<Decoder, Message, Describe>>(std::move(decoder),
-                                                                       std::move(describe));
+                                                                       std::move(describe), with_text);
 }
 
 using KindAndText = std::pair<std::string, std::string>;
@@ -85,23 +86,27 @@ using KindAndText = std::pair<std::string, std::string>;
 
 class RawSplitter final : public FrameSplitter {
  public:
+  explicit RawSplitter(bool with_text) : with_text_(with_text) {}
   void feed(ByteView bytes, std::vector<WireFrame>& out) override {
     if (bytes.empty()) return;
     WireFrame frame;
     frame.raw.assign(bytes.begin(), bytes.end());
     frame.valid = true;
-    frame.text = protocol::escape(bytes);
+    if (with_text_) frame.text = protocol::escape(bytes);
     out.push_back(std::move(frame));
   }
   void finish(std::vector<WireFrame>& /*out*/) override {}
   std::size_t buffered() const override { return 0; }
+
+ private:
+  bool with_text_;
 };
 
 class RawAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "raw"; }
-  std::unique_ptr<FrameSplitter> splitter() const override {
-    return std::make_unique<RawSplitter>();
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
+    return std::make_unique<RawSplitter>(with_text);
   }
   std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
     return std::nullopt;
@@ -120,11 +125,11 @@ class LogiAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "logi"; }
 
-  std::unique_ptr<FrameSplitter> splitter() const override {
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace logi = protocol::logi;
-    return make_splitter<logi::Message>(logi::Decoder{}, [](const logi::Message& m) {
-      return KindAndText{kind_of(m), logi::describe(m)};
-    });
+    return make_splitter<logi::Message>(logi::Decoder{}, [](const logi::Message& m, bool text) {
+      return KindAndText{kind_of(m), text ? logi::describe(m) : std::string()};
+    }, with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {
@@ -182,11 +187,11 @@ class ArduinoAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "arduino"; }
 
-  std::unique_ptr<FrameSplitter> splitter() const override {
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace arduino = protocol::arduino;
-    return make_splitter<arduino::Message>(arduino::Decoder{}, [](const arduino::Message& m) {
-      return KindAndText{std::string(arduino::command_of(m.body)), arduino::describe(m)};
-    });
+    return make_splitter<arduino::Message>(arduino::Decoder{}, [](const arduino::Message& m, bool text) {
+      return KindAndText{std::string(arduino::command_of(m.body)), text ? arduino::describe(m) : std::string()};
+    }, with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {
@@ -231,13 +236,13 @@ class Wr8Adapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "wr8"; }
 
-  std::unique_ptr<FrameSplitter> splitter() const override {
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace wr8 = protocol::wr8;
-    return make_splitter<wr8::Message>(wr8::Decoder{}, [](const wr8::Message& m) {
+    return make_splitter<wr8::Message>(wr8::Decoder{}, [](const wr8::Message& m, bool text) {
       std::string kind(wr8::to_string(wr8::code_of(m)));
       std::replace(kind.begin(), kind.end(), '-', '_');  // AUTH-REPLY -> AUTH_REPLY
-      return KindAndText{std::move(kind), wr8::describe(m)};
-    });
+      return KindAndText{std::move(kind), text ? wr8::describe(m) : std::string()};
+    }, with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
@@ -270,13 +275,13 @@ class LekaAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "leka"; }
 
-  std::unique_ptr<FrameSplitter> splitter() const override {
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace leka = protocol::leka;
-    return make_splitter<leka::Message>(leka::Decoder{}, [](const leka::Message& m) {
+    return make_splitter<leka::Message>(leka::Decoder{}, [](const leka::Message& m, bool text) {
       std::string kind =
           m.commands.empty() ? std::string{} : std::string(leka::spec_of(m.commands.front()).name);
-      return KindAndText{std::move(kind), leka::describe(m)};
-    });
+      return KindAndText{std::move(kind), text ? leka::describe(m) : std::string()};
+    }, with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {

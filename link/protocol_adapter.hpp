@@ -45,7 +45,10 @@ class ProtocolAdapter {
   virtual ~ProtocolAdapter() = default;
   /// "logi", "wr8", "arduino", "leka" or "raw".
   virtual std::string_view name() const = 0;
-  virtual std::unique_ptr<FrameSplitter> splitter() const = 0;
+  /// `with_text` false leaves WireFrame::text empty for valid frames: the
+  /// fault injector needs kinds, not descriptions, and skipping them is most
+  /// of the cost of splitting a fast stream.
+  virtual std::unique_ptr<FrameSplitter> splitter(bool with_text = true) const = 0;
   /// Where the checksum is written in a frame; nullopt when the protocol has
   /// none (WR8, raw) or the frame is not one.
   virtual std::optional<ByteRange> checksum_field(protocol::ByteView frame) const = 0;

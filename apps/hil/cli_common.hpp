@@ -94,4 +94,7 @@ void register_wr8(CommandSet& commands);
 void register_arduino(CommandSet& commands);
 void register_leka(CommandSet& commands);
 
+/// Registers `hil proxy`.
+void register_proxy(CLI::App& app, std::function<int()>& run);
+
 }  // namespace hil::apps

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   hil::apps::register_wr8(commands);
   hil::apps::register_arduino(commands);
   hil::apps::register_leka(commands);
+  hil::apps::register_proxy(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 && (std::string_view(argv[1]) == "encode" || std::string_view(argv[1]) == "decode") &&

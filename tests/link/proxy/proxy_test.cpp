@@ -1,0 +1,211 @@
+// The proxy over real transports: TCP to TCP and pty to TCP, with faults and
+// capture. Each test runs the io_context with a deadline, so none can hang.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <asio/io_context.hpp>
+#include <filesystem>
+#include <set>
+
+#include "link/asio_executor.hpp"
+#include "link/capture/wire_log.hpp"
+#include "link/faults/profile_yaml.hpp"
+#include "link/proxy.hpp"
+#include "link/transport.hpp"
+
+namespace hil::link {
+namespace {
+
+using protocol::to_bytes;
+
+// An upstream "car" that answers every byte it gets by echoing it.
+struct EchoCar {
+  std::unique_ptr<Listener> listener;
+  std::vector<BytePipePtr> pipes;
+  std::string received;
+
+  explicit EchoCar(TransportContext& ctx) {
+    listener = listen(ctx, parse_endpoint("tcp://127.0.0.1:0"));
+    listener->start([this](BytePipePtr p) {
+      pipes.push_back(p);
+      std::weak_ptr<BytePipe> weak = p;
+      p->start({[this, weak](ByteView b) {
+                  received.append(b.begin(), b.end());
+                  if (auto self = weak.lock()) self->write(b);
+                },
+                [](std::error_code) {}});
+    });
+  }
+};
+
+// A client of the proxy, collecting what comes back.
+struct Client {
+  BytePipePtr pipe;
+  std::string received;
+  std::optional<std::error_code> closed;
+  bool connected = false;
+  std::error_code connect_error;
+
+  void connect_to(TransportContext& ctx, const std::string& uri, const std::string& first_write = {}) {
+    connect(ctx, parse_endpoint(uri), [this, first_write](std::error_code ec, BytePipePtr p) {
+      connect_error = ec;
+      if (ec) return;
+      connected = true;
+      pipe = p;
+      p->start({[this](ByteView b) { received.append(b.begin(), b.end()); },
+                [this](std::error_code e) { closed = e; }});
+      if (!first_write.empty()) p->write(to_bytes(first_write));
+    });
+  }
+};
+
+class ProxyTest : public ::testing::Test {
+ protected:
+  asio::io_context io;
+  AsioExecutor executor{io};
+  TransportContext ctx{executor, &io};
+
+  // Runs the io_context until `done` holds or 5 s pass.
+  bool run_until(const std::function<bool()>& done) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (!done() && std::chrono::steady_clock::now() < deadline) {
+      io.run_for(std::chrono::milliseconds(5));
+      io.restart();
+    }
+    return done();
+  }
+  void settle(std::chrono::milliseconds d) {
+    const auto until = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < until) {
+      io.run_for(std::chrono::milliseconds(5));
+      io.restart();
+    }
+  }
+
+  ProxyOptions options(const EchoCar& car, const std::string& faults_yaml = "rules: []") {
+    ProxyOptions o;
+    o.listen = parse_endpoint("tcp://127.0.0.1:0");
+    o.upstream = parse_endpoint(car.listener->address());
+    o.protocol = protocol_adapter("logi");
+    o.faults = parse_fault_profile_text(faults_yaml, "test");
+    o.seed = 7;
+    return o;
+  }
+};
+
+TEST_F(ProxyTest, TcpToTcpCarriesBothDirections) {
+  EchoCar car(ctx);
+  Proxy proxy(ctx, options(car));
+  proxy.start();
+  Client client;
+  client.connect_to(ctx, proxy.address(), "LOGI:SP:050:D7#LOGI:MV:FWD:23#");
+  ASSERT_TRUE(run_until([&] { return client.received.size() == 30; })) << client.received;
+  EXPECT_EQ(car.received, "LOGI:SP:050:D7#LOGI:MV:FWD:23#");
+  EXPECT_EQ(client.received, "LOGI:SP:050:D7#LOGI:MV:FWD:23#");
+  EXPECT_EQ(proxy.links_opened(), 1u);
+  EXPECT_EQ(proxy.open_links(), 1u);
+}
+
+TEST_F(ProxyTest, FaultRulesActOnFramesOfTheNamedKind) {
+  EchoCar car(ctx);
+  Proxy proxy(ctx, options(car, R"(
+rules:
+  - kind: drop
+    direction: to_car
+    match: "SP"
+    first: 1
+)"));
+  proxy.start();
+  Client client;
+  client.connect_to(ctx, proxy.address(), "LOGI:SP:050:D7#LOGI:MV:FWD:23#");
+  ASSERT_TRUE(run_until([&] { return client.received.size() >= 15; }));
+  settle(std::chrono::milliseconds(50));
+  EXPECT_EQ(car.received, "LOGI:MV:FWD:23#");
+  EXPECT_EQ(client.received, "LOGI:MV:FWD:23#");
+}
+
+TEST_F(ProxyTest, RefuseRuleTurnsClientsAway) {
+  EchoCar car(ctx);
+  Proxy proxy(ctx, options(car, R"(
+rules:
+  - kind: refuse
+    at: 0s
+    for: 60s
+)"));
+  proxy.start();
+  Client client;
+  client.connect_to(ctx, proxy.address());
+  ASSERT_TRUE(run_until([&] { return client.closed.has_value() || (client.connect_error && true); }));
+  EXPECT_EQ(proxy.connections_refused(), 1u);
+  EXPECT_EQ(proxy.links_opened(), 0u);
+  EXPECT_TRUE(car.pipes.empty());
+}
+
+TEST_F(ProxyTest, UnreachableCarClosesTheClient) {
+  ProxyOptions o;
+  o.listen = parse_endpoint("tcp://127.0.0.1:0");
+  {
+    // A port that was free a moment ago: nothing listens there now.
+    auto probe = listen(ctx, parse_endpoint("tcp://127.0.0.1:0"));
+    o.upstream = parse_endpoint(probe->address());
+    probe->close();
+  }
+  std::vector<std::string> lines;
+  o.log = [&](const std::string& line) { lines.push_back(line); };
+  Proxy proxy(ctx, o);
+  proxy.start();
+  Client client;
+  client.connect_to(ctx, proxy.address());
+  ASSERT_TRUE(run_until([&] { return client.closed.has_value(); }));
+  bool said = false;
+  for (const auto& l : lines) said = said || l.find("cannot reach the car") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST_F(ProxyTest, WireLogRecordsEveryLink) {
+  EchoCar car(ctx);
+  auto o = options(car);
+  const auto path = std::filesystem::temp_directory_path() / ("hil-proxy-test-" + std::to_string(::getpid()) + ".ndjson");
+  std::filesystem::remove(path);
+  o.wire_log_path = path.string();
+  {
+    Proxy proxy(ctx, o);
+    proxy.start();
+    Client a, b;
+    a.connect_to(ctx, proxy.address(), "LOGI:SP:050:D7#");
+    b.connect_to(ctx, proxy.address(), "LOGI:MV:CW:DC#");
+    ASSERT_TRUE(run_until([&] { return a.received.size() == 15 && b.received.size() == 14; }));
+    proxy.close();
+    settle(std::chrono::milliseconds(20));
+  }
+  const auto records = read_wire_log(path);
+  std::set<std::string> links;
+  std::size_t delivered = 0;
+  for (const auto& r : records) {
+    links.insert(r["link"].get<std::string>());
+    if (r["event"] == "delivered") delivered += r["bytes"].get<std::size_t>();
+  }
+  EXPECT_EQ(links, (std::set<std::string>{"link1", "link2"}));
+  EXPECT_EQ(delivered, 2u * (15 + 14));  // each frame there and back
+  std::filesystem::remove(path);
+}
+
+TEST_F(ProxyTest, PtyClientReachesATcpCar) {
+  EchoCar car(ctx);
+  auto o = options(car);
+  const std::string path = "/tmp/hil-proxy-test-pty-" + std::to_string(::getpid());
+  o.listen = parse_endpoint("pty://" + path);
+  Proxy proxy(ctx, o);
+  proxy.start();
+  Client client;
+  client.connect_to(ctx, "pty://" + path, "LOGI:GS:002:CB#");
+  ASSERT_TRUE(run_until([&] { return client.received.size() == 15; })) << client.received;
+  EXPECT_EQ(car.received, "LOGI:GS:002:CB#");
+  proxy.close();
+  settle(std::chrono::milliseconds(20));
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+}  // namespace
+}  // namespace hil::link
