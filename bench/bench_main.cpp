@@ -53,8 +53,8 @@ class RecordingReporter : public benchmark::ConsoleReporter {
     bool ok = !failed_;
     for (const auto& [name, ratio] : ratios()) {
       const bool pass = ratio <= max_ratio;
-      std::printf("%s: bytewise/whole cost per byte = %.2f (limit %.1f) %s\n", name.c_str(), ratio, max_ratio,
-                  pass ? "ok" : "TOO SLOW");
+      std::printf("%s: bytewise/whole cost per byte = %.2f (limit %.1f) %s\n", name.c_str(), ratio,
+                  max_ratio, pass ? "ok" : "TOO SLOW");
       ok = ok && pass;
     }
     return ok;
@@ -66,9 +66,9 @@ class RecordingReporter : public benchmark::ConsoleReporter {
     char line[256];
     for (const auto& [name, b] : best_) {
       const auto slash = name.rfind('/');
-      std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.0f | %.2f |\n", name.substr(0, slash).c_str(),
-                    name.substr(slash + 1).c_str(), b.bytes_per_second / 1e6, b.frames_per_second,
-                    b.ms_per_iteration);
+      std::snprintf(line, sizeof line, "| %s | %s | %.1f | %.0f | %.2f |\n",
+                    name.substr(0, slash).c_str(), name.substr(slash + 1).c_str(),
+                    b.bytes_per_second / 1e6, b.frames_per_second, b.ms_per_iteration);
       out << line;
     }
     out << "\n| decoder | bytewise / whole cost per byte |\n|---|---:|\n";

@@ -31,8 +31,8 @@ std::vector<std::uint8_t> build_stream(MakeFrame make_frame, std::size_t* frame_
 /// Decodes `stream` with pieces of `piece` bytes (0 = all at once) per
 /// iteration and checks that every frame came out.
 template <class Decoder, class Message>
-void run_decoder(benchmark::State& state, const std::vector<std::uint8_t>& stream, std::size_t frames,
-                 std::size_t piece) {
+void run_decoder(benchmark::State& state, const std::vector<std::uint8_t>& stream,
+                 std::size_t frames, std::size_t piece) {
   std::vector<protocol::DecodeItem<Message>> items;
   items.reserve(frames + 16);
   for (auto _ : state) {
@@ -51,8 +51,8 @@ void run_decoder(benchmark::State& state, const std::vector<std::uint8_t>& strea
     if (items.size() != frames) state.SkipWithError("decoder lost or split frames");
   }
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
-  state.counters["frames_per_s"] =
-      benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["frames_per_s"] = benchmark::Counter(
+      static_cast<double>(frames), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["stream_bytes"] = static_cast<double>(stream.size());
 }
 

@@ -141,7 +141,8 @@ Latency round_trips(const std::string& uri, int frames) {
       if (n <= 0) std::exit(4);
       got += static_cast<std::size_t>(n);
     }
-    if (i >= 200) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    if (i >= 200)
+      us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
   }
   ::close(fd);
   std::sort(us.begin(), us.end());
@@ -152,9 +153,11 @@ double throughput_mb_s(const std::string& uri, const Car& sink, std::size_t mib)
   const int fd = connect_to(uri);
   // Whole STAT frames (a frame-aware proxy holds an unfinished frame back).
   const std::string frame =
-      "LOGI:STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,RPM:120:121:-119:0:3B#";
+      "LOGI:STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,RPM:120:121:"
+      "-119:0:3B#";
   std::vector<char> chunk;
-  while (chunk.size() + frame.size() <= 64 * 1024) chunk.insert(chunk.end(), frame.begin(), frame.end());
+  while (chunk.size() + frame.size() <= 64 * 1024)
+    chunk.insert(chunk.end(), frame.begin(), frame.end());
   const std::uint64_t start_count = sink.received();
   const std::uint64_t total = (mib * 1024 * 1024 / chunk.size() + 1) * chunk.size();
   const auto t0 = Clock::now();
@@ -192,12 +195,18 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (a == "--frames") frames = std::stoi(value());
-    else if (a == "--mib") mib = std::stoul(value());
-    else if (a == "--protocol") protocol = value();
-    else if (a == "--markdown") markdown = value();
+    if (a == "--frames")
+      frames = std::stoi(value());
+    else if (a == "--mib")
+      mib = std::stoul(value());
+    else if (a == "--protocol")
+      protocol = value();
+    else if (a == "--markdown")
+      markdown = value();
     else {
-      std::fprintf(stderr, "usage: proxy_bench [--frames N] [--mib M] [--protocol raw|logi] [--markdown FILE]\n");
+      std::fprintf(
+          stderr,
+          "usage: proxy_bench [--frames N] [--mib M] [--protocol raw|logi] [--markdown FILE]\n");
       return 2;
     }
   }
@@ -221,8 +230,8 @@ int main(int argc, char** argv) {
                 "| through the proxy | %.1f µs | %.1f µs | %.0f MB/s |\n\n"
                 "Added median latency per frame per crossing: %.1f µs (target < 50 µs). "
                 "Throughput through one proxied connection: %.0f MB/s (target >= 100 MB/s).\n",
-                protocol.c_str(), direct.p50_us, direct.p99_us, direct_mb, proxied.p50_us, proxied.p99_us,
-                proxied_mb, added_per_frame_us, proxied_mb);
+                protocol.c_str(), direct.p50_us, direct.p99_us, direct_mb, proxied.p50_us,
+                proxied.p99_us, proxied_mb, added_per_frame_us, proxied_mb);
   std::fputs(table, stdout);
   if (!markdown.empty()) std::ofstream(markdown, std::ios::app) << table << '\n';
   return 0;

@@ -5,11 +5,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset default >/dev/null
-cmake --build --preset default --target decoder_bench
+cmake --build --preset default --target decoder_bench proxy_bench
 table=$(mktemp)
-trap 'rm -f "$table"' EXIT
+proxy_table=$(mktemp)
+trap 'rm -f "$table" "$proxy_table"' EXIT
 build/bench/decoder_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
   --hil_max_bytewise_ratio=5 --hil_markdown="$table"
+
+build/bench/proxy_bench --frames 20000 --mib 256 --protocol raw --markdown "$proxy_table"
+build/bench/proxy_bench --frames 20000 --mib 128 --protocol logi --markdown "$proxy_table"
 
 doc=docs/performance.md
 begin='<!-- decoder-bench:begin -->'
@@ -22,7 +26,12 @@ end='<!-- decoder-bench:end -->'
   echo
   cat "$table"
   echo
-  sed -n "/$end/,\$p" "$doc"
+  sed -n "/$end/,/proxy-bench:begin/p" "$doc"
+  echo
+  echo "Measured $(date -u +%Y-%m-%d) with \`bench/run.sh\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way):"
+  echo
+  cat "$proxy_table"
+  sed -n "/proxy-bench:end/,\$p" "$doc"
 } > "$doc.new"
 mv "$doc.new" "$doc"
 echo "updated $doc"

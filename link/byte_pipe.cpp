@@ -4,6 +4,8 @@
 
 namespace hil::link {
 
-std::error_code end_of_stream() { return asio::error::make_error_code(asio::error::eof); }
+std::error_code end_of_stream() {
+  return asio::error::make_error_code(asio::error::eof);
+}
 
 }  // namespace hil::link

@@ -11,8 +11,8 @@
 
 namespace hil::link {
 
-using protocol::ByteView;
 using protocol::Bytes;
+using protocol::ByteView;
 
 enum class CloseMode : std::uint8_t {
   graceful,  ///< flush what is queued, then close (TCP: FIN)

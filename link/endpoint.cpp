@@ -17,7 +17,8 @@ unsigned long long number(std::string_view uri, std::string_view text, const cha
   unsigned long long v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (ec != std::errc{} || end != text.data() + text.size() || v > max) {
-    fail(uri, std::string(what) + " '" + std::string(text) + "' is not a number 0.." + std::to_string(max));
+    fail(uri, std::string(what) + " '" + std::string(text) + "' is not a number 0.." +
+                  std::to_string(max));
   }
   return v;
 }
@@ -28,7 +29,8 @@ TcpEndpoint parse_tcp(std::string_view uri, std::string_view rest) {
     fail(uri, "expected tcp://HOST:PORT, e.g. tcp://127.0.0.1:9000");
   }
   std::string_view host = rest.substr(0, colon);
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+    host = host.substr(1, host.size() - 2);
   if (host.empty()) fail(uri, "the host is empty (use 127.0.0.1 for this machine only)");
   TcpEndpoint e;
   e.host = std::string(host);
@@ -47,7 +49,8 @@ PtyEndpoint parse_pty(std::string_view uri, std::string_view rest) {
   for (const std::string_view option : protocol::split(rest.substr(q + 1), '&')) {
     const std::size_t eq = option.find('=');
     const std::string_view key = option.substr(0, eq);
-    const std::string_view value = eq == std::string_view::npos ? std::string_view{} : option.substr(eq + 1);
+    const std::string_view value =
+        eq == std::string_view::npos ? std::string_view{} : option.substr(eq + 1);
     if (key == "baud") {
       e.baud = static_cast<unsigned>(number(uri, value, "baud", 4'000'000));
     } else if (key == "reset_ms") {
@@ -92,8 +95,9 @@ std::string to_uri(const Endpoint& endpoint) {
               sep = "&";
             }
             if (e.reset_on_open.count() != 0) {
-              uri += sep + "reset_ms=" +
-                     std::to_string(std::chrono::duration_cast<milliseconds>(e.reset_on_open).count());
+              uri +=
+                  sep + "reset_ms=" +
+                  std::to_string(std::chrono::duration_cast<milliseconds>(e.reset_on_open).count());
             }
             return uri;
           },

@@ -43,7 +43,8 @@ std::size_t VirtualExecutor::run_until(Time until) {
 
 std::size_t VirtualExecutor::run_until_idle(std::size_t max_tasks) {
   std::size_t ran = 0;
-  while (ran < max_tasks && run_one()) ++ran;
+  while (ran < max_tasks && run_one())
+    ++ran;
   return ran;
 }
 

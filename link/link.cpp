@@ -5,10 +5,14 @@
 namespace hil::link {
 namespace {
 
-constexpr std::size_t index(Direction d) { return static_cast<std::size_t>(d); }
+constexpr std::size_t index(Direction d) {
+  return static_cast<std::size_t>(d);
+}
 constexpr Direction kDirections[] = {Direction::to_car, Direction::to_client};
 
-std::string side_name(Direction sender) { return sender == Direction::to_car ? "client" : "car"; }
+std::string side_name(Direction sender) {
+  return sender == Direction::to_car ? "client" : "car";
+}
 LinkClose::By side_of(Direction sender) {
   return sender == Direction::to_car ? LinkClose::By::client : LinkClose::By::car;
 }
@@ -17,16 +21,22 @@ LinkClose::By side_of(Direction sender) {
 
 std::string_view to_string(LinkClose::By by) {
   switch (by) {
-    case LinkClose::By::client: return "client";
-    case LinkClose::By::car: return "car";
-    case LinkClose::By::fault: return "fault";
-    case LinkClose::By::hil: return "hil";
+    case LinkClose::By::client:
+      return "client";
+    case LinkClose::By::car:
+      return "car";
+    case LinkClose::By::fault:
+      return "fault";
+    case LinkClose::By::hil:
+      return "hil";
   }
   return "hil";
 }
 
-std::shared_ptr<Link> Link::create(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options) {
-  return std::shared_ptr<Link>(new Link(executor, std::move(client), std::move(car), std::move(options)));
+std::shared_ptr<Link> Link::create(Executor& executor, BytePipePtr client, BytePipePtr car,
+                                   LinkOptions options) {
+  return std::shared_ptr<Link>(
+      new Link(executor, std::move(client), std::move(car), std::move(options)));
 }
 
 Link::Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options)
@@ -36,10 +46,11 @@ Link::Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions 
   auto protocol = options.protocol ? options.protocol : protocol_adapter("raw");
   const auto sink = [this](const FaultEvent& e) {
     ++stats_.faults;
-    for (const auto& o : observers_) o->on_fault(e);
+    for (const auto& o : observers_)
+      o->on_fault(e);
   };
-  injectors_[index(Direction::to_car)] =
-      std::make_unique<FaultInjector>(Direction::to_car, protocol, std::move(options.to_car), options.seed, sink);
+  injectors_[index(Direction::to_car)] = std::make_unique<FaultInjector>(
+      Direction::to_car, protocol, std::move(options.to_car), options.seed, sink);
   injectors_[index(Direction::to_client)] = std::make_unique<FaultInjector>(
       Direction::to_client, protocol, std::move(options.to_client), options.seed, sink);
 }
@@ -55,20 +66,22 @@ void Link::start() {
   open_ = true;
   const Time now = executor_.now();
   for (const auto& o : observers_) {
-    o->on_open(now, pipes_[index(Direction::to_client)]->describe(), pipes_[index(Direction::to_car)]->describe());
+    o->on_open(now, pipes_[index(Direction::to_client)]->describe(),
+               pipes_[index(Direction::to_car)]->describe());
   }
   // Bytes the client sends travel to_car; bytes the car sends travel to_client.
   for (const auto d : kDirections) {
     // pipes_ is indexed by the direction a pipe receives; it sends the other.
     const Direction sender = d == Direction::to_car ? Direction::to_client : Direction::to_car;
     std::weak_ptr<Link> weak = weak_from_this();
-    pipes_[index(sender)]->start(BytePipe::Handlers{
-        [weak, d](ByteView bytes) {
-          if (auto self = weak.lock()) self->on_bytes(d, bytes);
-        },
-        [weak, d](std::error_code ec) {
-          if (auto self = weak.lock()) self->on_side_closed(d, ec);
-        }});
+    pipes_[index(sender)]->start(BytePipe::Handlers{[weak, d](ByteView bytes) {
+                                                      if (auto self = weak.lock())
+                                                        self->on_bytes(d, bytes);
+                                                    },
+                                                    [weak, d](std::error_code ec) {
+                                                      if (auto self = weak.lock())
+                                                        self->on_side_closed(d, ec);
+                                                    }});
   }
 }
 
@@ -76,7 +89,8 @@ void Link::on_bytes(Direction d, ByteView bytes) {
   if (!open_) return;
   const Time now = executor_.now();
   stats_.bytes_sent[index(d)] += bytes.size();
-  for (const auto& o : observers_) o->on_sent(now, d, bytes);
+  for (const auto& o : observers_)
+    o->on_sent(now, d, bytes);
   injectors_[index(d)]->push(now, bytes);
   pump(d);
 }
@@ -93,7 +107,8 @@ void Link::pump(Direction d) {
     if (auto* delivery = std::get_if<Delivery>(&output)) {
       stats_.bytes_delivered[index(d)] += delivery->bytes.size();
       pipes_[index(d)]->write(delivery->bytes);
-      for (const auto& o : observers_) o->on_delivered(now, d, delivery->bytes);
+      for (const auto& o : observers_)
+        o->on_delivered(now, d, delivery->bytes);
     } else {
       const bool reset = std::get<LinkBreak>(output).reset;
       shut(LinkClose{LinkClose::By::fault, reset ? CloseMode::reset : CloseMode::graceful,
@@ -131,7 +146,8 @@ void Link::schedule(Direction d) {
 void Link::on_side_closed(Direction d, std::error_code ec) {
   if (!open_) return;
   if (ec && ec != end_of_stream()) {
-    shut(LinkClose{side_of(d), CloseMode::reset, side_name(d) + " connection failed: " + ec.message()});
+    shut(LinkClose{side_of(d), CloseMode::reset,
+                   side_name(d) + " connection failed: " + ec.message()});
     return;
   }
   // The sender is gone; what it sent and the injector still holds (delays,
@@ -152,18 +168,25 @@ void Link::shut(LinkClose close) {
     pipes_[index(d)]->close(close.mode);
   }
   const Time now = executor_.now();
-  for (const auto& o : observers_) o->on_close(now, close);
+  for (const auto& o : observers_)
+    o->on_close(now, close);
 }
 
-void Link::close(CloseMode mode) { shut(LinkClose{LinkClose::By::hil, mode, "closed by hil"}); }
+void Link::close(CloseMode mode) {
+  shut(LinkClose{LinkClose::By::hil, mode, "closed by hil"});
+}
 
-bool Link::is_open() const { return open_; }
+bool Link::is_open() const {
+  return open_;
+}
 
 void Link::set_profile(Direction direction, FaultProfile profile) {
   injectors_[index(direction)]->set_profile(std::move(profile));
   pump(direction);
 }
 
-LinkStats Link::stats() const { return stats_; }
+LinkStats Link::stats() const {
+  return stats_;
+}
 
 }  // namespace hil::link

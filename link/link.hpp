@@ -27,7 +27,7 @@ struct LinkClose {
   };
   By by = By::hil;
   CloseMode mode = CloseMode::graceful;  ///< reset: the connection was aborted
-  std::string reason;                    ///< for a person: "car closed", "fault injected: reset (to_car)"
+  std::string reason;  ///< for a person: "car closed", "fault injected: reset (to_car)"
 };
 std::string_view to_string(LinkClose::By by);
 
@@ -48,8 +48,8 @@ class LinkObserver {
 
 struct LinkOptions {
   std::shared_ptr<const ProtocolAdapter> protocol;  ///< null means raw
-  FaultProfile to_car;     ///< faults on bytes from the client to the car
-  FaultProfile to_client;  ///< faults on bytes from the car to the client
+  FaultProfile to_car;                              ///< faults on bytes from the client to the car
+  FaultProfile to_client;                           ///< faults on bytes from the car to the client
   std::uint64_t seed = 0;  ///< each direction derives its own stream from it
   std::vector<std::shared_ptr<LinkObserver>> observers;
 };
@@ -62,7 +62,8 @@ struct LinkStats {
 
 class Link : public std::enable_shared_from_this<Link> {
  public:
-  static std::shared_ptr<Link> create(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options);
+  static std::shared_ptr<Link> create(Executor& executor, BytePipePtr client, BytePipePtr car,
+                                      LinkOptions options);
   ~Link();
 
   void start();

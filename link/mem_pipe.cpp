@@ -122,7 +122,9 @@ class MemListener final : public Listener {
       : network_(network), name_(std::move(name)), entry_(std::move(entry)) {}
   ~MemListener() override { close(); }
 
-  void start(std::function<void(BytePipePtr)> on_accept) override { entry_->on_accept = std::move(on_accept); }
+  void start(std::function<void(BytePipePtr)> on_accept) override {
+    entry_->on_accept = std::move(on_accept);
+  }
   void close() override {
     if (!entry_->open) return;
     entry_->open = false;

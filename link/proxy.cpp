@@ -16,8 +16,8 @@ class TerminalObserver final : public LinkObserver {
   TerminalObserver(std::string id, std::function<void(const std::string&)> log)
       : id_(std::move(id)), log_(std::move(log)) {}
   void on_fault(const FaultEvent& e) override {
-    log_(id_ + " " + format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " + std::string(to_string(e.direction)) +
-         "): " + e.detail);
+    log_(id_ + " " + format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " +
+         std::string(to_string(e.direction)) + "): " + e.detail);
   }
   void on_close(Time at, const LinkClose& close) override {
     log_(id_ + " " + format_ms(at) + " closed: " + close.reason);
@@ -31,15 +31,19 @@ class TerminalObserver final : public LinkObserver {
 std::string numbered_path(const std::string& path, std::size_t number) {
   if (number == 1) return path;
   const std::filesystem::path p(path);
-  return (p.parent_path() / (p.stem().string() + "-" + std::to_string(number) + p.extension().string())).string();
+  return (p.parent_path() /
+          (p.stem().string() + "-" + std::to_string(number) + p.extension().string()))
+      .string();
 }
 
 }  // namespace
 
-Proxy::Proxy(TransportContext& context, ProxyOptions options) : context_(context), options_(std::move(options)) {
+Proxy::Proxy(TransportContext& context, ProxyOptions options)
+    : context_(context), options_(std::move(options)) {
   if (!options_.protocol) options_.protocol = protocol_adapter("raw");
   gate_ = std::make_unique<FaultInjector>(Direction::to_car, options_.protocol,
-                                          for_direction(options_.faults, Direction::to_car), options_.seed);
+                                          for_direction(options_.faults, Direction::to_car),
+                                          options_.seed);
 }
 
 Proxy::~Proxy() {
@@ -59,7 +63,9 @@ void Proxy::start() {
   });
 }
 
-std::string Proxy::address() const { return listener_ ? listener_->address() : to_uri(options_.listen); }
+std::string Proxy::address() const {
+  return listener_ ? listener_->address() : to_uri(options_.listen);
+}
 
 void Proxy::on_accept(BytePipePtr client) {
   if (closed_) {
@@ -76,17 +82,19 @@ void Proxy::on_accept(BytePipePtr client) {
   }
   say("link" + std::to_string(number) + " client connected: " + client->describe());
   std::weak_ptr<bool> alive = alive_;
-  connect(context_, options_.upstream, [this, alive, client, number](std::error_code ec, BytePipePtr car) {
-    if (!alive.lock() || !*alive.lock()) return;
-    if (ec || closed_) {
-      say("link" + std::to_string(number) + " cannot reach the car at " + to_uri(options_.upstream) + ": " +
-          (ec ? ec.message() : std::string("proxy closing")));
-      client->close(CloseMode::reset);
-      if (car) car->close(CloseMode::reset);
-      return;
-    }
-    join(client, car, number);
-  });
+  connect(context_, options_.upstream,
+          [this, alive, client, number](std::error_code ec, BytePipePtr car) {
+            if (!alive.lock() || !*alive.lock()) return;
+            if (ec || closed_) {
+              say("link" + std::to_string(number) + " cannot reach the car at " +
+                  to_uri(options_.upstream) + ": " +
+                  (ec ? ec.message() : std::string("proxy closing")));
+              client->close(CloseMode::reset);
+              if (car) car->close(CloseMode::reset);
+              return;
+            }
+            join(client, car, number);
+          });
 }
 
 void Proxy::join(BytePipePtr client, BytePipePtr car, std::size_t number) {
@@ -96,24 +104,30 @@ void Proxy::join(BytePipePtr client, BytePipePtr car, std::size_t number) {
   link_options.to_car = for_direction(options_.faults, Direction::to_car);
   link_options.to_client = for_direction(options_.faults, Direction::to_client);
   link_options.seed = options_.seed + number - 1;
-  if (options_.log) link_options.observers.push_back(std::make_shared<TerminalObserver>(id, options_.log));
+  if (options_.log)
+    link_options.observers.push_back(std::make_shared<TerminalObserver>(id, options_.log));
   std::error_code ec;
   if (!options_.wire_log_path.empty()) {
     auto log = WireLog::open(options_.wire_log_path, WireLogOptions{id, options_.protocol, {}}, ec);
-    if (log) link_options.observers.push_back(log);
-    else say(id + " cannot write the wire log " + options_.wire_log_path + ": " + ec.message());
+    if (log)
+      link_options.observers.push_back(log);
+    else
+      say(id + " cannot write the wire log " + options_.wire_log_path + ": " + ec.message());
   }
   if (!options_.pcap_path.empty()) {
     const std::string path = numbered_path(options_.pcap_path, number);
     auto pcap = PcapWriter::open(path, PcapOptions{}, ec);
-    if (pcap) link_options.observers.push_back(pcap);
-    else say(id + " cannot write the pcap " + path + ": " + ec.message());
+    if (pcap)
+      link_options.observers.push_back(pcap);
+    else
+      say(id + " cannot write the pcap " + path + ": " + ec.message());
   }
-  auto link = Link::create(context_.executor, std::move(client), std::move(car), std::move(link_options));
+  auto link =
+      Link::create(context_.executor, std::move(client), std::move(car), std::move(link_options));
   links_.push_back(link);
   ++links_opened_;
-  say(id + " joined to the car at " + to_uri(options_.upstream) + " (seed " + std::to_string(options_.seed + number - 1) +
-      ")");
+  say(id + " joined to the car at " + to_uri(options_.upstream) + " (seed " +
+      std::to_string(options_.seed + number - 1) + ")");
   link->start();
 }
 
@@ -121,7 +135,8 @@ void Proxy::close() {
   if (closed_) return;
   closed_ = true;
   if (listener_) listener_->close();
-  for (auto& link : links_) link->close();
+  for (auto& link : links_)
+    link->close();
 }
 
 void Proxy::set_faults(const FaultProfile& faults) {
@@ -135,8 +150,8 @@ void Proxy::set_faults(const FaultProfile& faults) {
 }
 
 std::size_t Proxy::open_links() const {
-  return static_cast<std::size_t>(
-      std::count_if(links_.begin(), links_.end(), [](const auto& link) { return link->is_open(); }));
+  return static_cast<std::size_t>(std::count_if(links_.begin(), links_.end(),
+                                                [](const auto& link) { return link->is_open(); }));
 }
 
 }  // namespace hil::link

@@ -20,7 +20,7 @@ struct ProxyOptions {
   Endpoint listen;    ///< where clients connect (tcp:// or pty://)
   Endpoint upstream;  ///< the car: tcp://, pty:// (a device path) or mem://
   std::shared_ptr<const ProtocolAdapter> protocol;  ///< null: raw
-  FaultProfile faults;  ///< rules for both directions (each rule's direction filter applies)
+  FaultProfile faults;     ///< rules for both directions (each rule's direction filter applies)
   std::uint64_t seed = 0;  ///< link N uses seed + N - 1, so links differ and replay
   /// NDJSON wire log shared by every link (records carry "link": "link<N>"); empty: none.
   std::string wire_log_path;
@@ -61,7 +61,7 @@ class Proxy {
   TransportContext& context_;
   ProxyOptions options_;
   std::unique_ptr<Listener> listener_;
-  std::unique_ptr<FaultInjector> gate_;  // answers refuse_connection()
+  std::unique_ptr<FaultInjector> gate_;       // answers refuse_connection()
   std::vector<std::shared_ptr<Link>> links_;  // owned; closed ones are pruned on accept
   std::size_t links_opened_ = 0;
   std::size_t accepted_ = 0;

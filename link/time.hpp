@@ -12,12 +12,14 @@ using Duration = std::chrono::nanoseconds;
 /// Time since the run started (nanoseconds, exact in virtual time).
 using Time = std::chrono::nanoseconds;
 
-using std::chrono::milliseconds;
 using std::chrono::microseconds;
+using std::chrono::milliseconds;
 using std::chrono::seconds;
 
 /// Milliseconds as a double, for reports and logs.
-inline double to_ms(Duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+inline double to_ms(Duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
 
 /// "12.345 ms"-style text with three decimals.
 std::string format_ms(Duration d);

@@ -9,7 +9,8 @@ void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary) {
   cmd.add_option("frames", input.frames,
                  binary ? "Frame bytes as hex, e.g. 2A 2B 2C 2D 01 70 70 (spaces optional)"
                         : "Frames as text (use --hex to give them as hex)");
-  cmd.add_option("-f,--file", input.file, "Decode a raw byte stream read from a file ('-' for stdin)");
+  cmd.add_option("-f,--file", input.file,
+                 "Decode a raw byte stream read from a file ('-' for stdin)");
   cmd.add_flag("--hex", input.hex,
                binary ? "The --file holds hex text (e.g. a pasted capture), not raw bytes"
                       : "The frames (and --file) are hex text, not raw bytes");
@@ -33,7 +34,9 @@ protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {
     }
     if (input.hex) {
       const auto parsed = protocol::parse_hex(protocol::to_string(bytes));
-      if (!parsed) throw CLI::ValidationError("--file", "'" + input.file + "' is not hex text (pairs of 0-9 A-F)");
+      if (!parsed)
+        throw CLI::ValidationError("--file",
+                                   "'" + input.file + "' is not hex text (pairs of 0-9 A-F)");
       bytes = *parsed;
     }
   }

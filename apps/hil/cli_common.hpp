@@ -4,8 +4,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
-#include <map>
 #include <iostream>
+#include <map>
 #include <string>
 #include <variant>
 #include <vector>
@@ -39,7 +39,8 @@ std::string render_bytes(protocol::ByteView bytes, bool binary);
 /// item is a frame, 1 when any error was found or there was nothing to decode.
 template <class Message, class Decoder>
 int print_items(Decoder decoder, protocol::ByteView bytes, bool binary, const DecodeInput& input,
-                const std::function<std::string(const Message&)>& describe, std::ostream& out = std::cout) {
+                const std::function<std::string(const Message&)>& describe,
+                std::ostream& out = std::cout) {
   std::vector<protocol::DecodeItem<Message>> items;
   decoder.feed(bytes, items);
   decoder.finish(items);
@@ -74,7 +75,8 @@ int print_items(Decoder decoder, protocol::ByteView bytes, bool binary, const De
     }
     out << "summary: " << offset << " bytes, " << frames << " frame(s), " << (items.size() - frames)
         << " error(s)";
-    for (const auto& [kind, n] : errors) out << ", " << n << ' ' << kind;
+    for (const auto& [kind, n] : errors)
+      out << ", " << n << ' ' << kind;
     out << '\n';
   }
   return status;

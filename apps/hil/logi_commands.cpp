@@ -18,12 +18,14 @@ void register_logi(CommandSet& commands) {
   };
   auto args = std::make_shared<Args>();
 
-  auto* enc = commands.encode.add_subcommand("logi", "LOGI frame from its payload, e.g. SP:050 or MV:FWD");
+  auto* enc =
+      commands.encode.add_subcommand("logi", "LOGI frame from its payload, e.g. SP:050 or MV:FWD");
   enc->add_option("payload", args->payload,
                   "Payload: SP:xxx ST:RUN ST:STOP GS:xxx MD:MAN MD:AUTO MV:<dir> FB:<CMD>:<0|1> "
                   "STAT:SP:..,STA:..,RUN:..,MODE:..,MAN:..,DIS:..,TRK:..,DEV:..,OBS:..,RPM:a:b:c:d")
       ->required();
-  enc->add_flag("--raw", args->raw, "Frame the payload as given, without checking it (for odd frames)");
+  enc->add_flag("--raw", args->raw,
+                "Frame the payload as given, without checking it (for odd frames)");
   enc->callback([&run = commands.run, args] {
     run = [args]() -> int {
       if (args->raw) {
@@ -43,7 +45,8 @@ void register_logi(CommandSet& commands) {
 
   auto* dec = commands.decode.add_subcommand("logi", "Decode LOGI frames or a LOGI byte stream");
   add_decode_input(*dec, args->input, false);
-  dec->add_flag("--lenient", args->lenient, "Accept lowercase checksum hex (reported as tolerated)");
+  dec->add_flag("--lenient", args->lenient,
+                "Accept lowercase checksum hex (reported as tolerated)");
   dec->callback([&run = commands.run, args] {
     run = [args]() -> int {
       const auto bytes = read_decode_input(args->input, false);

@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "hil 0.1.0");
   app.footer(
-      "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, binary).\n"
+      "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, "
+      "binary).\n"
       "Examples:\n"
       "  hil encode logi SP:050                      LOGI:SP:050:D7#\n"
       "  hil encode wr8 task 1 drive 100             03 01 01 04 64 00 00 00\n"
@@ -24,9 +25,11 @@ int main(int argc, char** argv) {
       "  hil decode leka --hex --file capture.hex --summary\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
-  auto* encode = app.add_subcommand("encode", "Print the frame for a message (binary frames as hex)");
+  auto* encode =
+      app.add_subcommand("encode", "Print the frame for a message (binary frames as hex)");
   encode->require_subcommand(1);
-  auto* decode = app.add_subcommand("decode", "Decode frames or a byte stream and print every frame and error");
+  auto* decode = app.add_subcommand(
+      "decode", "Decode frames or a byte stream and print every frame and error");
   decode->require_subcommand(1);
 
   std::function<int()> run;
@@ -38,7 +41,8 @@ int main(int argc, char** argv) {
   hil::apps::register_proxy(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
-  if (argc >= 3 && (std::string_view(argv[1]) == "encode" || std::string_view(argv[1]) == "decode") &&
+  if (argc >= 3 &&
+      (std::string_view(argv[1]) == "encode" || std::string_view(argv[1]) == "decode") &&
       argv[2][0] != '-') {
     const std::string_view protocol = argv[2];
     if (protocol != "logi" && protocol != "wr8" && protocol != "arduino" && protocol != "leka") {

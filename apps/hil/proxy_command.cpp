@@ -26,23 +26,32 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
     bool quiet = false;
   };
   auto args = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("proxy", "Put the fault injector between a client and a car (real time)");
-  cmd->add_option("--protocol", args->protocol, "Frame-aware faults and decoded logs for: logi, wr8, arduino, leka, raw")
+  auto* cmd =
+      app.add_subcommand("proxy", "Put the fault injector between a client and a car (real time)");
+  cmd->add_option("--protocol", args->protocol,
+                  "Frame-aware faults and decoded logs for: logi, wr8, arduino, leka, raw")
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka", "raw"}));
-  cmd->add_option("--listen", args->listen, "Where the client connects: tcp://127.0.0.1:PORT or pty:///PATH[?baud=9600]")
+  cmd->add_option("--listen", args->listen,
+                  "Where the client connects: tcp://127.0.0.1:PORT or pty:///PATH[?baud=9600]")
       ->required();
-  cmd->add_option("--upstream", args->upstream, "The car: tcp://HOST:PORT, or pty:///dev/ttyUSB0 for a serial device")
+  cmd->add_option("--upstream", args->upstream,
+                  "The car: tcp://HOST:PORT, or pty:///dev/ttyUSB0 for a serial device")
       ->required();
-  cmd->add_option("--faults", args->faults, "Fault profile (YAML, see docs/faults.md); none: a clean pass-through");
+  cmd->add_option("--faults", args->faults,
+                  "Fault profile (YAML, see docs/faults.md); none: a clean pass-through");
   cmd->add_option("--seed", args->seed, "Seed for the fault rules (printed when chosen at random)");
-  cmd->add_option("--log", args->wire_log, "Write every byte of every link to this NDJSON wire log");
+  cmd->add_option("--log", args->wire_log,
+                  "Write every byte of every link to this NDJSON wire log");
   cmd->add_option("--pcap", args->pcap, "Write the first link as a pcap (link N: NAME-N.pcap)");
-  cmd->add_flag("-q,--quiet", args->quiet, "Print only the start line and errors, not each connection and fault");
+  cmd->add_flag("-q,--quiet", args->quiet,
+                "Print only the start line and errors, not each connection and fault");
   cmd->footer(
       "Examples:\n"
-      "  hil proxy --protocol logi --listen tcp://127.0.0.1:9001 --upstream tcp://192.168.4.1:8080 \\\n"
+      "  hil proxy --protocol logi --listen tcp://127.0.0.1:9001 --upstream tcp://192.168.4.1:8080 "
+      "\\\n"
       "            --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
-      "  hil proxy --protocol arduino --listen 'pty:///tmp/hil-arduino0?baud=9600' --upstream pty:///dev/ttyUSB0\n"
+      "  hil proxy --protocol arduino --listen 'pty:///tmp/hil-arduino0?baud=9600' --upstream "
+      "pty:///dev/ttyUSB0\n"
       "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
   cmd->callback([&run, args] {
     run = [args]() -> int {
@@ -59,7 +68,8 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       options.seed = args->seed ? *args->seed : std::random_device{}();
       options.wire_log_path = args->wire_log;
       options.pcap_path = args->pcap;
-      if (!args->quiet) options.log = [](const std::string& line) { std::cout << line << std::endl; };
+      if (!args->quiet)
+        options.log = [](const std::string& line) { std::cout << line << std::endl; };
 
       asio::io_context io;
       link::AsioExecutor executor(io);
@@ -72,7 +82,8 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
         return 1;
       }
       if (const auto* tcp = std::get_if<link::TcpEndpoint>(&options.listen);
-          tcp != nullptr && tcp->host != "127.0.0.1" && tcp->host != "localhost" && tcp->host != "::1") {
+          tcp != nullptr && tcp->host != "127.0.0.1" && tcp->host != "localhost" &&
+          tcp->host != "::1") {
         std::cout << "note: listening on " << tcp->host << ", reachable from other machines\n";
       }
       std::cout << "hil proxy: clients connect to " << proxy.address() << ", car at "

@@ -14,9 +14,13 @@ int hex_value(char c) {
 
 }  // namespace
 
-Bytes to_bytes(std::string_view text) { return Bytes(text.begin(), text.end()); }
+Bytes to_bytes(std::string_view text) {
+  return Bytes(text.begin(), text.end());
+}
 
-std::string to_string(ByteView bytes) { return std::string(bytes.begin(), bytes.end()); }
+std::string to_string(ByteView bytes) {
+  return std::string(bytes.begin(), bytes.end());
+}
 
 std::string to_hex(ByteView bytes) {
   std::string out;
@@ -38,7 +42,8 @@ std::optional<Bytes> parse_hex(std::string_view text) {
       if (pending >= 0) return std::nullopt;  // a lone digit between separators
       continue;
     }
-    if (c == '0' && pending < 0 && i + 1 < text.size() && (text[i + 1] == 'x' || text[i + 1] == 'X')) {
+    if (c == '0' && pending < 0 && i + 1 < text.size() &&
+        (text[i + 1] == 'x' || text[i + 1] == 'X')) {
       ++i;
       continue;
     }

@@ -29,9 +29,9 @@ std::string_view to_string(ErrorKind kind);
 
 struct DecodeError {
   ErrorKind kind{};
-  Bytes raw;           ///< the offending bytes, exactly as received
-  std::string detail;  ///< what was wrong and where, for a person
-  std::string context; ///< the command or packet kind recognised before failing, if any
+  Bytes raw;            ///< the offending bytes, exactly as received
+  std::string detail;   ///< what was wrong and where, for a person
+  std::string context;  ///< the command or packet kind recognised before failing, if any
 
   friend bool operator==(const DecodeError&, const DecodeError&) = default;
 };

@@ -67,7 +67,8 @@ DecodeError to_error(DelimitedFramer::Event&& event, std::size_t max_frame_bytes
       break;
     case DelimitedFramer::Kind::interrupted:
       e.kind = ErrorKind::bad_format;
-      e.detail = "frame of " + std::to_string(n) + " byte(s) has no end marker before the next header";
+      e.detail =
+          "frame of " + std::to_string(n) + " byte(s) has no end marker before the next header";
       break;
     case DelimitedFramer::Kind::oversized:
       e.kind = ErrorKind::oversized;

@@ -10,8 +10,8 @@ namespace hil::protocol {
 
 /// Decimal integer with an optional leading '-' (and '+' when allow_plus),
 /// at most `max_digits` digits, nothing else. Returns nullopt otherwise.
-std::optional<long long> parse_decimal(std::string_view text, bool allow_sign, bool allow_plus = false,
-                                       std::size_t max_digits = 9);
+std::optional<long long> parse_decimal(std::string_view text, bool allow_sign,
+                                       bool allow_plus = false, std::size_t max_digits = 9);
 
 /// Exactly two hex digits; sets `lowercase` when any digit is a lowercase letter.
 std::optional<std::uint8_t> parse_hex_byte(std::string_view text, bool* lowercase = nullptr);

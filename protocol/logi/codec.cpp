@@ -23,7 +23,8 @@ void require(bool ok, const char* what) {
 }
 
 bool valid_extra_key(std::string_view key) {
-  return !key.empty() && is_printable_ascii(key) && key.find_first_of(":,#") == std::string_view::npos;
+  return !key.empty() && is_printable_ascii(key) &&
+         key.find_first_of(":,#") == std::string_view::npos;
 }
 
 bool valid_extra_value(std::string_view value) {
@@ -39,12 +40,14 @@ std::string status_payload(const Status& s) {
                   ",RUN:" + (s.running ? "1" : "0") + ",MODE:" + std::string(to_string(s.mode)) +
                   ",MAN:" + std::string(to_string(s.manual)) +
                   ",DIS:" + std::to_string(s.distance_cm) + ",TRK:";
-  for (int bit = 3; bit >= 0; --bit) p.push_back(((s.track_mask >> bit) & 1) != 0 ? '1' : '0');
-  p += ",DEV:" + std::to_string(s.deviation) + ",OBS:" + (s.obstacle ? "1" : "0") + ",RPM:" +
-       std::to_string(s.rpm[0]) + ':' + std::to_string(s.rpm[1]) + ':' + std::to_string(s.rpm[2]) +
-       ':' + std::to_string(s.rpm[3]);
+  for (int bit = 3; bit >= 0; --bit)
+    p.push_back(((s.track_mask >> bit) & 1) != 0 ? '1' : '0');
+  p += ",DEV:" + std::to_string(s.deviation) + ",OBS:" + (s.obstacle ? "1" : "0") +
+       ",RPM:" + std::to_string(s.rpm[0]) + ':' + std::to_string(s.rpm[1]) + ':' +
+       std::to_string(s.rpm[2]) + ':' + std::to_string(s.rpm[3]);
   for (const auto& [key, value] : s.extra) {
-    require(valid_extra_key(key) && valid_extra_value(value), "STAT extra field has a reserved character");
+    require(valid_extra_key(key) && valid_extra_value(value),
+            "STAT extra field has a reserved character");
     p += ',' + key + ':' + value;
   }
   return p;
@@ -73,21 +76,25 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
   for (const std::string_view field : split(body, ',')) {
     const std::size_t colon = field.find(':');
     if (colon == std::string_view::npos || colon == 0) {
-      return fail(ErrorKind::bad_format, "STAT field '" + std::string(field) + "' is not KEY:VALUE", ctx);
+      return fail(ErrorKind::bad_format, "STAT field '" + std::string(field) + "' is not KEY:VALUE",
+                  ctx);
     }
     const std::string_view key = field.substr(0, colon);
     const std::string_view value = field.substr(colon + 1);
     std::size_t k = 0;
-    while (k < kKeys && names[k] != key) ++k;
+    while (k < kKeys && names[k] != key)
+      ++k;
     if (k == kKeys) {
       s.extra.emplace_back(std::string(key), std::string(value));
       continue;
     }
-    if (seen[k]) return fail(ErrorKind::bad_format, "STAT key " + std::string(key) + " repeated", ctx);
+    if (seen[k])
+      return fail(ErrorKind::bad_format, "STAT key " + std::string(key) + " repeated", ctx);
     seen[k] = true;
     const auto bad = [&](const char* expected) {
       return fail(ErrorKind::bad_format,
-                  "STAT " + std::string(key) + ":" + std::string(value) + ": expected " + expected, ctx);
+                  "STAT " + std::string(key) + ":" + std::string(value) + ": expected " + expected,
+                  ctx);
     };
     const auto flag = [&](bool& out) {
       if (value != "0" && value != "1") return false;
@@ -133,7 +140,8 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
           return bad("four 0/1 channels H4H3H2H1");
         }
         s.track_mask = 0;
-        for (const char c : value) s.track_mask = static_cast<std::uint8_t>((s.track_mask << 1) | (c - '0'));
+        for (const char c : value)
+          s.track_mask = static_cast<std::uint8_t>((s.track_mask << 1) | (c - '0'));
         break;
       }
       case kDev: {
@@ -160,7 +168,8 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
     }
   }
   for (std::size_t k = 0; k < kKeys; ++k) {
-    if (!seen[k]) return fail(ErrorKind::bad_format, "STAT lacks key " + std::string(names[k]), ctx);
+    if (!seen[k])
+      return fail(ErrorKind::bad_format, "STAT lacks key " + std::string(names[k]), ctx);
   }
   return s;
 }
@@ -169,28 +178,28 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
 
 std::uint8_t checksum(std::string_view base) {
   unsigned sum = 0;
-  for (const char c : base) sum += static_cast<unsigned char>(c);
+  for (const char c : base)
+    sum += static_cast<unsigned char>(c);
   return static_cast<std::uint8_t>(sum & 0xFFu);
 }
 
 std::string payload_of(const Message& m) {
   return std::visit(
-      Overloaded{
-          [](const SetSpeed& v) {
-            require(v.percent >= 0 && v.percent <= 100, "SP outside 0..100");
-            return "SP:" + three_digits(v.percent);
-          },
-          [](const SetRun& v) { return std::string(v.run ? "ST:RUN" : "ST:STOP"); },
-          [](const SetStation& v) {
-            require(v.station >= 0 && v.station <= 999, "GS outside 000..999");
-            return "GS:" + three_digits(v.station);
-          },
-          [](const SetMode& v) { return "MD:" + std::string(to_string(v.mode)); },
-          [](const Move& v) { return "MV:" + std::string(to_string(v.direction)); },
-          [](const Status& v) { return status_payload(v); },
-          [](const Feedback& v) {
-            return "FB:" + std::string(to_string(v.command)) + (v.accepted ? ":1" : ":0");
-          }},
+      Overloaded{[](const SetSpeed& v) {
+                   require(v.percent >= 0 && v.percent <= 100, "SP outside 0..100");
+                   return "SP:" + three_digits(v.percent);
+                 },
+                 [](const SetRun& v) { return std::string(v.run ? "ST:RUN" : "ST:STOP"); },
+                 [](const SetStation& v) {
+                   require(v.station >= 0 && v.station <= 999, "GS outside 000..999");
+                   return "GS:" + three_digits(v.station);
+                 },
+                 [](const SetMode& v) { return "MD:" + std::string(to_string(v.mode)); },
+                 [](const Move& v) { return "MV:" + std::string(to_string(v.direction)); },
+                 [](const Status& v) { return status_payload(v); },
+                 [](const Feedback& v) {
+                   return "FB:" + std::string(to_string(v.command)) + (v.accepted ? ":1" : ":0");
+                 }},
       m);
 }
 
@@ -205,15 +214,19 @@ std::string frame_text(std::string_view payload) {
   return frame;
 }
 
-std::string encode_text(const Message& m) { return frame_text(payload_of(m)); }
+std::string encode_text(const Message& m) {
+  return frame_text(payload_of(m));
+}
 
-Bytes encode(const Message& m) { return to_bytes(encode_text(m)); }
+Bytes encode(const Message& m) {
+  return to_bytes(encode_text(m));
+}
 
 std::variant<Message, PayloadError> parse_payload(std::string_view payload) {
   const std::size_t colon = payload.find(':');
   if (colon == std::string_view::npos) {
-    return fail(ErrorKind::bad_format, "payload '" + std::string(payload) + "' has no ':' after its code",
-                payload);
+    return fail(ErrorKind::bad_format,
+                "payload '" + std::string(payload) + "' has no ':' after its code", payload);
   }
   const std::string_view code = payload.substr(0, colon);
   const std::string_view arg = payload.substr(colon + 1);
@@ -243,7 +256,9 @@ std::variant<Message, PayloadError> parse_payload(std::string_view payload) {
   }
   if (code == "MV") {
     const auto d = parse_direction(arg);
-    if (!d) return bad_arg(ErrorKind::bad_format, "FWD, BWD, LEFT, RIGHT, LF, RF, LB, RB, CW, CCW or STOP");
+    if (!d)
+      return bad_arg(ErrorKind::bad_format,
+                     "FWD, BWD, LEFT, RIGHT, LF, RF, LB, RB, CW, CCW or STOP");
     return Move{*d};
   }
   if (code == "STAT") return parse_status(arg);
@@ -252,7 +267,8 @@ std::variant<Message, PayloadError> parse_payload(std::string_view payload) {
     if (c2 == std::string_view::npos) return bad_arg(ErrorKind::bad_format, "<CMD>:<0|1>");
     const auto cmd = parse_command(arg.substr(0, c2));
     const std::string_view flag = arg.substr(c2 + 1);
-    if (!cmd) return bad_arg(ErrorKind::bad_format, "a command SP, ST, GS, MD or MV before the flag");
+    if (!cmd)
+      return bad_arg(ErrorKind::bad_format, "a command SP, ST, GS, MD or MV before the flag");
     if (flag != "0" && flag != "1") return bad_arg(ErrorKind::bad_format, "flag 0 or 1");
     return Feedback{*cmd, flag == "1"};
   }
@@ -262,7 +278,8 @@ std::variant<Message, PayloadError> parse_payload(std::string_view payload) {
 Item decode_frame(ByteView raw, const DecoderOptions& options) {
   const std::string_view text(reinterpret_cast<const char*>(raw.data()), raw.size());
   const auto error = [&](ErrorKind kind, std::string detail, std::string context = {}) {
-    return Item{DecodeError{kind, Bytes(raw.begin(), raw.end()), std::move(detail), std::move(context)}};
+    return Item{
+        DecodeError{kind, Bytes(raw.begin(), raw.end()), std::move(detail), std::move(context)}};
   };
   if (!text.starts_with(kHeader) || text.size() < kHeader.size() + 1 ||
       static_cast<std::uint8_t>(text.back()) != kTail) {
@@ -279,24 +296,28 @@ Item decode_frame(ByteView raw, const DecoderOptions& options) {
   bool lowercase = false;
   const auto cs = parse_hex_byte(cs_text, &lowercase);
   if (!cs) {
-    return error(ErrorKind::bad_format, "checksum '" + escape(to_bytes(cs_text)) + "' is not two hex digits",
+    return error(ErrorKind::bad_format,
+                 "checksum '" + escape(to_bytes(cs_text)) + "' is not two hex digits",
                  std::string(code));
   }
   const std::uint8_t expected = checksum(text.substr(0, kHeader.size() + payload.size()));
   if (*cs != expected) {
     return error(ErrorKind::bad_checksum,
-                 "checksum " + std::string(cs_text) + ", computed " + kHex[expected >> 4] + kHex[expected & 0x0F],
+                 "checksum " + std::string(cs_text) + ", computed " + kHex[expected >> 4] +
+                     kHex[expected & 0x0F],
                  std::string(code));
   }
   if (!is_printable_ascii(payload)) {
-    return error(ErrorKind::bad_format, "payload has a byte outside printable ASCII", std::string(code));
+    return error(ErrorKind::bad_format, "payload has a byte outside printable ASCII",
+                 std::string(code));
   }
   std::optional<ErrorKind> tolerated;
   if (lowercase) {
     if (!options.accept_lowercase_checksum) {
-      return error(ErrorKind::lowercase_checksum,
-                   "checksum " + std::string(cs_text) + " is lowercase; the protocol requires uppercase hex",
-                   std::string(code));
+      return error(
+          ErrorKind::lowercase_checksum,
+          "checksum " + std::string(cs_text) + " is lowercase; the protocol requires uppercase hex",
+          std::string(code));
     }
     tolerated = ErrorKind::lowercase_checksum;
   }
@@ -304,7 +325,8 @@ Item decode_frame(ByteView raw, const DecoderOptions& options) {
   if (auto* e = std::get_if<PayloadError>(&parsed)) {
     return error(e->kind, std::move(e->detail), std::move(e->context));
   }
-  return Item{Frame<Message>{std::get<Message>(std::move(parsed)), Bytes(raw.begin(), raw.end()), tolerated}};
+  return Item{Frame<Message>{std::get<Message>(std::move(parsed)), Bytes(raw.begin(), raw.end()),
+                             tolerated}};
 }
 
 Decoder::Decoder(DecoderOptions options)

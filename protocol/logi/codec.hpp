@@ -36,7 +36,7 @@ std::string encode_text(const Message& m);
 Bytes encode(const Message& m);
 
 struct PayloadError {
-  ErrorKind kind;       ///< bad_format, bad_value or unknown_code
+  ErrorKind kind;  ///< bad_format, bad_value or unknown_code
   std::string detail;
   std::string context;  ///< the command code ("SP", "STAT", ...) when recognised
 };

@@ -13,11 +13,17 @@ constexpr std::array<std::string_view, 5> kCommandNames = {"SP", "ST", "GS", "MD
 
 }  // namespace
 
-std::string_view to_string(Direction d) { return kDirectionNames.at(static_cast<std::size_t>(d)); }
+std::string_view to_string(Direction d) {
+  return kDirectionNames.at(static_cast<std::size_t>(d));
+}
 
-std::string_view to_string(Mode m) { return m == Mode::manual ? "MAN" : "AUTO"; }
+std::string_view to_string(Mode m) {
+  return m == Mode::manual ? "MAN" : "AUTO";
+}
 
-std::string_view to_string(Command c) { return kCommandNames.at(static_cast<std::size_t>(c)); }
+std::string_view to_string(Command c) {
+  return kCommandNames.at(static_cast<std::size_t>(c));
+}
 
 std::optional<Direction> parse_direction(std::string_view text) {
   for (std::size_t i = 0; i < kDirectionNames.size(); ++i) {
@@ -53,27 +59,29 @@ std::optional<Command> command_of(const Message& m) {
 
 std::string describe(const Message& m) {
   std::ostringstream os;
-  std::visit(
-      Overloaded{
-          [&](const SetSpeed& v) { os << "SetSpeed percent=" << v.percent; },
-          [&](const SetRun& v) { os << "SetRun " << (v.run ? "RUN" : "STOP"); },
-          [&](const SetStation& v) { os << "SetStation station=" << v.station; },
-          [&](const SetMode& v) { os << "SetMode " << to_string(v.mode); },
-          [&](const Move& v) { os << "Move " << to_string(v.direction); },
-          [&](const Status& v) {
-            os << "Status speed_percent=" << v.speed_percent << " station=" << v.station
-               << " running=" << v.running << " mode=" << to_string(v.mode)
-               << " manual=" << to_string(v.manual) << " distance_cm=" << v.distance_cm
-               << " track=";
-            for (int bit = 3; bit >= 0; --bit) os << ((v.track_mask >> bit) & 1);
-            os << " deviation=" << v.deviation << " obstacle=" << v.obstacle << " rpm="
-               << v.rpm[0] << ':' << v.rpm[1] << ':' << v.rpm[2] << ':' << v.rpm[3];
-            for (const auto& [key, value] : v.extra) os << " +" << key << '=' << value;
-          },
-          [&](const Feedback& v) {
-            os << "Feedback " << to_string(v.command) << ' ' << (v.accepted ? "accepted" : "rejected");
-          }},
-      m);
+  std::visit(Overloaded{[&](const SetSpeed& v) { os << "SetSpeed percent=" << v.percent; },
+                        [&](const SetRun& v) { os << "SetRun " << (v.run ? "RUN" : "STOP"); },
+                        [&](const SetStation& v) { os << "SetStation station=" << v.station; },
+                        [&](const SetMode& v) { os << "SetMode " << to_string(v.mode); },
+                        [&](const Move& v) { os << "Move " << to_string(v.direction); },
+                        [&](const Status& v) {
+                          os << "Status speed_percent=" << v.speed_percent
+                             << " station=" << v.station << " running=" << v.running
+                             << " mode=" << to_string(v.mode) << " manual=" << to_string(v.manual)
+                             << " distance_cm=" << v.distance_cm << " track=";
+                          for (int bit = 3; bit >= 0; --bit)
+                            os << ((v.track_mask >> bit) & 1);
+                          os << " deviation=" << v.deviation << " obstacle=" << v.obstacle
+                             << " rpm=" << v.rpm[0] << ':' << v.rpm[1] << ':' << v.rpm[2] << ':'
+                             << v.rpm[3];
+                          for (const auto& [key, value] : v.extra)
+                            os << " +" << key << '=' << value;
+                        },
+                        [&](const Feedback& v) {
+                          os << "Feedback " << to_string(v.command) << ' '
+                             << (v.accepted ? "accepted" : "rejected");
+                        }},
+             m);
   return os.str();
 }
 

@@ -18,8 +18,9 @@ namespace hil::protocol::logi {
 /// Manual-mode motion: the MV commands and the MAN telemetry field.
 enum class Direction : std::uint8_t { stop, fwd, bwd, left, right, lf, rf, lb, rb, cw, ccw };
 inline constexpr std::array<Direction, 11> kAllDirections = {
-    Direction::stop, Direction::fwd, Direction::bwd, Direction::left, Direction::right, Direction::lf,
-    Direction::rf,   Direction::lb,  Direction::rb,  Direction::cw,   Direction::ccw};
+    Direction::stop,  Direction::fwd, Direction::bwd, Direction::left,
+    Direction::right, Direction::lf,  Direction::rf,  Direction::lb,
+    Direction::rb,    Direction::cw,  Direction::ccw};
 
 enum class Mode : std::uint8_t { automatic, manual };
 
@@ -60,16 +61,16 @@ struct Move {
 
 /// STAT telemetry, sent about every 500 ms.
 struct Status {
-  int speed_percent = 0;            ///< SP, 0..100
-  int station = 0;                  ///< STA, target station 0..999
-  bool running = false;             ///< RUN
-  Mode mode = Mode::automatic;      ///< MODE
+  int speed_percent = 0;               ///< SP, 0..100
+  int station = 0;                     ///< STA, target station 0..999
+  bool running = false;                ///< RUN
+  Mode mode = Mode::automatic;         ///< MODE
   Direction manual = Direction::stop;  ///< MAN
-  int distance_cm = 0;              ///< DIS, ultrasonic range, >= 0
-  std::uint8_t track_mask = 0;      ///< TRK, bit 3 = H4 ... bit 0 = H1 (written H4 H3 H2 H1)
-  int deviation = 0;                ///< DEV, signed track deviation
-  bool obstacle = false;            ///< OBS, obstacle lock
-  std::array<int, 4> rpm{};         ///< RPM, M1..M4 = LR, LF, RF, RR; signed
+  int distance_cm = 0;                 ///< DIS, ultrasonic range, >= 0
+  std::uint8_t track_mask = 0;         ///< TRK, bit 3 = H4 ... bit 0 = H1 (written H4 H3 H2 H1)
+  int deviation = 0;                   ///< DEV, signed track deviation
+  bool obstacle = false;               ///< OBS, obstacle lock
+  std::array<int, 4> rpm{};            ///< RPM, M1..M4 = LR, LF, RF, RR; signed
   /// Keys the profile does not know, kept in arrival order (forward compatibility).
   std::vector<std::pair<std::string, std::string>> extra;
   friend bool operator==(const Status&, const Status&) = default;
@@ -86,9 +87,9 @@ using Message = std::variant<SetSpeed, SetRun, SetStation, SetMode, Move, Status
 
 using hil::protocol::to_string;  // the shared overloads (bytes, error kinds) stay visible
 
-std::string_view to_string(Direction d);   ///< "STOP", "FWD", ... as on the wire
-std::string_view to_string(Mode m);        ///< "AUTO" or "MAN"
-std::string_view to_string(Command c);     ///< "SP", "ST", ...
+std::string_view to_string(Direction d);  ///< "STOP", "FWD", ... as on the wire
+std::string_view to_string(Mode m);       ///< "AUTO" or "MAN"
+std::string_view to_string(Command c);    ///< "SP", "ST", ...
 std::optional<Direction> parse_direction(std::string_view text);
 std::optional<Mode> parse_mode(std::string_view text);
 std::optional<Command> parse_command(std::string_view text);

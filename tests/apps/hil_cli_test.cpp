@@ -19,7 +19,8 @@ TEST(HilCli, EncodesLogiFromPayload) {
 
 TEST(HilCli, EncodesLogiStatus) {
   const auto r = run_hil(
-      "encode logi STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,RPM:1:2:3:4");
+      "encode logi "
+      "STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,RPM:1:2:3:4");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("LOGI:STAT:SP:050,STA:002"));
 }
@@ -58,7 +59,8 @@ TEST(HilCli, LenientLogiDecodeToleratesLowercaseChecksum) {
 }
 
 TEST(HilCli, DecodesAStreamFromAFileWithSummary) {
-  const auto r = run_hil("decode logi --no-raw --summary --file scenarios/captures/logi-session.txt");
+  const auto r =
+      run_hil("decode logi --no-raw --summary --file scenarios/captures/logi-session.txt");
   EXPECT_EQ(r.exit_code, 1);  // the capture holds deliberate errors
   EXPECT_THAT(r.output, HasSubstr("summary: 739 bytes, 13 frame(s), 4 error(s)"));
 }
@@ -116,7 +118,8 @@ TEST(HilCli, DecodesArduinoRequest) {
 
 TEST(HilCli, EncodesLekaFramesAsSpacedHex) {
   EXPECT_EQ(run_hil("encode leka info").output, "2A 2B 2C 2D 01 70 70\n");
-  EXPECT_EQ(run_hil("encode leka led.belt.single 0 255 0 0").output, "2A 2B 2C 2D 05 15 00 FF 00 00 41\n");
+  EXPECT_EQ(run_hil("encode leka led.belt.single 0 255 0 0").output,
+            "2A 2B 2C 2D 05 15 00 FF 00 00 41\n");
   const auto group = run_hil("encode leka led.ear.all 255 0 0 + motor.all 1 200");
   EXPECT_EQ(group.exit_code, 0);
   EXPECT_THAT(group.output, HasSubstr("2A 2B 2C 2D 07 11 FF 00 00 21 01 C8"));
@@ -147,21 +150,41 @@ TEST(HilCli, EveryCaptureDecodesWithTheErrorsItWasMadeWith) {
   };
   for (const Capture& c : {
            Capture{"arduino --file scenarios/captures/arduino-session.txt",
-                   "summary: 243 bytes, 15 frame(s), 4 error(s), 1 bad_checksum, 1 bad_format, 1 bad_value, 1 garbage"},
+                   "summary: 243 bytes, 15 frame(s), 4 error(s), 1 bad_checksum, 1 bad_format, 1 "
+                   "bad_value, 1 garbage"},
            Capture{"wr8 --hex --file scenarios/captures/wr8-vehicle.hex",
                    "summary: 165 bytes, 12 frame(s), 1 error(s), 1 garbage"},
            Capture{"leka --hex --file scenarios/captures/leka-master.hex",
-                   "summary: 86 bytes, 6 frame(s), 3 error(s), 1 bad_checksum, 1 bad_value, 1 truncated"},
+                   "summary: 86 bytes, 6 frame(s), 3 error(s), 1 bad_checksum, 1 bad_value, 1 "
+                   "truncated"},
        }) {
     const auto r = run_hil(std::string("decode ") + c.args + " --summary --no-raw");
     EXPECT_THAT(r.output, HasSubstr(c.summary)) << c.args;
   }
 }
 
+TEST(HilCli, ProxyRejectsABadEndpointOrFaultFileAndSaysWhere) {
+  const auto uri = run_hil("proxy --listen tcp://127.0.0.1:0 --upstream tcp://127.0.0.1");
+  EXPECT_EQ(uri.exit_code, 1);
+  EXPECT_THAT(uri.output, HasSubstr("expected tcp://HOST:PORT"));
+
+  const auto faults = run_hil(
+      "proxy --listen tcp://127.0.0.1:0 --upstream tcp://127.0.0.1:9 --faults "
+      "tests/apps/data/bad-faults.yaml");
+  EXPECT_EQ(faults.exit_code, 1);
+  EXPECT_THAT(faults.output,
+              HasSubstr("bad-faults.yaml:4:12: rule 1 (fragment): 'sizes' must be [min, max]"));
+
+  const auto missing = run_hil("proxy --listen tcp://127.0.0.1:0");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.output, HasSubstr("--upstream is required"));
+}
+
 TEST(HilCli, HelpListsEveryProtocol) {
   const auto r = run_hil("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* p : {"logi", "wr8", "arduino", "leka"}) EXPECT_THAT(r.output, HasSubstr(p));
+  for (const char* p : {"logi", "wr8", "arduino", "leka"})
+    EXPECT_THAT(r.output, HasSubstr(p));
 }
 
 }  // namespace

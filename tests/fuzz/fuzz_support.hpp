@@ -25,8 +25,10 @@ inline void check(bool ok, const char* what) {
 /// that the decoder never holds more than `bound` bytes and that every input
 /// byte comes out in exactly one item, in order. Returns the items.
 template <class Decoder, class Message>
-std::vector<protocol::DecodeItem<Message>> feed_and_check(Decoder& decoder, std::span<const std::uint8_t> plan,
-                                                          std::span<const std::uint8_t> stream, std::size_t bound) {
+std::vector<protocol::DecodeItem<Message>> feed_and_check(Decoder& decoder,
+                                                          std::span<const std::uint8_t> plan,
+                                                          std::span<const std::uint8_t> stream,
+                                                          std::size_t bound) {
   std::vector<protocol::DecodeItem<Message>> items;
   std::size_t pos = 0;
   std::size_t i = 0;

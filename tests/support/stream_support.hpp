@@ -14,8 +14,8 @@
 
 namespace hil::test {
 
-using protocol::ByteView;
 using protocol::Bytes;
+using protocol::ByteView;
 
 /// Feeds the whole stream at once, then finishes.
 template <class Decoder, class Item>
@@ -29,12 +29,14 @@ std::vector<Item> decode_whole(Decoder decoder, ByteView stream) {
 /// Feeds the stream in pieces of the given sizes (cycled; a size of 0 counts
 /// as 1), then finishes.
 template <class Decoder, class Item>
-std::vector<Item> decode_chunked(Decoder decoder, ByteView stream, const std::vector<std::size_t>& pieces) {
+std::vector<Item> decode_chunked(Decoder decoder, ByteView stream,
+                                 const std::vector<std::size_t>& pieces) {
   std::vector<Item> out;
   std::size_t pos = 0;
   std::size_t i = 0;
   while (pos < stream.size()) {
-    const std::size_t want = pieces.empty() ? stream.size() : std::max<std::size_t>(1, pieces[i++ % pieces.size()]);
+    const std::size_t want =
+        pieces.empty() ? stream.size() : std::max<std::size_t>(1, pieces[i++ % pieces.size()]);
     const std::size_t n = std::min(want, stream.size() - pos);
     decoder.feed(stream.subspan(pos, n), out);
     pos += n;
@@ -67,7 +69,8 @@ Bytes raw_of_all(const std::vector<protocol::DecodeItem<Message>>& items) {
 
 /// Number of error items of a kind.
 template <class Message>
-std::size_t count_errors(const std::vector<protocol::DecodeItem<Message>>& items, protocol::ErrorKind kind) {
+std::size_t count_errors(const std::vector<protocol::DecodeItem<Message>>& items,
+                         protocol::ErrorKind kind) {
   return static_cast<std::size_t>(std::count_if(items.begin(), items.end(), [&](const auto& item) {
     const auto* e = std::get_if<protocol::DecodeError>(&item);
     return e != nullptr && e->kind == kind;
@@ -84,7 +87,8 @@ inline rc::Gen<std::vector<std::size_t>> gen_pieces() {
 
 inline Bytes concat(const std::vector<Bytes>& parts) {
   Bytes out;
-  for (const auto& p : parts) out.insert(out.end(), p.begin(), p.end());
+  for (const auto& p : parts)
+    out.insert(out.end(), p.begin(), p.end());
   return out;
 }
 

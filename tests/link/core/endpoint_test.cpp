@@ -15,18 +15,21 @@ TEST(Endpoint, ParsesTcp) {
 }
 
 TEST(Endpoint, ParsesPtyWithOptions) {
-  const auto e = std::get<PtyEndpoint>(parse_endpoint("pty:///tmp/hil-arduino0?baud=9600&reset_ms=200"));
+  const auto e =
+      std::get<PtyEndpoint>(parse_endpoint("pty:///tmp/hil-arduino0?baud=9600&reset_ms=200"));
   EXPECT_EQ(e.path, "/tmp/hil-arduino0");
   EXPECT_EQ(e.baud, 9600u);
   EXPECT_EQ(e.reset_on_open, milliseconds(200));
   EXPECT_EQ(std::get<PtyEndpoint>(parse_endpoint("pty:///dev/x")).baud, 0u);
 }
 
-TEST(Endpoint, ParsesMem) { EXPECT_EQ(parse_endpoint("mem://car0"), (Endpoint{MemEndpoint{"car0"}})); }
+TEST(Endpoint, ParsesMem) {
+  EXPECT_EQ(parse_endpoint("mem://car0"), (Endpoint{MemEndpoint{"car0"}}));
+}
 
 TEST(Endpoint, RoundTripsThroughText) {
-  for (const char* uri : {"tcp://127.0.0.1:9000", "tcp://[::1]:80", "pty:///tmp/a?baud=9600&reset_ms=200",
-                          "pty:///tmp/b", "mem://x"}) {
+  for (const char* uri : {"tcp://127.0.0.1:9000", "tcp://[::1]:80",
+                          "pty:///tmp/a?baud=9600&reset_ms=200", "pty:///tmp/b", "mem://x"}) {
     EXPECT_EQ(to_uri(parse_endpoint(uri)), uri);
   }
 }

@@ -47,7 +47,8 @@ struct Client {
   bool connected = false;
   std::error_code connect_error;
 
-  void connect_to(TransportContext& ctx, const std::string& uri, const std::string& first_write = {}) {
+  void connect_to(TransportContext& ctx, const std::string& uri,
+                  const std::string& first_write = {}) {
     connect(ctx, parse_endpoint(uri), [this, first_write](std::error_code ec, BytePipePtr p) {
       connect_error = ec;
       if (ec) return;
@@ -136,7 +137,8 @@ rules:
   proxy.start();
   Client client;
   client.connect_to(ctx, proxy.address());
-  ASSERT_TRUE(run_until([&] { return client.closed.has_value() || (client.connect_error && true); }));
+  ASSERT_TRUE(
+      run_until([&] { return client.closed.has_value() || (client.connect_error && true); }));
   EXPECT_EQ(proxy.connections_refused(), 1u);
   EXPECT_EQ(proxy.links_opened(), 0u);
   EXPECT_TRUE(car.pipes.empty());
@@ -159,14 +161,16 @@ TEST_F(ProxyTest, UnreachableCarClosesTheClient) {
   client.connect_to(ctx, proxy.address());
   ASSERT_TRUE(run_until([&] { return client.closed.has_value(); }));
   bool said = false;
-  for (const auto& l : lines) said = said || l.find("cannot reach the car") != std::string::npos;
+  for (const auto& l : lines)
+    said = said || l.find("cannot reach the car") != std::string::npos;
   EXPECT_TRUE(said);
 }
 
 TEST_F(ProxyTest, WireLogRecordsEveryLink) {
   EchoCar car(ctx);
   auto o = options(car);
-  const auto path = std::filesystem::temp_directory_path() / ("hil-proxy-test-" + std::to_string(::getpid()) + ".ndjson");
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hil-proxy-test-" + std::to_string(::getpid()) + ".ndjson");
   std::filesystem::remove(path);
   o.wire_log_path = path.string();
   {

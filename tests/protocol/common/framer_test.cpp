@@ -9,7 +9,8 @@ namespace {
 
 using Kind = DelimitedFramer::Kind;
 
-std::vector<DelimitedFramer::Event> run(std::string_view text, std::size_t max = 32, bool finish = true) {
+std::vector<DelimitedFramer::Event> run(std::string_view text, std::size_t max = 32,
+                                        bool finish = true) {
   DelimitedFramer framer("AB:", '#', max);
   std::vector<DelimitedFramer::Event> out;
   framer.feed(to_bytes(text), out);
@@ -30,7 +31,8 @@ TEST(SequenceMatcher, FindsHeaderAfterFalseStart) {
 TEST(SequenceMatcher, HandlesSelfOverlappingPatterns) {
   SequenceMatcher m("AAB");
   int hits = 0;
-  for (const char c : std::string("AAAAB")) hits += m.feed(static_cast<std::uint8_t>(c)) ? 1 : 0;
+  for (const char c : std::string("AAAAB"))
+    hits += m.feed(static_cast<std::uint8_t>(c)) ? 1 : 0;
   EXPECT_EQ(hits, 1);
 }
 
@@ -87,7 +89,8 @@ TEST(DelimitedFramer, FinishReportsTruncatedFrame) {
   EXPECT_EQ(events[0].kind, Kind::truncated);
 }
 
-RC_GTEST_PROP(DelimitedFramer, EveryByteComesOutOnceInOrder, (const std::vector<std::uint8_t>& noise)) {
+RC_GTEST_PROP(DelimitedFramer, EveryByteComesOutOnceInOrder,
+              (const std::vector<std::uint8_t>& noise)) {
   // Bias the alphabet towards the header and terminator bytes.
   const auto stream = *rc::gen::container<std::vector<std::uint8_t>>(
       rc::gen::element<std::uint8_t>('A', 'B', ':', '#', 'x', 0x00));
@@ -98,7 +101,8 @@ RC_GTEST_PROP(DelimitedFramer, EveryByteComesOutOnceInOrder, (const std::vector<
   framer.feed(all, out);
   framer.finish(out);
   Bytes joined;
-  for (const auto& e : out) joined.insert(joined.end(), e.bytes.begin(), e.bytes.end());
+  for (const auto& e : out)
+    joined.insert(joined.end(), e.bytes.begin(), e.bytes.end());
   RC_ASSERT(joined == all);
 }
 

@@ -61,20 +61,23 @@ TEST(LogiDecoder, LowercaseChecksumIsADistinctViolation) {
   ASSERT_EQ(strict.size(), 1u);
   EXPECT_EQ(error_at(strict, 0).kind, ErrorKind::lowercase_checksum);
 
-  const auto lenient = decode_all("LOGI:SP:050:d7#", DecoderOptions{.accept_lowercase_checksum = true});
+  const auto lenient =
+      decode_all("LOGI:SP:050:d7#", DecoderOptions{.accept_lowercase_checksum = true});
   ASSERT_EQ(lenient.size(), 1u);
   const auto& f = std::get<Frame<Message>>(lenient[0]);
   EXPECT_EQ(f.message, Message{SetSpeed{50}});
   EXPECT_EQ(f.tolerated, ErrorKind::lowercase_checksum);
 
   // A wrong value in lowercase is a checksum error, lenient or not.
-  const auto wrong = decode_all("LOGI:SP:050:d8#", DecoderOptions{.accept_lowercase_checksum = true});
+  const auto wrong =
+      decode_all("LOGI:SP:050:d8#", DecoderOptions{.accept_lowercase_checksum = true});
   EXPECT_EQ(error_at(wrong, 0).kind, ErrorKind::bad_checksum);
 }
 
 TEST(LogiDecoder, UnknownStatKeysAreKept) {
   const std::string payload =
-      "STAT:SP:030,STA:001,RUN:0,MODE:MAN,MAN:CW,DIS:45,TRK:1001,DEV:0,OBS:1,RPM:1:2:3:4,BAT:7.4V,FW:v1:2";
+      "STAT:SP:030,STA:001,RUN:0,MODE:MAN,MAN:CW,DIS:45,TRK:1001,DEV:0,OBS:1,RPM:1:2:3:4,BAT:7.4V,"
+      "FW:v1:2";
   const auto items = decode_all(frame_text(payload));
   ASSERT_EQ(items.size(), 1u);
   const auto& s = std::get<Status>(std::get<Frame<Message>>(items[0]).message);
@@ -113,12 +116,13 @@ TEST(LogiDecoder, MalformedCommandsCarryTheirCommandCode) {
     ErrorKind kind;
     const char* context;
   };
-  for (const Case& c : {Case{"SP:50", ErrorKind::bad_format, "SP"}, Case{"SP:101", ErrorKind::bad_value, "SP"},
-                        Case{"SP:abc", ErrorKind::bad_format, "SP"}, Case{"GS:1", ErrorKind::bad_format, "GS"},
-                        Case{"ST:GO", ErrorKind::bad_format, "ST"}, Case{"MD:MANUAL", ErrorKind::bad_format, "MD"},
-                        Case{"MV:UP", ErrorKind::bad_format, "MV"}, Case{"FB:XX:1", ErrorKind::bad_format, "FB"},
-                        Case{"FB:SP:2", ErrorKind::bad_format, "FB"},
-                        Case{"ZZ:1", ErrorKind::unknown_code, "ZZ"}, Case{"PING", ErrorKind::bad_format, "PING"}}) {
+  for (const Case& c :
+       {Case{"SP:50", ErrorKind::bad_format, "SP"}, Case{"SP:101", ErrorKind::bad_value, "SP"},
+        Case{"SP:abc", ErrorKind::bad_format, "SP"}, Case{"GS:1", ErrorKind::bad_format, "GS"},
+        Case{"ST:GO", ErrorKind::bad_format, "ST"}, Case{"MD:MANUAL", ErrorKind::bad_format, "MD"},
+        Case{"MV:UP", ErrorKind::bad_format, "MV"}, Case{"FB:XX:1", ErrorKind::bad_format, "FB"},
+        Case{"FB:SP:2", ErrorKind::bad_format, "FB"}, Case{"ZZ:1", ErrorKind::unknown_code, "ZZ"},
+        Case{"PING", ErrorKind::bad_format, "PING"}}) {
     const auto items = decode_all(frame_text(c.payload));
     ASSERT_EQ(items.size(), 1u) << c.payload;
     EXPECT_EQ(error_at(items, 0).kind, c.kind) << c.payload;

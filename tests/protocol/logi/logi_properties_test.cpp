@@ -14,7 +14,9 @@ using test::decode_whole;
 using test::messages_of;
 using test::raw_of_all;
 
-bool contains_header(const Bytes& b) { return to_string(b).find(kHeader) != std::string::npos; }
+bool contains_header(const Bytes& b) {
+  return to_string(b).find(kHeader) != std::string::npos;
+}
 
 RC_GTEST_PROP(LogiProperties, DecodeOfEncodeIsIdentity, (const Message& m)) {
   const auto item = decode_frame(encode(m));
@@ -24,12 +26,16 @@ RC_GTEST_PROP(LogiProperties, DecodeOfEncodeIsIdentity, (const Message& m)) {
   RC_ASSERT(frame->raw == encode(m));
 }
 
-RC_GTEST_PROP(LogiProperties, AnyChunkingDecodesLikeTheWholeStream, (const std::vector<Message>& ms)) {
+RC_GTEST_PROP(LogiProperties, AnyChunkingDecodesLikeTheWholeStream,
+              (const std::vector<Message>& ms)) {
   std::vector<Bytes> frames;
-  for (const auto& m : ms) frames.push_back(encode(m));
+  for (const auto& m : ms)
+    frames.push_back(encode(m));
   // Some noise so errors are part of the comparison too.
-  const auto noise = *rc::gen::container<Bytes>(rc::gen::element<std::uint8_t>('L', 'O', 'G', 'I', ':', '#', 'x'));
-  frames.insert(frames.begin() + *rc::gen::inRange<std::ptrdiff_t>(0, static_cast<std::ptrdiff_t>(frames.size()) + 1),
+  const auto noise =
+      *rc::gen::container<Bytes>(rc::gen::element<std::uint8_t>('L', 'O', 'G', 'I', ':', '#', 'x'));
+  frames.insert(frames.begin() + *rc::gen::inRange<std::ptrdiff_t>(
+                                     0, static_cast<std::ptrdiff_t>(frames.size()) + 1),
                 noise);
   const Bytes stream = concat(frames);
   const auto pieces = *test::gen_pieces();
@@ -52,7 +58,8 @@ RC_GTEST_PROP(LogiProperties, EveryByteIsAccountedForOnce, (const std::vector<Me
   RC_ASSERT(raw_of_all(items) == stream);
 }
 
-RC_GTEST_PROP(LogiProperties, RandomGarbageBetweenFramesLosesNoFrame, (const std::vector<Message>& ms)) {
+RC_GTEST_PROP(LogiProperties, RandomGarbageBetweenFramesLosesNoFrame,
+              (const std::vector<Message>& ms)) {
   Bytes stream;
   for (const auto& m : ms) {
     const auto garbage = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
@@ -91,15 +98,18 @@ bool single_byte_change_detected(const Bytes& frame, std::size_t pos, std::uint8
 RC_GTEST_PROP(LogiProperties, EverySingleByteChangeIsDetected, (const Message& m)) {
   const Bytes frame = encode(m);
   const auto pos = *rc::gen::inRange<std::size_t>(0, frame.size());
-  const auto value = *rc::gen::suchThat(rc::gen::arbitrary<std::uint8_t>(), [&](std::uint8_t v) { return v != frame[pos]; });
+  const auto value = *rc::gen::suchThat(rc::gen::arbitrary<std::uint8_t>(),
+                                        [&](std::uint8_t v) { return v != frame[pos]; });
   RC_ASSERT(single_byte_change_detected(frame, pos, value));
 }
 
 TEST(LogiProperties, EverySingleByteChangeOfEverySpecCommandIsDetected) {
   // Exhaustive over positions and values for the command set.
-  std::vector<Message> commands = {SetSpeed{0}, SetSpeed{100}, SetRun{true}, SetRun{false},
-                                   SetStation{1}, SetStation{2}, SetMode{Mode::manual}, SetMode{Mode::automatic}};
-  for (const auto d : kAllDirections) commands.push_back(Move{d});
+  std::vector<Message> commands = {SetSpeed{0},           SetSpeed{100},           SetRun{true},
+                                   SetRun{false},         SetStation{1},           SetStation{2},
+                                   SetMode{Mode::manual}, SetMode{Mode::automatic}};
+  for (const auto d : kAllDirections)
+    commands.push_back(Move{d});
   std::size_t checked = 0;
   for (const auto& m : commands) {
     const Bytes frame = encode(m);

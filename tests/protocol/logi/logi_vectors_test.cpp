@@ -37,10 +37,13 @@ const Vector kSpecFrames[] = {
     {"LOGI:MV:STOP:88#", Move{Direction::stop}},
 };
 
-TEST(LogiVectors, ThereAreTwentySpecFrames) { EXPECT_EQ(std::size(kSpecFrames), 20u); }
+TEST(LogiVectors, ThereAreTwentySpecFrames) {
+  EXPECT_EQ(std::size(kSpecFrames), 20u);
+}
 
 TEST(LogiVectors, EncodeReproducesEverySpecFrame) {
-  for (const auto& v : kSpecFrames) EXPECT_EQ(encode_text(v.message), v.frame) << describe(v.message);
+  for (const auto& v : kSpecFrames)
+    EXPECT_EQ(encode_text(v.message), v.frame) << describe(v.message);
 }
 
 TEST(LogiVectors, DecodeGivesBackEverySpecMessage) {
