@@ -83,6 +83,8 @@ void Link::start() {
                                                         self->on_side_closed(d, ec);
                                                     }});
   }
+  // Timed rules (a reset at 7 s, a stall at 5 s) fire even on a quiet link.
+  for (const auto d : kDirections) schedule(d);
 }
 
 void Link::on_bytes(Direction d, ByteView bytes) {

@@ -1,0 +1,154 @@
+// A Link over mem pipes in virtual time: what each side receives, when, and
+// how the link ends, with exact times.
+
+#include <gtest/gtest.h>
+
+#include "link/faults/profile_yaml.hpp"
+#include "link/link.hpp"
+#include "link/mem_pipe.hpp"
+
+namespace hil::link {
+namespace {
+
+using protocol::to_bytes;
+
+struct End {
+  std::string data;
+  std::vector<std::pair<Time, std::string>> arrivals;
+  std::optional<std::error_code> closed;
+  Time closed_at{-1};
+};
+
+struct Recorder final : LinkObserver {
+  std::vector<FaultEvent> faults;
+  std::optional<LinkClose> close;
+  void on_fault(const FaultEvent& e) override { faults.push_back(e); }
+  void on_close(Time, const LinkClose& c) override { close = c; }
+};
+
+class LinkTest : public ::testing::Test {
+ protected:
+  VirtualExecutor ex;
+  BytePipePtr client_app, client_side, car_app, car_side;
+  End at_client, at_car;
+  std::shared_ptr<Recorder> recorder = std::make_shared<Recorder>();
+  std::shared_ptr<Link> link;
+
+  void open(const std::string& to_car_yaml = "rules: []", const std::string& to_client_yaml = "rules: []") {
+    std::tie(client_app, client_side) = make_mem_pipe(ex, "client");
+    std::tie(car_side, car_app) = make_mem_pipe(ex, "car");
+    watch(client_app, at_client);
+    watch(car_app, at_car);
+    LinkOptions o;
+    o.protocol = protocol_adapter("logi");
+    o.to_car = parse_fault_profile_text(to_car_yaml, "to_car");
+    o.to_client = parse_fault_profile_text(to_client_yaml, "to_client");
+    o.seed = 1;
+    o.observers.push_back(recorder);
+    link = Link::create(ex, client_side, car_side, o);
+    link->start();
+  }
+  void watch(const BytePipePtr& pipe, End& end) {
+    pipe->start({[this, &end](ByteView b) {
+                   end.data.append(b.begin(), b.end());
+                   end.arrivals.emplace_back(ex.now(), std::string(b.begin(), b.end()));
+                 },
+                 [this, &end](std::error_code ec) {
+                   end.closed = ec;
+                   end.closed_at = ex.now();
+                 }});
+  }
+};
+
+TEST_F(LinkTest, CarriesBothDirectionsUntouchedWithoutFaults) {
+  open();
+  client_app->write(to_bytes("LOGI:SP:050:D7#"));
+  car_app->write(to_bytes("LOGI:FB:SP:1:35#"));
+  ex.run_until_idle();
+  EXPECT_EQ(at_car.data, "LOGI:SP:050:D7#");
+  EXPECT_EQ(at_client.data, "LOGI:FB:SP:1:35#");
+  const auto stats = link->stats();
+  EXPECT_EQ(stats.bytes_sent[0], 15u);
+  EXPECT_EQ(stats.bytes_delivered[1], 16u);
+  EXPECT_EQ(stats.faults, 0u);
+}
+
+TEST_F(LinkTest, DelayedBytesArriveAtTheExactTime) {
+  open("rules:\n  - kind: delay\n    delay: 100ms\n");
+  ex.run_until(milliseconds(250));
+  client_app->write(to_bytes("LOGI:MV:FWD:23#"));
+  ex.run_until_idle();
+  ASSERT_EQ(at_car.arrivals.size(), 1u);
+  EXPECT_EQ(at_car.arrivals[0].first, milliseconds(350));
+}
+
+TEST_F(LinkTest, FaultRulesChangeWhileTheLinkRuns) {
+  open();
+  client_app->write(to_bytes("LOGI:MV:FWD:23#"));
+  ex.run_for(seconds(1));
+  link->set_profile(Direction::to_car, parse_fault_profile_text("rules:\n  - kind: drop\n", "live"));
+  client_app->write(to_bytes("LOGI:MV:STOP:88#"));
+  ex.run_for(seconds(1));
+  link->set_profile(Direction::to_car, FaultProfile{});
+  client_app->write(to_bytes("LOGI:MV:CW:DC#"));
+  ex.run_until_idle();
+  EXPECT_EQ(at_car.data, "LOGI:MV:FWD:23#LOGI:MV:CW:DC#");
+  ASSERT_EQ(recorder->faults.size(), 1u);
+  EXPECT_EQ(recorder->faults[0].kind, "drop");
+  EXPECT_EQ(recorder->faults[0].at, seconds(1));
+}
+
+TEST_F(LinkTest, ClientCloseDeliversWhatIsInFlightThenClosesTheCar) {
+  open("rules:\n  - kind: delay\n    delay: 100ms\n");
+  client_app->write(to_bytes("LOGI:MV:STOP:88#"));
+  client_app->close();
+  ex.run_until_idle();
+  EXPECT_EQ(at_car.data, "LOGI:MV:STOP:88#");
+  EXPECT_EQ(at_car.closed, end_of_stream());
+  EXPECT_EQ(at_car.closed_at, milliseconds(100));
+  ASSERT_TRUE(recorder->close.has_value());
+  EXPECT_EQ(recorder->close->by, LinkClose::By::client);
+  EXPECT_EQ(recorder->close->mode, CloseMode::graceful);
+  EXPECT_FALSE(link->is_open());
+}
+
+TEST_F(LinkTest, ResetFaultAbortsBothSides) {
+  open("rules: []", "rules:\n  - kind: reset\n    at: 2s\n");
+  ex.run_until_idle();
+  EXPECT_EQ(at_client.closed, std::make_error_code(std::errc::connection_reset));
+  EXPECT_EQ(at_car.closed, std::make_error_code(std::errc::connection_reset));
+  EXPECT_EQ(at_client.closed_at, seconds(2));
+  ASSERT_TRUE(recorder->close.has_value());
+  EXPECT_EQ(recorder->close->by, LinkClose::By::fault);
+  EXPECT_EQ(recorder->close->mode, CloseMode::reset);
+}
+
+TEST_F(LinkTest, SameSeedSameFaultsUnderTheLink) {
+  const auto run_once = [](std::uint64_t seed) {
+    VirtualExecutor ex;
+    auto [client_app, client_side] = make_mem_pipe(ex, "c");
+    auto [car_side, car_app] = make_mem_pipe(ex, "k");
+    std::string got;
+    car_app->start({[&](ByteView b) { got.append(b.begin(), b.end()); }, {}});
+    client_app->start({});
+    LinkOptions o;
+    o.protocol = protocol_adapter("logi");
+    o.to_car = parse_fault_profile_text(
+        "rules:\n  - kind: drop\n    probability: 0.5\n  - kind: fragment\n    sizes: [1, 5]\n    gap: [0ms, 3ms]\n",
+        "t");
+    o.seed = seed;
+    auto link = Link::create(ex, client_side, car_side, o);
+    link->start();
+    for (int i = 0; i < 40; ++i) {
+      client_app->write(to_bytes(i % 2 == 0 ? "LOGI:MV:FWD:23#" : "LOGI:MV:STOP:88#"));
+      ex.run_for(milliseconds(50));
+    }
+    ex.run_until_idle();
+    return got;
+  };
+  EXPECT_EQ(run_once(42), run_once(42));
+  EXPECT_NE(run_once(42), run_once(43));
+}
+
+}  // namespace
+}  // namespace hil::link
