@@ -62,4 +62,12 @@ using ConnectHandler = std::function<void(std::error_code, BytePipePtr)>;
 /// eof, for every transport (mem pipes included), so callers test one value.
 std::error_code end_of_stream();
 
+/// The code on_close receives when close() was called on this end.
+std::error_code closed_here();
+
+/// Asio reports OS errors in its own category, which std::errc conditions do
+/// not match; transports pass them through this so that
+/// `ec == std::errc::connection_reset` works for every transport.
+std::error_code portable_error(std::error_code ec);
+
 }  // namespace hil::link

@@ -42,9 +42,7 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
                                                : end_of_stream();
       executor_.post([peer, ec] { peer->remote_closed(ec); });
     }
-    executor_.post([self = shared_from_this()] {
-      self->notify_close(std::make_error_code(std::errc::operation_canceled));
-    });
+    executor_.post([self = shared_from_this()] { self->notify_close(closed_here()); });
   }
 
   bool is_open() const override { return open_; }

@@ -119,18 +119,6 @@ namespace {
 
 using Descriptor = asio::posix::stream_descriptor;
 
-/// As in tcp.cpp: OS errors leave in std::system_category, so std::errc
-/// conditions match them.
-std::error_code portable(std::error_code ec) {
-  if (ec.category() == asio::error::get_system_category())
-    return {ec.value(), std::system_category()};
-  return ec;
-}
-
-std::error_code closed_here() {
-  return std::make_error_code(std::errc::operation_canceled);
-}
-
 [[noreturn]] void throw_errno(const std::string& what) {
   throw std::system_error(errno, std::generic_category(), what);
 }
@@ -273,7 +261,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
 
   void on_read(std::error_code ec, std::size_t n) {
     reading_ = false;
-    ec = portable(ec);
+    ec = portable_error(ec);
     if (state_ == State::closed || state_ == State::client_gone) return;
     if (n > 0 && state_ == State::open) received(ByteView(buffer_.data(), n));
     if (state_ == State::closed || ec == std::errc::operation_canceled) return;
@@ -333,7 +321,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
 
   void on_written(std::error_code ec) {
     writing_ = false;
-    ec = portable(ec);
+    ec = portable_error(ec);
     if (state_ != State::open && state_ != State::flushing) return;
     if (ec) {
       if (state_ == State::open) notify_close(ec);

@@ -28,20 +28,6 @@ constexpr auto accept_retry = std::chrono::milliseconds(100);
 /// At most this many queued writes go into one gathered async_write.
 constexpr std::size_t max_gather = 64;
 
-/// Asio reports OS errors in its own category, which std::errc conditions
-/// do not match; callers get them in std::system_category instead, so
-/// `ec == std::errc::connection_reset` works for every transport.
-std::error_code portable(std::error_code ec) {
-  if (ec.category() == asio::error::get_system_category())
-    return {ec.value(), std::system_category()};
-  return ec;
-}
-
-/// What on_close receives when this side closed the pipe (as mem pipes do).
-std::error_code closed_here() {
-  return std::make_error_code(std::errc::operation_canceled);
-}
-
 std::string text_of(const tcp::endpoint& e) {
   const auto a = e.address();
   return (a.is_v6() ? "[" + a.to_string() + "]" : a.to_string()) + ":" + std::to_string(e.port());
@@ -196,7 +182,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   }
 
   void notify_close(std::error_code ec) {
-    ec = portable(ec);
+    ec = portable_error(ec);
     if (close_notified_) return;
     close_notified_ = true;
     // Handlers often capture the pipe; dropping them breaks that cycle.
@@ -230,7 +216,7 @@ tcp::endpoint resolve_for_listen(asio::io_context& io, const TcpEndpoint& endpoi
   tcp::resolver resolver(io);
   const auto results = resolver.resolve(host, std::to_string(endpoint.port), ec);
   if (ec || results.empty()) {
-    throw std::system_error(portable(ec ? ec : asio::error::host_not_found),
+    throw std::system_error(portable_error(ec ? ec : asio::error::host_not_found),
                             uri + ": cannot resolve '" + host + "'");
   }
   return results.begin()->endpoint();
@@ -276,7 +262,7 @@ TcpListener::TcpListener(asio::io_context& io, const TcpEndpoint& endpoint)
   if (!ec) acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
   if (!ec) acceptor.bind(bind_to, ec);
   if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) throw std::system_error(portable(ec), uri + ": cannot listen");
+  if (ec) throw std::system_error(portable_error(ec), uri + ": cannot listen");
   state_->local = text_of(acceptor.local_endpoint());
 }
 
@@ -320,13 +306,13 @@ void tcp_connect(asio::io_context& io, const TcpEndpoint& endpoint, ConnectHandl
       host, std::to_string(endpoint.port),
       [op](std::error_code ec, const tcp::resolver::results_type& results) {
         if (ec) {
-          op->handler(portable(ec), nullptr);
+          op->handler(portable_error(ec), nullptr);
           return;
         }
         asio::async_connect(
             op->socket, results, [op](std::error_code connect_ec, const tcp::endpoint& remote) {
               if (connect_ec) {
-                op->handler(portable(connect_ec), nullptr);
+                op->handler(portable_error(connect_ec), nullptr);
                 return;
               }
               std::error_code local_ec;

@@ -72,6 +72,10 @@ struct FaultInjector::State {
     Time due{0};
     std::optional<Bytes> bytes;  // nullopt: a LinkBreak
     bool reset = false;
+    // Untouched frames of one push() due at the same time go out as one
+    // write, as the sender wrote them (and at stream speed, not per frame).
+    std::uint64_t push = 0;
+    bool mergeable = false;
   };
   struct Batch {
     std::optional<Time> deadline;
@@ -108,6 +112,8 @@ struct FaultInjector::State {
 
   std::uint64_t frames_seen = 0;
   std::uint64_t faults = 0;
+  std::uint64_t pushes = 0;           // push() calls so far
+  std::uint64_t faults_at_frame = 0;  // `faults` when the current frame began
   Time last_now{0};
   bool finished = false;
   bool broken = false;
@@ -214,9 +220,16 @@ struct FaultInjector::State {
   }
 
   /// Queues one write for `desired` or, to keep stream order, later.
-  void schedule(Time now, std::uint64_t frame, Time desired, Bytes bytes) {
+  void schedule(Time now, std::uint64_t frame, Time desired, Bytes bytes, bool mergeable = false) {
     Time t = after_stalls(std::max(desired, last_due));
     const std::size_t bw = bandwidth_rule_at(t);
+    if (mergeable && bw >= profile.rules.size() && !queue.empty()) {
+      Pending& last = queue.back();
+      if (last.mergeable && last.bytes && last.push == pushes && last.due == t) {
+        append(*last.bytes, bytes);
+        return;
+      }
+    }
     if (bw < profile.rules.size()) {
       const auto rate = std::get<Bandwidth>(profile.rules[bw].action).bytes_per_second;
       const auto n = static_cast<std::uint64_t>(bytes.size());
@@ -231,7 +244,7 @@ struct FaultInjector::State {
       t = paced;
     }
     last_due = t;
-    queue.push_back(Pending{t, std::move(bytes), false});
+    queue.push_back(Pending{t, std::move(bytes), false, pushes, mergeable});
   }
 
   /// One write the sender's frames make after frame rules: fragmented when a
@@ -241,7 +254,8 @@ struct FaultInjector::State {
     if (bytes.empty()) return;
     const Time desired = now + delay;
     if (!fragment_rule) {
-      schedule(now, frame, desired, std::move(bytes));
+      // No rule touched this frame if no fault was recorded since it began.
+      schedule(now, frame, desired, std::move(bytes), faults == faults_at_frame);
       return;
     }
     const auto& f = std::get<Fragment>(profile.rules[*fragment_rule].action);
@@ -394,6 +408,7 @@ struct FaultInjector::State {
 
   void process(Time now, WireFrame&& frame) {
     const std::uint64_t n = ++frames_seen;
+    faults_at_frame = faults;
     const std::size_t count = profile.rules.size();
     Bytes bytes = std::move(frame.raw);
 
@@ -533,6 +548,7 @@ void FaultInjector::push(Time now, protocol::ByteView bytes) {
   auto& s = *state_;
   s.advance(now);
   if (s.broken || s.finished) return;
+  ++s.pushes;
   s.splitter->feed(bytes, s.frames);
   s.take_frames(now);
 }
@@ -541,6 +557,7 @@ void FaultInjector::finish(Time now) {
   auto& s = *state_;
   s.advance(now);
   if (s.broken || s.finished) return;
+  ++s.pushes;
   s.splitter->finish(s.frames);
   s.take_frames(now);
   if (s.batch && !s.broken) s.release_batch(now, "sender closed");

@@ -34,7 +34,8 @@ class LinkTest : public ::testing::Test {
   std::shared_ptr<Recorder> recorder = std::make_shared<Recorder>();
   std::shared_ptr<Link> link;
 
-  void open(const std::string& to_car_yaml = "rules: []", const std::string& to_client_yaml = "rules: []") {
+  void open(const std::string& to_car_yaml = "rules: []",
+            const std::string& to_client_yaml = "rules: []") {
     std::tie(client_app, client_side) = make_mem_pipe(ex, "client");
     std::tie(car_side, car_app) = make_mem_pipe(ex, "car");
     watch(client_app, at_client);
@@ -73,6 +74,28 @@ TEST_F(LinkTest, CarriesBothDirectionsUntouchedWithoutFaults) {
   EXPECT_EQ(stats.faults, 0u);
 }
 
+TEST_F(LinkTest, UntouchedFramesOfOneWriteArriveAsOneWrite) {
+  open();
+  client_app->write(to_bytes("LOGI:SP:050:D7#LOGI:MD:MAN:0C#LOGI:MV:FWD:23#"));
+  client_app->write(to_bytes("LOGI:MV:STOP:88#"));
+  ex.run_until_idle();
+  ASSERT_EQ(at_car.arrivals.size(), 2u);
+  EXPECT_EQ(at_car.arrivals[0].second, "LOGI:SP:050:D7#LOGI:MD:MAN:0C#LOGI:MV:FWD:23#");
+  EXPECT_EQ(at_car.arrivals[1].second, "LOGI:MV:STOP:88#");
+}
+
+TEST_F(LinkTest, AFrameARuleTouchedIsItsOwnWrite) {
+  open("rules:\n  - kind: delay\n    delay: 10ms\n    at_frame: 2\n");
+  client_app->write(to_bytes("LOGI:SP:050:D7#LOGI:MD:MAN:0C#LOGI:MV:FWD:23#"));
+  ex.run_until_idle();
+  ASSERT_EQ(at_car.arrivals.size(), 3u);
+  EXPECT_EQ(at_car.arrivals[0], (std::pair<Time, std::string>{Time{0}, "LOGI:SP:050:D7#"}));
+  EXPECT_EQ(at_car.arrivals[1],
+            (std::pair<Time, std::string>{milliseconds(10), "LOGI:MD:MAN:0C#"}));
+  EXPECT_EQ(at_car.arrivals[2],
+            (std::pair<Time, std::string>{milliseconds(10), "LOGI:MV:FWD:23#"}));
+}
+
 TEST_F(LinkTest, DelayedBytesArriveAtTheExactTime) {
   open("rules:\n  - kind: delay\n    delay: 100ms\n");
   ex.run_until(milliseconds(250));
@@ -86,7 +109,8 @@ TEST_F(LinkTest, FaultRulesChangeWhileTheLinkRuns) {
   open();
   client_app->write(to_bytes("LOGI:MV:FWD:23#"));
   ex.run_for(seconds(1));
-  link->set_profile(Direction::to_car, parse_fault_profile_text("rules:\n  - kind: drop\n", "live"));
+  link->set_profile(Direction::to_car,
+                    parse_fault_profile_text("rules:\n  - kind: drop\n", "live"));
   client_app->write(to_bytes("LOGI:MV:STOP:88#"));
   ex.run_for(seconds(1));
   link->set_profile(Direction::to_car, FaultProfile{});
@@ -123,7 +147,7 @@ TEST_F(LinkTest, ResetFaultAbortsBothSides) {
   EXPECT_EQ(recorder->close->mode, CloseMode::reset);
 }
 
-TEST_F(LinkTest, SameSeedSameFaultsUnderTheLink) {
+TEST(LinkSeed, SameSeedSameFaultsUnderTheLink) {
   const auto run_once = [](std::uint64_t seed) {
     VirtualExecutor ex;
     auto [client_app, client_side] = make_mem_pipe(ex, "c");
@@ -134,7 +158,8 @@ TEST_F(LinkTest, SameSeedSameFaultsUnderTheLink) {
     LinkOptions o;
     o.protocol = protocol_adapter("logi");
     o.to_car = parse_fault_profile_text(
-        "rules:\n  - kind: drop\n    probability: 0.5\n  - kind: fragment\n    sizes: [1, 5]\n    gap: [0ms, 3ms]\n",
+        "rules:\n  - kind: drop\n    probability: 0.5\n  - kind: fragment\n    sizes: [1, 5]\n    "
+        "gap: [0ms, 3ms]\n",
         "t");
     o.seed = seed;
     auto link = Link::create(ex, client_side, car_side, o);
