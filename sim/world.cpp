@@ -1,0 +1,193 @@
+#include "sim/world.hpp"
+
+#include <box2d/box2d.h>
+
+#include <stdexcept>
+
+#include "sim/fixture_tag.hpp"
+
+namespace hil::sim {
+
+using detail::fixture_index;
+using detail::fixture_kind;
+using detail::fixture_tag;
+using detail::FixtureKind;
+
+class World::ContactListener final : public b2ContactListener {
+ public:
+  explicit ContactListener(World& world) : world_(world) {}
+  void BeginContact(b2Contact* contact) override { report(contact, ContactEvent::Phase::begin); }
+  void EndContact(b2Contact* contact) override { report(contact, ContactEvent::Phase::end); }
+
+ private:
+  void report(b2Contact* contact, ContactEvent::Phase phase) {
+    const std::uintptr_t a = contact->GetFixtureA()->GetUserData().pointer;
+    const std::uintptr_t b = contact->GetFixtureB()->GetUserData().pointer;
+    Vec2 point;
+    if (phase == ContactEvent::Phase::begin) {
+      b2WorldManifold manifold;
+      contact->GetWorldManifold(&manifold);
+      if (contact->GetManifold()->pointCount > 0)
+        point = {manifold.points[0].x, manifold.points[0].y};
+    }
+    one_side(a, b, phase, point);
+    one_side(b, a, phase, point);
+  }
+
+  void one_side(std::uintptr_t self, std::uintptr_t other, ContactEvent::Phase phase, Vec2 point) {
+    if (fixture_kind(self) != FixtureKind::vehicle) return;
+    const std::size_t index = fixture_index(self);
+    Vehicle& vehicle = *world_.vehicles_.at(index);
+    ContactEvent event;
+    event.time = step_end(world_.steps_ + 1);
+    event.vehicle = index;
+    event.phase = phase;
+    event.other = fixture_index(other);
+    switch (fixture_kind(other)) {
+      case FixtureKind::obstacle:
+        event.with = ContactEvent::With::obstacle;
+        event.other_name = std::visit([](const auto& o) { return o.name; },
+                                      world_.def_.arena.obstacles.at(event.other));
+        break;
+      case FixtureKind::vehicle:
+        event.with = ContactEvent::With::vehicle;
+        event.other_name = world_.vehicles_.at(event.other)->name();
+        break;
+      default:
+        event.with = ContactEvent::With::wall;
+        event.other = 0;
+        event.other_name = "wall";
+        break;
+    }
+    event.point_m = phase == ContactEvent::Phase::begin ? point : vehicle.pose().position();
+    vehicle.contacts_ += phase == ContactEvent::Phase::begin ? 1 : -1;
+    world_.contacts_.push_back(std::move(event));
+  }
+
+  World& world_;
+};
+
+World::World(WorldDef def) : def_(std::move(def)) {
+  const auto problems = validate(def_.arena);
+  if (!problems.empty()) {
+    std::string text = "arena '" + def_.arena.name + "' is unusable:";
+    for (const auto& p : problems) text += "\n  " + p;
+    throw std::invalid_argument(text);
+  }
+  b2_ = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));  // seen from above: no gravity
+  listener_ = std::make_unique<ContactListener>(*this);
+  b2_->SetContactListener(listener_.get());
+  build_arena();
+}
+
+World::~World() {
+  // Destroying a touching body reports EndContact; nobody is listening now.
+  b2_->SetContactListener(nullptr);
+  vehicles_.clear();
+}
+
+void World::build_arena() {
+  const Arena& arena = def_.arena;
+  b2BodyDef body_def;  // static, at the origin
+  b2Body* ground = b2_->CreateBody(&body_def);
+  auto add_box = [&](double cx, double cy, double hw, double hh, double angle, std::uintptr_t tag) {
+    b2PolygonShape shape;
+    shape.SetAsBox(static_cast<float>(hw), static_cast<float>(hh),
+                   b2Vec2(static_cast<float>(cx), static_cast<float>(cy)), static_cast<float>(angle));
+    b2FixtureDef fixture;
+    fixture.shape = &shape;
+    fixture.friction = 0.3f;
+    fixture.userData.pointer = tag;
+    ground->CreateFixture(&fixture);
+  };
+  if (arena.walls) {
+    const double t = arena.wall_thickness_m;
+    const double w = arena.width_m;
+    const double h = arena.height_m;
+    const auto wall = fixture_tag(FixtureKind::wall, 0);
+    add_box(w / 2, -t / 2, w / 2 + t, t / 2, 0, wall);
+    add_box(w / 2, h + t / 2, w / 2 + t, t / 2, 0, wall);
+    add_box(-t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
+    add_box(w + t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
+  }
+  for (std::size_t i = 0; i < arena.obstacles.size(); ++i) {
+    const auto tag = fixture_tag(FixtureKind::obstacle, i);
+    if (const auto* box = std::get_if<BoxObstacle>(&arena.obstacles[i])) {
+      add_box(box->center_m.x_m, box->center_m.y_m, box->width_m / 2, box->height_m / 2,
+              box->angle_rad, tag);
+    } else {
+      const auto& circle = std::get<CircleObstacle>(arena.obstacles[i]);
+      b2CircleShape shape;
+      shape.m_p.Set(static_cast<float>(circle.center_m.x_m), static_cast<float>(circle.center_m.y_m));
+      shape.m_radius = static_cast<float>(circle.radius_m);
+      b2FixtureDef fixture;
+      fixture.shape = &shape;
+      fixture.friction = 0.3f;
+      fixture.userData.pointer = tag;
+      ground->CreateFixture(&fixture);
+    }
+  }
+}
+
+Vehicle& World::add_vehicle(VehicleDef def) {
+  const std::size_t index = vehicles_.size();
+  vehicles_.push_back(std::unique_ptr<Vehicle>(new Vehicle(*this, index, std::move(def))));
+  return *vehicles_.back();
+}
+
+void World::step() {
+  for (auto& vehicle : vehicles_) vehicle->before_step(kStepSeconds);
+  b2_->Step(static_cast<float>(kStepSeconds), def_.velocity_iterations, def_.position_iterations);
+  ++steps_;
+  for (auto& vehicle : vehicles_) vehicle->after_step(kStepSeconds);
+}
+
+void World::advance_to(Duration time) {
+  if (time > requested_) requested_ = time;
+  while (step_end(steps_ + 1) <= requested_) step();
+}
+
+std::vector<ContactEvent> World::take_contacts() {
+  std::vector<ContactEvent> out;
+  out.swap(contacts_);
+  return out;
+}
+
+std::uint64_t World::state_hash() const {
+  StateHasher hasher;
+  hasher.add(steps_);
+  hasher.add(static_cast<std::uint64_t>(vehicles_.size()));
+  for (const auto& vehicle : vehicles_) vehicle->hash_state(hasher);
+  return hasher.value();
+}
+
+namespace {
+
+class ClosestHit final : public b2RayCastCallback {
+ public:
+  explicit ClosestHit(const b2Body* ignore) : ignore_(ignore) {}
+  float ReportFixture(b2Fixture* fixture, const b2Vec2&, const b2Vec2&, float fraction) override {
+    if (fixture->GetBody() == ignore_ || fixture->IsSensor()) return -1.0f;  // look through it
+    fraction_ = fraction;
+    return fraction;  // clip the ray: only closer hits from now on
+  }
+  std::optional<float> fraction() const { return fraction_; }
+
+ private:
+  const b2Body* ignore_;
+  std::optional<float> fraction_;
+};
+
+}  // namespace
+
+std::optional<double> World::ray_cast(Vec2 from, Vec2 to, const b2Body* ignore) const {
+  const double length_m = length(to - from);
+  if (!(length_m > 0)) return std::nullopt;
+  ClosestHit callback(ignore);
+  b2_->RayCast(&callback, b2Vec2(static_cast<float>(from.x_m), static_cast<float>(from.y_m)),
+               b2Vec2(static_cast<float>(to.x_m), static_cast<float>(to.y_m)));
+  if (!callback.fraction()) return std::nullopt;
+  return double{*callback.fraction()} * length_m;
+}
+
+}  // namespace hil::sim
