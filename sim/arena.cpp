@@ -19,7 +19,8 @@ double Tape::distance_to_centerline(Vec2 p) const {
 
 double Tape::length_m() const {
   double total = 0;
-  for (std::size_t i = 0; i + 1 < points_m.size(); ++i) total += length(points_m[i + 1] - points_m[i]);
+  for (std::size_t i = 0; i + 1 < points_m.size(); ++i)
+    total += length(points_m[i + 1] - points_m[i]);
   if (closed && points_m.size() > 2) total += length(points_m.front() - points_m.back());
   return total;
 }
@@ -44,7 +45,9 @@ bool inside(const Arena& arena, Vec2 p) {
   return p.x_m >= 0 && p.x_m <= arena.width_m && p.y_m >= 0 && p.y_m <= arena.height_m;
 }
 
-bool finite(Vec2 p) { return std::isfinite(p.x_m) && std::isfinite(p.y_m); }
+bool finite(Vec2 p) {
+  return std::isfinite(p.x_m) && std::isfinite(p.y_m);
+}
 
 }  // namespace
 

@@ -12,7 +12,8 @@ Battery::Battery(const BatteryDef& def) : def_(def) {
 }
 
 void Battery::update(double load, double dt_s, double sag_v) {
-  const double current_a = def_.idle_current_a + std::clamp(load, 0.0, 1.0) * def_.full_load_current_a;
+  const double current_a =
+      def_.idle_current_a + std::clamp(load, 0.0, 1.0) * def_.full_load_current_a;
   const double used = current_a * dt_s / 3600.0 / (def_.capacity_mah / 1000.0);
   reading_.charge = std::max(0.0, reading_.charge - used);
   reading_.current_a = current_a;

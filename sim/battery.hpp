@@ -8,10 +8,10 @@ namespace hil::sim {
 
 struct BatteryDef {
   double capacity_mah = 2200;
-  double full_v = 8.4;   ///< open-circuit voltage at 100 % (a 2S lithium pack)
-  double empty_v = 6.6;  ///< open-circuit voltage at 0 %
-  double idle_current_a = 0.15;        ///< electronics alone
-  double full_load_current_a = 3.0;    ///< added with every motor at full speed
+  double full_v = 8.4;               ///< open-circuit voltage at 100 % (a 2S lithium pack)
+  double empty_v = 6.6;              ///< open-circuit voltage at 0 %
+  double idle_current_a = 0.15;      ///< electronics alone
+  double full_load_current_a = 3.0;  ///< added with every motor at full speed
   double internal_resistance_ohm = 0.15;
   double initial_charge = 1.0;  ///< 0..1
 };

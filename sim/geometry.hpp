@@ -19,8 +19,12 @@ struct Vec2 {
   friend bool operator==(const Vec2&, const Vec2&) = default;
 };
 
-inline double dot(Vec2 a, Vec2 b) { return a.x_m * b.x_m + a.y_m * b.y_m; }
-inline double length(Vec2 a) { return std::hypot(a.x_m, a.y_m); }
+inline double dot(Vec2 a, Vec2 b) {
+  return a.x_m * b.x_m + a.y_m * b.y_m;
+}
+inline double length(Vec2 a) {
+  return std::hypot(a.x_m, a.y_m);
+}
 
 /// `v` turned counter-clockwise by `angle_rad`.
 inline Vec2 rotate(Vec2 v, double angle_rad) {
@@ -66,7 +70,11 @@ inline double wrap_angle(double angle_rad) {
   return a - std::numbers::pi;
 }
 
-inline constexpr double deg_to_rad(double deg) { return deg * std::numbers::pi / 180.0; }
-inline constexpr double rad_to_deg(double rad) { return rad * 180.0 / std::numbers::pi; }
+inline constexpr double deg_to_rad(double deg) {
+  return deg * std::numbers::pi / 180.0;
+}
+inline constexpr double rad_to_deg(double rad) {
+  return rad * 180.0 / std::numbers::pi;
+}
 
 }  // namespace hil::sim

@@ -21,10 +21,11 @@ MecanumWheels MecanumChassis::inverse_kinematics(const MecanumDef& def, const Tw
 Twist MecanumChassis::forward_kinematics(const MecanumDef& def, const MecanumWheels& w) {
   const double k = def.half_wheelbase_m + def.half_track_m;
   const double r = def.wheel_radius_m;
-  return {r / 4 * (w.front_left_radps + w.front_right_radps + w.rear_left_radps + w.rear_right_radps),
-          r / 4 * (-w.front_left_radps + w.front_right_radps + w.rear_left_radps - w.rear_right_radps),
-          r / (4 * k) *
-              (-w.front_left_radps + w.front_right_radps - w.rear_left_radps + w.rear_right_radps)};
+  return {
+      r / 4 * (w.front_left_radps + w.front_right_radps + w.rear_left_radps + w.rear_right_radps),
+      r / 4 * (-w.front_left_radps + w.front_right_radps + w.rear_left_radps - w.rear_right_radps),
+      r / (4 * k) *
+          (-w.front_left_radps + w.front_right_radps - w.rear_left_radps + w.rear_right_radps)};
 }
 
 void MecanumChassis::set_target(const Twist& target) {

@@ -13,8 +13,7 @@ SonarReading read_sonar(const SonarDef& def, const Pose& pose, const RayCaster& 
   double nearest = INFINITY;
   const int rays = std::max(1, def.rays);
   for (int i = 0; i < rays; ++i) {
-    const double offset =
-        rays == 1 ? 0.0 : def.beam_half_angle_rad * (2.0 * i / (rays - 1) - 1.0);
+    const double offset = rays == 1 ? 0.0 : def.beam_half_angle_rad * (2.0 * i / (rays - 1) - 1.0);
     const double angle = axis + offset;
     const Vec2 end = origin + def.max_range_m * Vec2{std::cos(angle), std::sin(angle)};
     if (const auto hit = world.cast(origin, end)) nearest = std::min(nearest, *hit);
@@ -48,7 +47,8 @@ LineReading line_reading_from(std::array<bool, 4> on) {
 
 LineReading read_line_tracker(const LineTrackerDef& def, const Pose& pose, const Arena& arena) {
   std::array<bool, 4> on{};
-  for (std::size_t i = 0; i < 4; ++i) on[i] = arena.on_tape(pose.to_arena({def.ahead_m, def.lateral_m[i]}));
+  for (std::size_t i = 0; i < 4; ++i)
+    on[i] = arena.on_tape(pose.to_arena({def.ahead_m, def.lateral_m[i]}));
   return line_reading_from(on);
 }
 
@@ -75,8 +75,8 @@ IrSide read_ir_side(const IrDef& def, Vec2 mount, double angle_rad, const Pose& 
 IrReading read_ir(const IrDef& def, const Pose& pose, const RayCaster& world) {
   const IrSide left = read_ir_side(def, def.left_mount_m, def.left_angle_rad, pose, world);
   const IrSide right = read_ir_side(def, def.right_mount_m, def.right_angle_rad, pose, world);
-  return {left.analog, right.analog, left.obstacle, right.obstacle, left.distance_m,
-          right.distance_m};
+  return {left.analog,    right.analog,    left.obstacle,
+          right.obstacle, left.distance_m, right.distance_m};
 }
 
 }  // namespace hil::sim

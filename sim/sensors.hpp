@@ -25,12 +25,12 @@ class RayCaster {
 
 struct SonarDef {
   Vec2 mount_m{0.14, 0.0};
-  double mount_angle_rad = 0;          ///< beam axis, counter-clockwise from forward
-  double min_range_m = 0.02;           ///< closer echoes read as this
-  double max_range_m = 4.0;            ///< nothing within this reads as this
-  double beam_half_angle_rad = 0.2618; ///< 15 degrees either side of the axis
-  int rays = 5;                        ///< rays spread across the beam (1 = the axis only)
-  double noise_stddev_m = 0;           ///< Gaussian noise on each reading
+  double mount_angle_rad = 0;           ///< beam axis, counter-clockwise from forward
+  double min_range_m = 0.02;            ///< closer echoes read as this
+  double max_range_m = 4.0;             ///< nothing within this reads as this
+  double beam_half_angle_rad = 0.2618;  ///< 15 degrees either side of the axis
+  int rays = 5;                         ///< rays spread across the beam (1 = the axis only)
+  double noise_stddev_m = 0;            ///< Gaussian noise on each reading
 };
 
 struct SonarReading {
@@ -90,8 +90,8 @@ struct SensorFaults {
   double sonar_glitch_probability = 0;  ///< chance a reading is replaced by the glitch value
   double sonar_glitch_m = 0;            ///< the value a glitched reading shows
   double rfid_miss_probability = 0;     ///< chance a pass over a tag is not read at all
-  double wheel_slip_fraction = 0;  ///< 0..1: the ground moves this much less than the wheels
-  double battery_sag_v = 0;        ///< volts taken off the terminal voltage
+  double wheel_slip_fraction = 0;       ///< 0..1: the ground moves this much less than the wheels
+  double battery_sag_v = 0;             ///< volts taken off the terminal voltage
 };
 
 SonarReading read_sonar(const SonarDef& def, const Pose& pose, const RayCaster& world,

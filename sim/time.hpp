@@ -20,6 +20,8 @@ constexpr Duration step_end(std::int64_t step) {
   return Duration{step * 1'000'000'000 / kStepsPerSecond};
 }
 
-inline double to_seconds(Duration d) { return std::chrono::duration<double>(d).count(); }
+inline double to_seconds(Duration d) {
+  return std::chrono::duration<double>(d).count();
+}
 
 }  // namespace hil::sim

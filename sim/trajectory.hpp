@@ -31,7 +31,7 @@ struct TrajectoryMark {
 };
 
 struct Trajectory {
-  std::string vehicle;  ///< the car's name, shown in the legend
+  std::string vehicle;     ///< the car's name, shown in the legend
   double length_m = 0.30;  ///< footprint drawn at the last pose
   double width_m = 0.25;
   std::vector<TrajectorySample> samples;

@@ -24,7 +24,9 @@ std::unique_ptr<Chassis> make_chassis(const ChassisDef& def) {
       def);
 }
 
-b2Vec2 to_b2(Vec2 v) { return b2Vec2(static_cast<float>(v.x_m), static_cast<float>(v.y_m)); }
+b2Vec2 to_b2(Vec2 v) {
+  return b2Vec2(static_cast<float>(v.x_m), static_cast<float>(v.y_m));
+}
 
 }  // namespace
 
@@ -45,11 +47,13 @@ Vehicle::Vehicle(World& world, std::size_t index, VehicleDef def)
   body_def.allowSleep = false;
   body_ = world.b2_->CreateBody(&body_def);
   b2PolygonShape shape;
-  shape.SetAsBox(static_cast<float>(footprint.length_m / 2), static_cast<float>(footprint.width_m / 2),
+  shape.SetAsBox(static_cast<float>(footprint.length_m / 2),
+                 static_cast<float>(footprint.width_m / 2),
                  b2Vec2(static_cast<float>(footprint.center_ahead_m), 0.0f), 0.0f);
   b2FixtureDef fixture;
   fixture.shape = &shape;
-  fixture.density = static_cast<float>(footprint.mass_kg / (footprint.length_m * footprint.width_m));
+  fixture.density =
+      static_cast<float>(footprint.mass_kg / (footprint.length_m * footprint.width_m));
   fixture.friction = 0.3f;
   fixture.restitution = 0.0f;
   fixture.userData.pointer = detail::fixture_tag(detail::FixtureKind::vehicle, index);
@@ -98,9 +102,8 @@ void Vehicle::before_step(double dt_s) {
   const double wz = wheels.wz_radps * grip;
   // Box2D's linear velocity is the centre of mass's: add w x (com - reference).
   const b2Vec2 com = body_->GetWorldCenter() - body_->GetPosition();
-  body_->SetLinearVelocity(
-      b2Vec2(static_cast<float>(v_ref.x_m - wz * double{com.y}),
-             static_cast<float>(v_ref.y_m + wz * double{com.x})));
+  body_->SetLinearVelocity(b2Vec2(static_cast<float>(v_ref.x_m - wz * double{com.y}),
+                                  static_cast<float>(v_ref.y_m + wz * double{com.x})));
   body_->SetAngularVelocity(static_cast<float>(wz));
 }
 
@@ -115,7 +118,9 @@ void Vehicle::after_step(double dt_s) {
   }
 }
 
-SonarReading Vehicle::sonar() { return read_sonar(def_.sonar, pose(), *this, random_, def_.faults); }
+SonarReading Vehicle::sonar() {
+  return read_sonar(def_.sonar, pose(), *this, random_, def_.faults);
+}
 
 LineReading Vehicle::line_tracker() const {
   return read_line_tracker(def_.line_tracker, pose(), world_.arena());
@@ -126,7 +131,9 @@ std::optional<std::string> Vehicle::rfid() const {
   return tag_under_->id;
 }
 
-IrReading Vehicle::ir() const { return read_ir(def_.ir, pose(), *this); }
+IrReading Vehicle::ir() const {
+  return read_ir(def_.ir, pose(), *this);
+}
 
 std::optional<double> Vehicle::cast(Vec2 from, Vec2 to) const {
   return world_.ray_cast(from, to, body_);

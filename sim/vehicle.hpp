@@ -63,9 +63,7 @@ class Vehicle : private RayCaster {
   /// The chassis as its model, or nullptr when it is another model.
   MecanumChassis* mecanum() { return dynamic_cast<MecanumChassis*>(chassis_.get()); }
   AckermannChassis* ackermann() { return dynamic_cast<AckermannChassis*>(chassis_.get()); }
-  DifferentialChassis* differential() {
-    return dynamic_cast<DifferentialChassis*>(chassis_.get());
-  }
+  DifferentialChassis* differential() { return dynamic_cast<DifferentialChassis*>(chassis_.get()); }
 
   SonarReading sonar();
   LineReading line_tracker() const;

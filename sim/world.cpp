@@ -71,7 +71,8 @@ World::World(WorldDef def) : def_(std::move(def)) {
   const auto problems = validate(def_.arena);
   if (!problems.empty()) {
     std::string text = "arena '" + def_.arena.name + "' is unusable:";
-    for (const auto& p : problems) text += "\n  " + p;
+    for (const auto& p : problems)
+      text += "\n  " + p;
     throw std::invalid_argument(text);
   }
   b2_ = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));  // seen from above: no gravity
@@ -93,7 +94,8 @@ void World::build_arena() {
   auto add_box = [&](double cx, double cy, double hw, double hh, double angle, std::uintptr_t tag) {
     b2PolygonShape shape;
     shape.SetAsBox(static_cast<float>(hw), static_cast<float>(hh),
-                   b2Vec2(static_cast<float>(cx), static_cast<float>(cy)), static_cast<float>(angle));
+                   b2Vec2(static_cast<float>(cx), static_cast<float>(cy)),
+                   static_cast<float>(angle));
     b2FixtureDef fixture;
     fixture.shape = &shape;
     fixture.friction = 0.3f;
@@ -118,7 +120,8 @@ void World::build_arena() {
     } else {
       const auto& circle = std::get<CircleObstacle>(arena.obstacles[i]);
       b2CircleShape shape;
-      shape.m_p.Set(static_cast<float>(circle.center_m.x_m), static_cast<float>(circle.center_m.y_m));
+      shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
+                    static_cast<float>(circle.center_m.y_m));
       shape.m_radius = static_cast<float>(circle.radius_m);
       b2FixtureDef fixture;
       fixture.shape = &shape;
@@ -136,15 +139,18 @@ Vehicle& World::add_vehicle(VehicleDef def) {
 }
 
 void World::step() {
-  for (auto& vehicle : vehicles_) vehicle->before_step(kStepSeconds);
+  for (auto& vehicle : vehicles_)
+    vehicle->before_step(kStepSeconds);
   b2_->Step(static_cast<float>(kStepSeconds), def_.velocity_iterations, def_.position_iterations);
   ++steps_;
-  for (auto& vehicle : vehicles_) vehicle->after_step(kStepSeconds);
+  for (auto& vehicle : vehicles_)
+    vehicle->after_step(kStepSeconds);
 }
 
 void World::advance_to(Duration time) {
   if (time > requested_) requested_ = time;
-  while (step_end(steps_ + 1) <= requested_) step();
+  while (step_end(steps_ + 1) <= requested_)
+    step();
 }
 
 std::vector<ContactEvent> World::take_contacts() {
@@ -157,7 +163,8 @@ std::uint64_t World::state_hash() const {
   StateHasher hasher;
   hasher.add(steps_);
   hasher.add(static_cast<std::uint64_t>(vehicles_.size()));
-  for (const auto& vehicle : vehicles_) vehicle->hash_state(hasher);
+  for (const auto& vehicle : vehicles_)
+    vehicle->hash_state(hasher);
   return hasher.value();
 }
 
