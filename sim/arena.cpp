@@ -1,5 +1,6 @@
 #include "sim/arena.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -23,6 +24,24 @@ double Tape::length_m() const {
     total += length(points_m[i + 1] - points_m[i]);
   if (closed && points_m.size() > 2) total += length(points_m.front() - points_m.back());
   return total;
+}
+
+bool Tape::covers(Vec2 p) const {
+  // The line tracker asks this four times a step: squared distances, and
+  // segments whose box (grown by half the width) misses p skipped outright.
+  const double half = width_m / 2;
+  const double half2 = half * half;
+  const auto near = [&](Vec2 a, Vec2 b) {
+    if (p.x_m < std::min(a.x_m, b.x_m) - half || p.x_m > std::max(a.x_m, b.x_m) + half ||
+        p.y_m < std::min(a.y_m, b.y_m) - half || p.y_m > std::max(a.y_m, b.y_m) + half)
+      return false;
+    return distance_squared_to_segment(p, a, b) <= half2;
+  };
+  if (points_m.size() == 1) return near(points_m[0], points_m[0]);
+  for (std::size_t i = 0; i + 1 < points_m.size(); ++i) {
+    if (near(points_m[i], points_m[i + 1])) return true;
+  }
+  return closed && points_m.size() > 2 && near(points_m.back(), points_m.front());
 }
 
 bool Arena::on_tape(Vec2 p) const {

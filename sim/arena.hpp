@@ -39,7 +39,7 @@ struct Tape {
   /// Distance from `p` to the tape's centre line.
   double distance_to_centerline(Vec2 p) const;
   /// True when `p` lies on the tape.
-  bool covers(Vec2 p) const { return distance_to_centerline(p) <= width_m / 2; }
+  bool covers(Vec2 p) const;
   /// Centre-line length.
   double length_m() const;
 };

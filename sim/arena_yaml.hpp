@@ -15,7 +15,7 @@ class Node;
 namespace hil::sim {
 
 /// An arena file that cannot load. what() reads "SOURCE:LINE:COLUMN: FIELD:
-/// MESSAGE", e.g. "lab.yaml:12:15: obstacles[1].radius_m: expected a
+/// MESSAGE", e.g. "lab.yaml:12:15: obstacles[1].circle.radius_m: expected a
 /// positive number of metres, got '-0.2'". Line and column count from 1; 0
 /// when unknown (a file that cannot be read).
 class ArenaError : public std::runtime_error {

@@ -53,13 +53,19 @@ struct Twist {
   friend bool operator==(const Twist&, const Twist&) = default;
 };
 
-/// Distance from `p` to the segment a-b.
-inline double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+/// Squared distance from `p` to the segment a-b.
+inline double distance_squared_to_segment(Vec2 p, Vec2 a, Vec2 b) {
   const Vec2 ab = b - a;
   const double len2 = dot(ab, ab);
   double t = len2 > 0 ? dot(p - a, ab) / len2 : 0.0;
   t = t < 0 ? 0 : (t > 1 ? 1 : t);
-  return length(p - (a + t * ab));
+  const Vec2 d = p - (a + t * ab);
+  return dot(d, d);
+}
+
+/// Distance from `p` to the segment a-b.
+inline double distance_to_segment(Vec2 p, Vec2 a, Vec2 b) {
+  return std::sqrt(distance_squared_to_segment(p, a, b));
 }
 
 /// `angle_rad` wrapped into (-pi, pi].

@@ -31,6 +31,9 @@ struct SonarDef {
   double beam_half_angle_rad = 0.2618;  ///< 15 degrees either side of the axis
   int rays = 5;                         ///< rays spread across the beam (1 = the axis only)
   double noise_stddev_m = 0;            ///< Gaussian noise on each reading
+  /// A new echo at most this often; reads in between return the last one.
+  /// An HC-SR04 needs about 60 ms between pings for old echoes to die out.
+  double period_s = 0.06;
 };
 
 struct SonarReading {

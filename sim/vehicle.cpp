@@ -83,6 +83,11 @@ void Vehicle::place(const Pose& pose) {
 }
 
 void Vehicle::before_step(double dt_s) {
+  // Box2D keeps the angle unwrapped in a float; a car circling for hours
+  // would lose turning precision, so bring it back near zero now and then.
+  if (const float angle = body_->GetAngle(); std::abs(angle) > 8.0f) {
+    body_->SetTransform(body_->GetPosition(), static_cast<float>(wrap_angle(angle)));
+  }
   const Twist wheels = chassis_->update(dt_s);
 
   // Odometry believes the wheels: integrate their twist at the mid-step heading.
@@ -119,7 +124,13 @@ void Vehicle::after_step(double dt_s) {
 }
 
 SonarReading Vehicle::sonar() {
-  return read_sonar(def_.sonar, pose(), *this, random_, def_.faults);
+  const Duration now = world_.time();
+  const Duration period{static_cast<std::int64_t>(def_.sonar.period_s * 1e9)};
+  if (!sonar_last_ || now - sonar_time_ >= period) {
+    sonar_last_ = read_sonar(def_.sonar, pose(), *this, random_, def_.faults);
+    sonar_time_ = now;
+  }
+  return *sonar_last_;
 }
 
 LineReading Vehicle::line_tracker() const {
@@ -155,6 +166,7 @@ void Vehicle::hash_state(StateHasher& hasher) const {
   hasher.add(rfid_reads_);
   hasher.add(tag_missed_);
   hasher.add(contacts_);
+  hasher.add(sonar_time_);
   Random copy = random_;  // the generator's next output stands for its state
   hasher.add(copy.next());
 }

@@ -65,6 +65,8 @@ class Vehicle : private RayCaster {
   AckermannChassis* ackermann() { return dynamic_cast<AckermannChassis*>(chassis_.get()); }
   DifferentialChassis* differential() { return dynamic_cast<DifferentialChassis*>(chassis_.get()); }
 
+  /// The latest echo: a new one when the sonar's period has passed since
+  /// the last, else the last again.
   SonarReading sonar();
   LineReading line_tracker() const;
   /// The tag under the reader now, unless this pass over it is being missed.
@@ -100,6 +102,8 @@ class Vehicle : private RayCaster {
   Battery battery_;
   Random random_;
   Odometry odometry_;
+  std::optional<SonarReading> sonar_last_;
+  Duration sonar_time_{};
   const RfidTag* tag_under_ = nullptr;
   bool tag_missed_ = false;
   std::uint64_t rfid_reads_ = 0;

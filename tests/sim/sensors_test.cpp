@@ -61,6 +61,7 @@ TEST(Sonar, NoiseIsSeededAndCentredOnTheTruth) {
   VehicleDef def = logi_car();
   def.start = Pose{1.0, 2.0, 0};
   def.sonar.noise_stddev_m = 0.02;
+  def.sonar.period_s = 0;  // a fresh echo on every read
   Vehicle& car = world.add_vehicle(def);
   double sum = 0;
   double sum2 = 0;
@@ -88,6 +89,7 @@ TEST(SensorFaults, SonarGlitchesAtTheirProbabilityWithTheirValue) {
   def.start = Pose{1.0, 2.0, 0};
   def.faults.sonar_glitch_probability = 0.2;
   def.faults.sonar_glitch_m = 0.0;
+  def.sonar.period_s = 0;
   Vehicle& car = world.add_vehicle(def);
   int glitches = 0;
   for (int i = 0; i < 5000; ++i) {
@@ -100,6 +102,22 @@ TEST(SensorFaults, SonarGlitchesAtTheirProbabilityWithTheirValue) {
     }
   }
   EXPECT_NEAR(glitches / 5000.0, 0.2, 0.02);
+}
+
+TEST(Sonar, ANewEchoComesOncePerPeriod) {
+  World world({open_field(4.0), 9});
+  VehicleDef def = logi_car();
+  def.start = Pose{1.0, 2.0, 0};
+  def.sonar.noise_stddev_m = 0.05;
+  Vehicle& car = world.add_vehicle(def);
+  const double first = car.sonar().distance_m;
+  EXPECT_EQ(car.sonar().distance_m, first);  // same instant: the same echo
+  world.advance_by(std::chrono::milliseconds(50));
+  EXPECT_EQ(car.sonar().distance_m, first);         // 50 ms < 60 ms
+  world.advance_by(std::chrono::milliseconds(10));  // the world is at step 7, 58.3 ms
+  EXPECT_EQ(car.sonar().distance_m, first);
+  world.advance_by(std::chrono::milliseconds(10));  // step 8, 66.7 ms
+  EXPECT_NE(car.sonar().distance_m, first);         // a new ping, new noise
 }
 
 TEST(LineTracker, MaskAndDeviationFollowTheTapeAcrossTheRow) {
