@@ -99,4 +99,7 @@ void register_leka(CommandSet& commands);
 /// Registers `hil proxy`.
 void register_proxy(CLI::App& app, std::function<int()>& run);
 
+/// Registers `hil world` (check, render, default).
+void register_world(CLI::App& app, std::function<int()>& run);
+
 }  // namespace hil::apps

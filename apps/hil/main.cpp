@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
       "  hil encode leka led.belt.single 0 255 0 0   2A 2B 2C 2D 05 15 00 FF 00 00 41\n"
       "  hil decode logi 'LOGI:SP:050:D7#'\n"
       "  hil decode leka --hex --file capture.hex --summary\n"
+      "  hil world check scenarios/worlds/*.yaml\n"
+      "  hil world render scenarios/worlds/corridor.yaml -o corridor.svg\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode =
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
   hil::apps::register_arduino(commands);
   hil::apps::register_leka(commands);
   hil::apps::register_proxy(app, run);
+  hil::apps::register_world(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&

@@ -180,6 +180,50 @@ TEST(HilCli, ProxyRejectsABadEndpointOrFaultFileAndSaysWhere) {
   EXPECT_THAT(missing.output, HasSubstr("--upstream is required"));
 }
 
+TEST(HilCli, WorldCheckReportsEachFileAndTheFirstErrorWithItsPosition) {
+  const auto good =
+      run_hil("world check scenarios/worlds/warehouse.yaml scenarios/worlds/corridor.yaml");
+  EXPECT_EQ(good.exit_code, 0);
+  EXPECT_THAT(good.output,
+              HasSubstr("warehouse.yaml: ok, 'warehouse', 4.00 x 3.00 m, 2 obstacle(s), "
+                        "1 tape(s) 7.71 m long, 2 tag(s): 001 002"));
+  EXPECT_THAT(good.output, HasSubstr("corridor.yaml: ok"));
+
+  const auto bad =
+      run_hil("world check scenarios/worlds/warehouse.yaml tests/apps/data/bad-world.yaml");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output, HasSubstr("warehouse.yaml: ok"));
+  EXPECT_THAT(bad.output, HasSubstr("bad-world.yaml:4:40: obstacles[0].circle.radius_m: expected a "
+                                    "positive number of metres, got '-0.2'"));
+
+  const auto missing = run_hil("world check no/such/world.yaml");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.output, HasSubstr("no/such/world.yaml"));
+}
+
+TEST(HilCli, WorldRenderDrawsTheBuiltInWarehouseAndWorldFiles) {
+  const auto builtin = run_hil("world render");
+  EXPECT_EQ(builtin.exit_code, 0);
+  EXPECT_THAT(builtin.output, HasSubstr("<svg"));
+  EXPECT_THAT(builtin.output, HasSubstr(">001<"));
+  EXPECT_THAT(builtin.output, HasSubstr("</svg>"));
+
+  const auto corridor = run_hil("world render scenarios/worlds/corridor.yaml --scale 100");
+  EXPECT_EQ(corridor.exit_code, 0);
+  EXPECT_THAT(corridor.output, HasSubstr("corridor"));
+
+  const auto bad = run_hil("world render tests/apps/data/bad-world.yaml");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output, HasSubstr("bad-world.yaml:4:40"));
+}
+
+TEST(HilCli, WorldDefaultPrintsAWorldFileThatChecksClean) {
+  const auto r = run_hil("world default");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_THAT(r.output, HasSubstr("name: warehouse"));
+  EXPECT_THAT(r.output, HasSubstr("id: \"002\""));
+}
+
 TEST(HilCli, HelpListsEveryProtocol) {
   const auto r = run_hil("--help");
   EXPECT_EQ(r.exit_code, 0);
