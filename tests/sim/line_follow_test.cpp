@@ -9,7 +9,12 @@
 #include <string>
 #include <vector>
 
+#include <cstdlib>
+#include <fstream>
+
 #include "sim/presets.hpp"
+#include "sim/recorder.hpp"
+#include "sim/svg.hpp"
 #include "tests/sim/sim_test_support.hpp"
 
 namespace hil::sim {
@@ -23,9 +28,16 @@ struct FollowRun {
   int contacts = 0;
 };
 
-FollowRun follow_to_002(VehicleDef def, double speed_mps, double gain_radps) {
+/// Follows the tape to station 002 while the Arduino robot, started below
+/// the pillar, drives into it; `recorder` gets both cars' runs.
+FollowRun follow_to_002(VehicleDef def, double speed_mps, double gain_radps,
+                        TrajectoryRecorder& recorder) {
   World world({default_warehouse_arena(), 5});
   Vehicle& car = world.add_vehicle(def);
+  VehicleDef robot = arduino_robot();
+  robot.start = Pose{0.3, 1.2, std::numbers::pi / 2};
+  Vehicle& other = world.add_vehicle(robot);
+  other.differential()->set_pwm(80, 80);
   const Tape& tape = world.arena().tapes.at(0);
   FollowRun run;
   int last_deviation = 0;
@@ -33,6 +45,7 @@ FollowRun follow_to_002(VehicleDef def, double speed_mps, double gain_radps) {
   // The controller runs every 10 ms on its own clock, as firmware would.
   for (int tick = 0; tick < 60 * 100; ++tick) {
     world.advance_to(std::chrono::milliseconds(10 * tick));
+    recorder.observe(world);
     const double now = to_seconds(world.time());
     const LineReading line = car.line_tracker();
     if (line.lost()) {
@@ -55,14 +68,20 @@ FollowRun follow_to_002(VehicleDef def, double speed_mps, double gain_radps) {
       }
     }
   }
-  world.advance_by(std::chrono::seconds(2));
-  run.contacts = static_cast<int>(world.take_contacts().size());
+  other.differential()->stop();
+  for (int tick = 0; tick < 200; ++tick) {
+    world.advance_by(std::chrono::milliseconds(10));
+    recorder.observe(world);
+  }
+  for (const auto& mark : recorder.trajectories().at(0).marks)
+    if (mark.kind == MarkKind::collision) ++run.contacts;
   EXPECT_NEAR(car.velocity().vx_mps, 0.0, 1e-6) << "the car should be at rest after stopping";
   return run;
 }
 
 TEST(LineFollow, TheLogiCarFollowsTheLoopFromStartPast001To002) {
-  const FollowRun run = follow_to_002(logi_car(), 0.25, 1.2);
+  TrajectoryRecorder recorder;
+  const FollowRun run = follow_to_002(logi_car(), 0.25, 1.2, recorder);
   EXPECT_EQ(run.stations, (std::vector<std::string>{"001", "002"}));
   // About 4.7 m of tape at 0.25 m/s, and slower in the bends.
   EXPECT_GT(run.seconds_to_002, 17.0);
@@ -70,6 +89,25 @@ TEST(LineFollow, TheLogiCarFollowsTheLoopFromStartPast001To002) {
   EXPECT_LT(run.worst_offset_m, 0.04);
   EXPECT_LT(run.longest_lost_s, 0.3);
   EXPECT_EQ(run.contacts, 0);
+
+  // The robot's run: into the pillar, and at rest against it.
+  const Trajectory& robot = recorder.trajectories().at(1);
+  ASSERT_GE(robot.marks.size(), 2u);
+  EXPECT_EQ(robot.marks[0].kind, MarkKind::collision);
+  EXPECT_EQ(robot.marks[0].label, "hit pillar");
+  EXPECT_EQ(robot.marks[1].kind, MarkKind::stop);
+
+  // The picture in docs/simulation.md: HIL_WRITE_IMAGES=docs/images writes it.
+  SvgOptions options;
+  options.title =
+      "Built-in warehouse: LOGI car following the tape to 002, Arduino robot into the pillar";
+  const std::string svg = render_svg(default_warehouse_arena(), recorder.trajectories(), options);
+  EXPECT_NE(svg.find("hit pillar"), std::string::npos);
+  if (const char* dir = std::getenv("HIL_WRITE_IMAGES"); dir != nullptr && *dir != '\0') {
+    std::ofstream file(std::string(dir) + "/warehouse-run.svg", std::ios::binary);
+    file << svg;
+    ASSERT_TRUE(file.good());
+  }
 }
 
 TEST(LineFollow, AMissedRfidReadCarriesTheCarPastTheStation) {

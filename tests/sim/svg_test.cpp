@@ -2,7 +2,7 @@
 // part of the arena once, with y up, escaped names and the same bytes each time.
 //
 // With HIL_WRITE_IMAGES=<dir> set, the example run of the built-in warehouse
-// is also written to <dir>/warehouse.svg (the picture in docs/images).
+// is also written to <dir>/warehouse.svg, to look at every kind of mark.
 
 #include "sim/svg.hpp"
 
