@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Sets up this machine (Debian 12), builds hil, and runs its main job.
 # Today the main job decodes the recorded wire captures in scenarios/captures/
-# with the protocol calculator, printing every frame and every error; it
-# grows into the scenario suite as the harness does.
+# with the protocol calculator, printing every frame and every error, checks
+# every world file in scenarios/worlds/ and draws each (and the built-in
+# warehouse) to build/worlds/*.svg; it grows into the scenario suite as the
+# harness does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,5 +27,13 @@ for capture in scenarios/captures/*.txt scenarios/captures/*.hex; do
     echo "hil exited with $rc on $capture"
     status=1
   fi
+done
+
+echo "== worlds"
+if ! "$hil" world check scenarios/worlds/*.yaml; then status=1; fi
+mkdir -p build/worlds
+"$hil" world render -o build/worlds/builtin-warehouse.svg || status=1
+for world in scenarios/worlds/*.yaml; do
+  "$hil" world render "$world" -o "build/worlds/$(basename "$world" .yaml).svg" || status=1
 done
 exit "$status"
