@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/hil_flags.hpp"
+
 namespace {
 
 struct Best {
@@ -100,27 +102,13 @@ class RecordingReporter : public benchmark::ConsoleReporter {
 void hil_register_benchmarks();
 
 int main(int argc, char** argv) {
-  double max_ratio = 0;
-  std::string markdown;
-  std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.starts_with("--hil_max_bytewise_ratio=")) {
-      max_ratio = std::atof(arg.c_str() + std::strlen("--hil_max_bytewise_ratio="));
-    } else if (arg.starts_with("--hil_markdown=")) {
-      markdown = arg.substr(std::strlen("--hil_markdown="));
-    } else {
-      args.push_back(argv[i]);
-    }
-  }
-  int n = static_cast<int>(args.size());
+  auto flags = hil::bench::take_hil_flags(argc, argv);
+  const double max_ratio = flags.number("max_bytewise_ratio");
   hil_register_benchmarks();
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
   RecordingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
-  benchmark::Shutdown();
-  if (!markdown.empty()) reporter.write_markdown(markdown);
+  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
+  if (const auto markdown = flags.text("markdown"); !markdown.empty())
+    reporter.write_markdown(markdown);
   if (max_ratio > 0 && !reporter.check(max_ratio)) return 1;
   return 0;
 }

@@ -34,6 +34,7 @@
 #include <variant>
 #include <vector>
 
+#include "bench/hil_flags.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 
@@ -292,37 +293,15 @@ class RecordingReporter : public benchmark::ConsoleReporter {
   bool failed_ = false;
 };
 
-double flag_value(const std::string& arg, const char* prefix) {
-  return std::atof(arg.c_str() + std::strlen(prefix));
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  double min_ratio = 0;
-  double min_realtime = 0;
-  std::string markdown;
-  std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.starts_with("--hil_min_ratio=")) {
-      min_ratio = flag_value(arg, "--hil_min_ratio=");
-    } else if (arg.starts_with("--hil_min_realtime=")) {
-      min_realtime = flag_value(arg, "--hil_min_realtime=");
-    } else if (arg.starts_with("--hil_markdown=")) {
-      markdown = arg.substr(std::strlen("--hil_markdown="));
-    } else {
-      args.push_back(argv[i]);
-    }
-  }
-  int n = static_cast<int>(args.size());
+  auto flags = hil::bench::take_hil_flags(argc, argv);
   register_all();
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 2;
   RecordingReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
-  benchmark::Shutdown();
-  if (!markdown.empty()) reporter.write_markdown(markdown);
-  if (!reporter.check(min_ratio, min_realtime)) return 1;
+  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
+  if (const auto markdown = flags.text("markdown"); !markdown.empty())
+    reporter.write_markdown(markdown);
+  if (!reporter.check(flags.number("min_ratio"), flags.number("min_realtime"))) return 1;
   return 0;
 }
