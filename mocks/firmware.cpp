@@ -1,0 +1,128 @@
+#include "mocks/firmware.hpp"
+
+#include <algorithm>
+
+#include "protocol/common/overloaded.hpp"
+
+namespace hil::mocks {
+
+Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), vehicle_(vehicle) {}
+
+Firmware::~Firmware() = default;
+
+void Firmware::advance(Time now) {
+  world_.advance_to(now);
+  run_actions(now, script_.take_due(now));
+}
+
+void Firmware::connect(Time now) {
+  advance(now);
+  connected_ = true;
+  ++stats_.connections;
+  output_.clear();
+  close_.reset();
+  on_connect(now);
+  on_tick(now);
+}
+
+void Firmware::disconnect(Time now) {
+  advance(now);
+  if (!connected_) return;
+  connected_ = false;
+  output_.clear();
+  close_.reset();
+  on_disconnect(now);
+  on_tick(now);
+}
+
+void Firmware::receive(Time now, ByteView bytes) {
+  advance(now);
+  stats_.bytes_in += bytes.size();
+  on_bytes(now, bytes);
+  on_tick(now);
+}
+
+void Firmware::wake(Time now) {
+  advance(now);
+  on_tick(now);
+}
+
+std::optional<Time> Firmware::next_wakeup() const {
+  std::optional<Time> next = next_tick();
+  if (const auto due = script_.next_due(); due && (!next || *due < *next)) next = due;
+  if (muted_until_ && (!next || *muted_until_ < *next)) next = muted_until_;
+  return next;
+}
+
+void Firmware::arm(Behaviour behaviour) {
+  script_.arm(std::move(behaviour));
+  if (wakeup_changed_) wakeup_changed_();
+}
+
+void Firmware::clear_behaviours() {
+  script_.clear();
+  if (wakeup_changed_) wakeup_changed_();
+}
+
+Bytes Firmware::take_output() {
+  Bytes out;
+  out.swap(output_);
+  return out;
+}
+
+std::optional<link::CloseMode> Firmware::take_close() {
+  auto mode = close_;
+  close_.reset();
+  return mode;
+}
+
+void Firmware::send(ByteView frame) {
+  if (!connected_) return;
+  output_.insert(output_.end(), frame.begin(), frame.end());
+  stats_.bytes_out += frame.size();
+  ++stats_.frames_out;
+}
+
+void Firmware::send(std::string_view frame) {
+  send(ByteView(reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()));
+}
+
+Disposition Firmware::dispose(Time now, std::string_view kind) {
+  const Disposition d = script_.dispose(now, kind);
+  if (d == Disposition::reject) ++stats_.rejected;
+  if (d == Disposition::ignore) ++stats_.ignored;
+  return d;
+}
+
+void Firmware::frame_handled(Time now, std::string_view kind) {
+  run_actions(now, script_.frame_handled(now, kind));
+}
+
+void Firmware::enter_fault(Time now, bool entered) {
+  if (fault_ == entered) return;
+  fault_ = entered;
+  on_fault(now, entered);
+}
+
+void Firmware::run_actions(Time now, const std::vector<Behaviour>& fired) {
+  for (const Behaviour& b : fired) {
+    std::visit(protocol::Overloaded{
+                   [](const Reject&) {},  // active in the script
+                   [](const Ignore&) {},
+                   [&](const MuteTelemetry& m) {
+                     const Time until = now + m.duration;
+                     if (!muted_until_ || until > *muted_until_) muted_until_ = until;
+                   },
+                   [&](const SendBytes& s) { send(ByteView(s.bytes)); },
+                   [&](const EnterFault&) { enter_fault(now, true); },
+                   [&](const ClearFault&) { enter_fault(now, false); },
+                   [&](const CloseConnection& c) {
+                     if (connected_) close_ = c.mode;
+                   },
+               },
+               b.action);
+  }
+  if (muted_until_ && now >= *muted_until_) muted_until_.reset();
+}
+
+}  // namespace hil::mocks

@@ -1,0 +1,138 @@
+#pragma once
+// A mock firmware: a sans-I/O state machine that takes the client's bytes
+// and the time, drives one simulated vehicle, and hands back the bytes to
+// send and the next time it wants to run. The same object runs under the
+// virtual-time driver and the real-time driver (mocks/server.hpp).
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "link/byte_pipe.hpp"
+#include "link/time.hpp"
+#include "mocks/behaviour.hpp"
+#include "protocol/common/bytes.hpp"
+#include "sim/vehicle.hpp"
+#include "sim/world.hpp"
+
+namespace hil::mocks {
+
+using protocol::Bytes;
+using protocol::ByteView;
+
+struct FirmwareStats {
+  std::uint64_t connections = 0;  ///< clients served so far
+  std::uint64_t bytes_in = 0;
+  std::uint64_t bytes_out = 0;
+  std::uint64_t frames_in = 0;   ///< client frames that decoded
+  std::uint64_t frames_out = 0;  ///< frames sent (answers, telemetry, scripted)
+  std::uint64_t bad_frames = 0;  ///< checksum errors, garbage, malformed or oversized input
+  std::uint64_t rejected = 0;    ///< commands a behaviour made the car refuse
+  std::uint64_t ignored = 0;     ///< commands a behaviour swallowed
+};
+
+class Firmware {
+ public:
+  /// The vehicle must live in `world`; both must outlive the firmware.
+  Firmware(sim::World& world, sim::Vehicle& vehicle);
+  virtual ~Firmware();
+  Firmware(const Firmware&) = delete;
+  Firmware& operator=(const Firmware&) = delete;
+
+  /// "logi", "wr8", "arduino" or "leka".
+  virtual std::string_view protocol() const = 0;
+
+  // ---- driver side: every call first advances the world to `now` ----
+
+  /// A client connected (TCP accept, the serial port opened).
+  void connect(Time now);
+  /// The client went away (or the driver closed it).
+  void disconnect(Time now);
+  /// Bytes from the client, in whatever pieces they arrived.
+  void receive(Time now, ByteView bytes);
+  /// The time asked for by next_wakeup() has come (or passed).
+  void wake(Time now);
+  /// When the firmware next wants wake(); nullopt: only on input.
+  std::optional<Time> next_wakeup() const;
+
+  /// Bytes to send to the client since the last call.
+  Bytes take_output();
+  /// Set when the firmware (or a behaviour) wants the connection closed;
+  /// the driver closes it after sending what take_output() returned.
+  std::optional<link::CloseMode> take_close();
+
+  // ---- harness side ----
+
+  /// Arms a scripted behaviour; a timed one fires on time (the driver is
+  /// told that the next wakeup may have moved).
+  void arm(Behaviour behaviour);
+  void clear_behaviours();
+  /// Called when next_wakeup() may have changed outside a driver call (a
+  /// behaviour armed by the harness); the server reschedules on it.
+  void set_wakeup_changed(std::function<void()> callback) { wakeup_changed_ = std::move(callback); }
+  const Script& script() const { return script_; }
+
+  bool connected() const { return connected_; }
+  bool in_fault() const { return fault_; }
+  const FirmwareStats& stats() const { return stats_; }
+  sim::World& world() { return world_; }
+  sim::Vehicle& vehicle() { return vehicle_; }
+  const sim::Vehicle& vehicle() const { return vehicle_; }
+
+  /// A short state summary for the terminal status line, e.g. "MAN FWD SP 50".
+  virtual std::string summary() const = 0;
+
+ protected:
+  // ---- what each firmware implements ----
+  virtual void on_connect(Time /*now*/) {}
+  virtual void on_disconnect(Time /*now*/) {}
+  /// Decode and handle client bytes. For each command, call dispose() with
+  /// its kind first and frame_handled() after.
+  virtual void on_bytes(Time now, ByteView bytes) = 0;
+  /// Control loop and telemetry; called on every wake and after input.
+  virtual void on_tick(Time now) = 0;
+  /// The firmware's own next wakeup (control loop, telemetry, a move ending).
+  virtual std::optional<Time> next_tick() const = 0;
+  /// Entering (true) or leaving (false) the fault state: stop the motors,
+  /// show the state where the protocol can.
+  virtual void on_fault(Time /*now*/, bool /*entered*/) {}
+
+  // ---- helpers for firmwares ----
+
+  /// Queues one frame for the client (counts it).
+  void send(ByteView frame);
+  void send(std::string_view frame);
+  /// What the armed behaviours say about a command of `kind`; counts
+  /// rejects and ignores.
+  Disposition dispose(Time now, std::string_view kind);
+  /// A client frame of `kind` was handled (fires after-frame behaviours).
+  void frame_handled(Time now, std::string_view kind);
+  /// A client frame (or run of bytes) was bad and dropped or refused.
+  void count_bad_frame() { ++stats_.bad_frames; }
+  void count_frame_in() { ++stats_.frames_in; }
+  /// Whether periodic telemetry is muted by a behaviour at `now`.
+  bool telemetry_muted(Time now) const { return muted_until_ && now < *muted_until_; }
+  /// Asks the driver to close the client's connection.
+  void request_close(link::CloseMode mode = link::CloseMode::graceful) { close_ = mode; }
+
+  sim::World& world_;
+  sim::Vehicle& vehicle_;
+
+ private:
+  void advance(Time now);
+  void run_actions(Time now, const std::vector<Behaviour>& fired);
+  void enter_fault(Time now, bool entered);
+
+  Script script_;
+  std::function<void()> wakeup_changed_;
+  FirmwareStats stats_;
+  Bytes output_;
+  std::optional<link::CloseMode> close_;
+  std::optional<Time> muted_until_;
+  bool connected_ = false;
+  bool fault_ = false;
+};
+
+}  // namespace hil::mocks

@@ -1,0 +1,183 @@
+#include "mocks/server.hpp"
+
+#include "link/capture/wire_log.hpp"
+#include "link/mem_pipe.hpp"
+
+namespace hil::mocks {
+namespace {
+
+// Tells a person about the faults injected on a client's link.
+class FaultLogger final : public link::LinkObserver {
+ public:
+  FaultLogger(std::string id, std::function<void(const std::string&)> log)
+      : id_(std::move(id)), log_(std::move(log)) {}
+  void on_fault(const link::FaultEvent& e) override {
+    log_(id_ + " " + link::format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " +
+         std::string(link::to_string(e.direction)) + "): " + e.detail);
+  }
+
+ private:
+  std::string id_;
+  std::function<void(const std::string&)> log_;
+};
+
+}  // namespace
+
+MockServer::MockServer(link::TransportContext& context, Firmware& firmware, ServerOptions options)
+    : context_(context), firmware_(firmware), options_(std::move(options)) {
+  if (!options_.protocol) options_.protocol = link::protocol_adapter(firmware_.protocol());
+  gate_ = std::make_unique<link::FaultInjector>(
+      link::Direction::to_car, options_.protocol,
+      link::for_direction(options_.faults, link::Direction::to_car), options_.seed);
+}
+
+MockServer::~MockServer() {
+  close();
+  firmware_.set_wakeup_changed({});
+  *alive_ = false;
+}
+
+void MockServer::say(const std::string& line) const {
+  if (options_.log) options_.log(line);
+}
+
+void MockServer::start() {
+  listener_ = link::listen(context_, options_.listen);
+  running_ = true;
+  std::weak_ptr<bool> alive_for_arm = alive_;
+  firmware_.set_wakeup_changed([this, alive_for_arm] {
+    if (const auto a = alive_for_arm.lock(); a && *a) reschedule();
+  });
+  std::weak_ptr<bool> alive = alive_;
+  listener_->start([this, alive](link::BytePipePtr client) {
+    if (const auto a = alive.lock(); a && *a) on_accept(std::move(client));
+  });
+  // The car lives before anyone connects: its control loop runs from now.
+  firmware_.wake(context_.executor.now());
+  flush();
+}
+
+std::string MockServer::address() const {
+  return listener_ ? listener_->address() : link::to_uri(options_.listen);
+}
+
+bool MockServer::client_connected() const {
+  return link_ && link_->is_open();
+}
+
+std::uint64_t MockServer::faults_injected() const {
+  return past_faults_ + (link_ ? link_->stats().faults : 0) + gate_refusals_;
+}
+
+void MockServer::on_accept(link::BytePipePtr client) {
+  if (!running_) {
+    client->close(link::CloseMode::reset);
+    return;
+  }
+  const auto now = context_.executor.now();
+  ++accepted_;
+  if (gate_->refuse_connection(now)) {
+    ++turned_away_;
+    ++gate_refusals_;
+    say(options_.name + " refused a connection (fault rule): " + client->describe());
+    client->close(link::CloseMode::reset);
+    return;
+  }
+  if (client_connected()) {
+    // The firmware serves one client: a second connection is accepted and
+    // closed at once, and the first keeps its session.
+    ++turned_away_;
+    say(options_.name + " turned away a second client (one at a time): " + client->describe());
+    client->close(link::CloseMode::graceful);
+    return;
+  }
+  if (link_) past_faults_ += link_->stats().faults;
+  const std::uint64_t number = ++served_;
+  const std::string id = options_.name + "/link" + std::to_string(number);
+
+  link::LinkOptions link_options;
+  link_options.protocol = options_.protocol;
+  link_options.to_car = link::for_direction(options_.faults, link::Direction::to_car);
+  link_options.to_client = link::for_direction(options_.faults, link::Direction::to_client);
+  link_options.seed = options_.seed + number - 1;
+  link_options.observers = options_.observers;
+  if (options_.log)
+    link_options.observers.push_back(std::make_shared<FaultLogger>(id, options_.log));
+  if (!options_.wire_log_path.empty()) {
+    std::error_code ec;
+    auto log = link::WireLog::open(options_.wire_log_path,
+                                   link::WireLogOptions{id, options_.protocol, {}}, ec);
+    if (log)
+      link_options.observers.push_back(log);
+    else
+      say(id + " cannot write the wire log " + options_.wire_log_path + ": " + ec.message());
+  }
+
+  say(id + " client connected: " + client->describe());
+  auto [car_end, firmware_end] = link::make_mem_pipe(context_.executor, id);
+  firmware_end_ = firmware_end;
+  std::weak_ptr<bool> alive = alive_;
+  std::weak_ptr<link::BytePipe> weak_end = firmware_end;
+  firmware_end->start(link::BytePipe::Handlers{
+      [this, alive](link::ByteView bytes) {
+        if (const auto a = alive.lock(); !a || !*a) return;
+        firmware_.receive(context_.executor.now(), bytes);
+        flush();
+      },
+      [this, alive, weak_end, id](std::error_code ec) {
+        if (const auto a = alive.lock(); !a || !*a) return;
+        if (weak_end.lock() != firmware_end_) return;  // an older session
+        firmware_end_.reset();
+        firmware_.disconnect(context_.executor.now());
+        say(id + " client gone" +
+            (ec == link::end_of_stream() || ec == link::closed_here() ? std::string()
+                                                                      : ": " + ec.message()));
+        flush();
+      }});
+  link_ = link::Link::create(context_.executor, std::move(client), std::move(car_end),
+                             std::move(link_options));
+  link_->start();
+  firmware_.connect(now);
+  flush();
+}
+
+void MockServer::flush() {
+  Bytes out = firmware_.take_output();
+  if (!out.empty() && firmware_end_) firmware_end_->write(out);
+  if (const auto mode = firmware_.take_close(); mode && firmware_end_) {
+    say(options_.name + " firmware closes the connection" +
+        (*mode == link::CloseMode::reset ? " (reset)" : ""));
+    auto end = firmware_end_;
+    end->close(*mode);
+  }
+  reschedule();
+}
+
+void MockServer::reschedule() {
+  const std::optional<Time> next = running_ ? firmware_.next_wakeup() : std::nullopt;
+  if (next == timer_due_ && (timer_ != 0 || !next)) return;
+  if (timer_ != 0) context_.executor.cancel(timer_);
+  timer_ = 0;
+  timer_due_ = next;
+  if (!next) return;
+  std::weak_ptr<bool> alive = alive_;
+  timer_ = context_.executor.call_at(*next, [this, alive] {
+    if (const auto a = alive.lock(); !a || !*a) return;
+    timer_ = 0;
+    timer_due_.reset();
+    firmware_.wake(context_.executor.now());
+    flush();
+  });
+}
+
+void MockServer::close() {
+  if (!running_) return;
+  running_ = false;
+  if (listener_) listener_->close();
+  if (link_) link_->close();
+  if (timer_ != 0) context_.executor.cancel(timer_);
+  timer_ = 0;
+  timer_due_.reset();
+}
+
+}  // namespace hil::mocks
