@@ -1,0 +1,201 @@
+// The WR8 mock firmware behind a MockServer on real TCP (127.0.0.1, a free
+// port) under the real-time driver: a GUI authenticates, drives 100 cm and
+// watches DATA; a wrong string gets the connection closed. Waits are bounded
+// and generous; nothing asserts how fast the machine is.
+
+#include <gtest/gtest.h>
+
+#include <asio/io_context.hpp>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <system_error>
+#include <vector>
+
+#include "link/asio_executor.hpp"
+#include "link/endpoint.hpp"
+#include "link/transport.hpp"
+#include "mocks/server.hpp"
+#include "mocks/wr8.hpp"
+#include "protocol/wr8/codec.hpp"
+#include "sim/presets.hpp"
+#include "sim/world.hpp"
+#include "tests/link/transports/real_time.hpp"
+
+namespace hil::mocks {
+namespace {
+
+namespace wr8 = protocol::wr8;
+using std::chrono::seconds;
+
+/// A WR8 car listening on tcp://127.0.0.1:0 and a GUI connected to it over
+/// a real socket, decoding what the car sends.
+class TcpCar {
+ public:
+  explicit TcpCar(Wr8Config config = {})
+      : config_(config),
+        vehicle_(world_.add_vehicle(sim::wr8_vehicle())),
+        firmware_(world_, vehicle_, config),
+        server_(context_, firmware_, server_options()) {
+    server_.start();
+    link::connect(context_, link::parse_endpoint(server_.address()),
+                  [this](std::error_code ec, link::BytePipePtr pipe) {
+                    if (ec) {
+                      closed_ = ec;
+                      return;
+                    }
+                    pipe_ = pipe;
+                    pipe_->start({[this](protocol::ByteView b) { on_data(b); },
+                                  [this](std::error_code why) { closed_ = why; }});
+                  });
+    EXPECT_TRUE(link::test::run_until(io_, [&] { return pipe_ || closed_; }));
+    EXPECT_TRUE(pipe_) << "could not connect to " << server_.address();
+    EXPECT_TRUE(link::test::run_until(io_, [&] { return firmware_.connected(); }));
+  }
+
+  ~TcpCar() {
+    if (pipe_) pipe_->close();
+    server_.close();
+    link::test::run_for(io_, std::chrono::milliseconds(20));
+  }
+
+  void send(const wr8::Message& m) {
+    if (pipe_) pipe_->write(wr8::encode(m, config_.profile));
+  }
+
+  bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = seconds(10)) {
+    return link::test::run_until(io_, done, limit);
+  }
+  void run_for(std::chrono::milliseconds d) { link::test::run_for(io_, d); }
+
+  /// The first response with this COI and code, if it has come.
+  std::optional<std::size_t> response_index(std::uint8_t coi, wr8::ResponseCode code) const {
+    for (std::size_t n = 0; n < received_.size(); ++n) {
+      const auto* r = std::get_if<wr8::Response>(&received_[n]);
+      if (r != nullptr && r->coi == coi && r->code == code) return n;
+    }
+    return std::nullopt;
+  }
+  template <class T>
+  std::vector<T> all() const {
+    std::vector<T> out;
+    for (const auto& m : received_) {
+      if (const auto* t = std::get_if<T>(&m)) out.push_back(*t);
+    }
+    return out;
+  }
+
+  const std::vector<wr8::Message>& received() const { return received_; }
+  std::size_t decode_errors() const { return decode_errors_; }
+  const std::optional<std::error_code>& closed() const { return closed_; }
+  Wr8Firmware& firmware() { return firmware_; }
+  sim::Vehicle& vehicle() { return vehicle_; }
+  const Wr8Config& config() const { return config_; }
+
+ private:
+  static ServerOptions server_options() {
+    ServerOptions options;
+    options.listen = link::TcpEndpoint{"127.0.0.1", 0};
+    options.name = "wr8";
+    return options;
+  }
+
+  void on_data(protocol::ByteView bytes) {
+    std::vector<wr8::Item> items;
+    decoder_.feed(bytes, items);
+    for (auto& item : items) {
+      if (auto* f = std::get_if<protocol::Frame<wr8::Message>>(&item)) {
+        received_.push_back(std::move(f->message));
+      } else {
+        ++decode_errors_;
+      }
+    }
+  }
+
+  Wr8Config config_;
+  asio::io_context io_;
+  link::AsioExecutor executor_{io_};
+  link::TransportContext context_{executor_, &io_};
+  sim::World world_{sim::WorldDef{}};
+  sim::Vehicle& vehicle_;
+  Wr8Firmware firmware_;
+  MockServer server_;
+  link::BytePipePtr pipe_;
+  std::optional<std::error_code> closed_;
+  wr8::Decoder decoder_{wr8::DecoderOptions{config_.profile, wr8::Sender::vehicle, 0}};
+  std::vector<wr8::Message> received_;
+  std::size_t decode_errors_ = 0;
+};
+
+double odometry_cm(const wr8::Data& d) {
+  for (const auto& v : d.values) {
+    if (v.code == wr8::data_code::odometry) return v.value.as_i32();
+  }
+  return -1;
+}
+
+TEST(Wr8OverTcp, AuthenticatesAndDrives100Cm) {
+  TcpCar car;
+  car.send(wr8::Auth{car.config().profile.auth_text});
+  ASSERT_TRUE(car.wait_for([&] { return !car.all<wr8::AuthReply>().empty(); }));
+  EXPECT_EQ(car.all<wr8::AuthReply>().front(), (wr8::AuthReply{8, 1, wr8::State::stop}));
+
+  car.send(wr8::Task{1, wr8::TaskCode::drive, {wr8::Word::from_i32(100)}});
+  ASSERT_TRUE(
+      car.wait_for([&] { return car.response_index(1, wr8::ResponseCode::started).has_value(); }));
+  // About 3.3 s of driving; the limit leaves room for a slow machine.
+  ASSERT_TRUE(
+      car.wait_for([&] { return car.response_index(1, wr8::ResponseCode::completed).has_value(); },
+                   seconds(30)));
+  EXPECT_LT(*car.response_index(1, wr8::ResponseCode::started),
+            *car.response_index(1, wr8::ResponseCode::completed));
+  EXPECT_FALSE(car.response_index(1, wr8::ResponseCode::error).has_value());
+  EXPECT_GE(car.vehicle().odometry().distance_m, 1.0);
+
+  // The DATA after the answer reports the distance (and STOP).
+  const std::size_t done_at = *car.response_index(1, wr8::ResponseCode::completed);
+  std::optional<wr8::Data> after;
+  ASSERT_TRUE(car.wait_for([&] {
+    for (std::size_t n = done_at + 1; n < car.received().size(); ++n) {
+      if (const auto* d = std::get_if<wr8::Data>(&car.received()[n])) {
+        after = *d;
+        return true;
+      }
+    }
+    return false;
+  }));
+  EXPECT_GE(odometry_cm(*after), 100);
+  EXPECT_EQ(after->state, wr8::State::stop);
+  EXPECT_EQ(car.decode_errors(), 0u);
+}
+
+TEST(Wr8OverTcp, DataArrivesAtAboutTenHertz) {
+  TcpCar car;
+  car.send(wr8::Auth{car.config().profile.auth_text});
+  ASSERT_TRUE(car.wait_for([&] { return !car.all<wr8::AuthReply>().empty(); }));
+  car.run_for(std::chrono::milliseconds(2000));
+  const auto data = car.all<wr8::Data>();
+  EXPECT_GE(data.size(), 5u);
+  // Timestamps (when each DATA went out) go forward.
+  for (std::size_t n = 0; n < data.size(); ++n) {
+    if (n > 0) {
+      EXPECT_GT(data[n].timestamp_ms, data[n - 1].timestamp_ms);
+    }
+    EXPECT_EQ(data[n].state, wr8::State::stop);
+  }
+  EXPECT_EQ(car.decode_errors(), 0u);
+}
+
+TEST(Wr8OverTcp, AWrongStringClosesTheConnection) {
+  TcpCar car;
+  car.send(wr8::Auth{});  // ten zero bytes
+  ASSERT_TRUE(car.wait_for([&] { return car.closed().has_value(); }));
+  EXPECT_EQ(*car.closed(), link::end_of_stream());
+  EXPECT_TRUE(car.received().empty());
+  EXPECT_EQ(car.firmware().state().auth_failures, 1u);
+  EXPECT_TRUE(car.wait_for([&] { return !car.firmware().connected(); }));
+}
+
+}  // namespace
+}  // namespace hil::mocks
