@@ -76,8 +76,8 @@ class DecoderSplitter final : public FrameSplitter {
 
 template <class Message, class Decoder, class Describe>
 std::unique_ptr<FrameSplitter> make_splitter(Decoder decoder, Describe describe, bool with_text) {
-  return std::make_unique<DecoderSplitter<Decoder, Message, Describe>>(std::move(decoder),
-                                                                       std::move(describe), with_text);
+  return std::make_unique<DecoderSplitter<Decoder, Message, Describe>>(
+      std::move(decoder), std::move(describe), with_text);
 }
 
 using KindAndText = std::pair<std::string, std::string>;
@@ -127,9 +127,12 @@ class LogiAdapter final : public ProtocolAdapter {
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace logi = protocol::logi;
-    return make_splitter<logi::Message>(logi::Decoder{}, [](const logi::Message& m, bool text) {
-      return KindAndText{kind_of(m), text ? logi::describe(m) : std::string()};
-    }, with_text);
+    return make_splitter<logi::Message>(
+        logi::Decoder{},
+        [](const logi::Message& m, bool text) {
+          return KindAndText{kind_of(m), text ? logi::describe(m) : std::string()};
+        },
+        with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {
@@ -189,9 +192,13 @@ class ArduinoAdapter final : public ProtocolAdapter {
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace arduino = protocol::arduino;
-    return make_splitter<arduino::Message>(arduino::Decoder{}, [](const arduino::Message& m, bool text) {
-      return KindAndText{std::string(arduino::command_of(m.body)), text ? arduino::describe(m) : std::string()};
-    }, with_text);
+    return make_splitter<arduino::Message>(
+        arduino::Decoder{},
+        [](const arduino::Message& m, bool text) {
+          return KindAndText{std::string(arduino::command_of(m.body)),
+                             text ? arduino::describe(m) : std::string()};
+        },
+        with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {
@@ -238,11 +245,14 @@ class Wr8Adapter final : public ProtocolAdapter {
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace wr8 = protocol::wr8;
-    return make_splitter<wr8::Message>(wr8::Decoder{}, [](const wr8::Message& m, bool text) {
-      std::string kind(wr8::to_string(wr8::code_of(m)));
-      std::replace(kind.begin(), kind.end(), '-', '_');  // AUTH-REPLY -> AUTH_REPLY
-      return KindAndText{std::move(kind), text ? wr8::describe(m) : std::string()};
-    }, with_text);
+    return make_splitter<wr8::Message>(
+        wr8::Decoder{},
+        [](const wr8::Message& m, bool text) {
+          std::string kind(wr8::to_string(wr8::code_of(m)));
+          std::replace(kind.begin(), kind.end(), '-', '_');  // AUTH-REPLY -> AUTH_REPLY
+          return KindAndText{std::move(kind), text ? wr8::describe(m) : std::string()};
+        },
+        with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
@@ -271,17 +281,66 @@ class Wr8Adapter final : public ProtocolAdapter {
 // ---------------------------------------------------------------- Leka
 // 2A 2B 2C 2D, length, command group, checksum
 
+// The robot's side of a Leka link: the only thing a robot sends is a text
+// line (the answer to `info`), so that direction is cut at line ends. A run
+// of kLineBound bytes with no line end is handed on as an invalid frame.
+class LineSplitter final : public FrameSplitter {
+ public:
+  static constexpr std::size_t kLineBound = protocol::leka::kMaxFrameBytes;
+  explicit LineSplitter(bool with_text) : with_text_(with_text) {}
+
+  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
+    for (const auto b : bytes) {
+      buf_.push_back(b);
+      if (b == '\n') {
+        emit(true, "reply", out);
+      } else if (buf_.size() >= kLineBound) {
+        emit(false, "oversized: no line end in " + std::to_string(kLineBound) + " bytes", out);
+      }
+    }
+  }
+  void finish(std::vector<WireFrame>& out) override {
+    if (!buf_.empty()) emit(false, "truncated: the stream ended inside a line", out);
+  }
+  std::size_t buffered() const override { return buf_.size(); }
+
+ private:
+  void emit(bool valid, std::string what, std::vector<WireFrame>& out) {
+    WireFrame frame;
+    frame.valid = valid;
+    frame.kind = valid ? "reply" : "";
+    if (with_text_ || !valid) {
+      frame.text = valid ? "reply \"" + protocol::escape(buf_) + "\"" : std::move(what);
+    }
+    frame.raw = std::move(buf_);
+    buf_.clear();
+    out.push_back(std::move(frame));
+  }
+
+  bool with_text_;
+  protocol::Bytes buf_;
+};
+
 class LekaAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "leka"; }
 
+  std::unique_ptr<FrameSplitter> splitter_for(Direction direction, bool with_text) const override {
+    if (direction == Direction::to_client) return std::make_unique<LineSplitter>(with_text);
+    return splitter(with_text);
+  }
+
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace leka = protocol::leka;
-    return make_splitter<leka::Message>(leka::Decoder{}, [](const leka::Message& m, bool text) {
-      std::string kind =
-          m.commands.empty() ? std::string{} : std::string(leka::spec_of(m.commands.front()).name);
-      return KindAndText{std::move(kind), text ? leka::describe(m) : std::string()};
-    }, with_text);
+    return make_splitter<leka::Message>(
+        leka::Decoder{},
+        [](const leka::Message& m, bool text) {
+          std::string kind = m.commands.empty()
+                                 ? std::string{}
+                                 : std::string(leka::spec_of(m.commands.front()).name);
+          return KindAndText{std::move(kind), text ? leka::describe(m) : std::string()};
+        },
+        with_text);
   }
 
   std::optional<ByteRange> checksum_field(ByteView frame) const override {

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "link/faults/profile.hpp"
 #include "protocol/common/bytes.hpp"
 
 namespace hil::link {
@@ -49,6 +50,13 @@ class ProtocolAdapter {
   /// fault injector needs kinds, not descriptions, and skipping them is most
   /// of the cost of splitting a fast stream.
   virtual std::unique_ptr<FrameSplitter> splitter(bool with_text = true) const = 0;
+  /// The splitter for one direction of a link. Most protocols frame both
+  /// directions alike; Leka's robot answers in text lines, not command frames.
+  virtual std::unique_ptr<FrameSplitter> splitter_for(Direction direction,
+                                                      bool with_text = true) const {
+    (void)direction;
+    return splitter(with_text);
+  }
   /// Where the checksum is written in a frame; nullopt when the protocol has
   /// none (WR8, raw) or the frame is not one.
   virtual std::optional<ByteRange> checksum_field(protocol::ByteView frame) const = 0;

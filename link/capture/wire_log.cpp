@@ -91,8 +91,8 @@ WireLog::WireLog(std::filesystem::path path, int fd, WireLogOptions options)
   if (!options_.wall_clock_us) options_.wall_clock_us = [] { return wall_time_us(); };
   if (options_.protocol) {
     for (auto& kind : splitters_) {
-      for (auto& s : kind)
-        s = options_.protocol->splitter();
+      for (const auto d : {Direction::to_car, Direction::to_client})
+        kind[index_of(d)] = options_.protocol->splitter_for(d);
     }
   }
 }

@@ -60,7 +60,7 @@ struct FaultInjector::State {
         seed(s),
         sink(std::move(k)),
         rng(s ^ kDirectionSalt[static_cast<std::size_t>(d)]),
-        splitter(protocol->splitter(false)),
+        splitter(protocol->splitter_for(d, false)),
         text_protocol(protocol->name() == "logi" || protocol->name() == "arduino") {}
 
   struct RuleState {

@@ -100,9 +100,6 @@ struct LekaOverPty : ::testing::Test {
     ServerOptions options;
     options.listen = link::PtyEndpoint{path, 115200, {}};
     options.name = "leka";
-    // Bytes pass as they are: the link's Leka adapter would hold the info
-    // line, which is not a command frame (see leka_test.cpp).
-    options.protocol = link::protocol_adapter("raw");
     server = std::make_unique<MockServer>(context, *firmware, options);
     server->start();
   }

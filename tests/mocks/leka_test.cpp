@@ -68,10 +68,9 @@ const Bytes kSeedBelt20 =
 
 const std::string kInfoLine = "LEKA name=leka firmware=1.0.0 buffer=128 state=ok\r\n";
 
-// The link passes bytes as they are. The link's Leka adapter splits both
-// directions with the command-frame decoder, which holds the robot's info
-// line (not a command frame) and short garbage until 128 bytes or a start
-// sequence have gone by.
+// These tests watch the firmware's own serial buffer fill with partial
+// frames and garbage, so the link passes bytes exactly as they are written
+// (a frame-aware link would hold a partial frame itself until it is whole).
 ServerOptions raw_link() {
   ServerOptions options;
   options.protocol = link::protocol_adapter("raw");

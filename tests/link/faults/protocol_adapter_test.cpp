@@ -152,6 +152,39 @@ TEST(ProtocolAdapter, SplittingDoesNotDependOnChunking) {
   }
 }
 
+TEST(ProtocolAdapter, LekaRobotRepliesAreCutAtLineEnds) {
+  const auto leka = protocol_adapter("leka");
+  auto splitter = leka->splitter_for(Direction::to_client);
+  std::vector<WireFrame> frames;
+  splitter->feed(to_bytes("LEKA name=leka"), frames);
+  EXPECT_TRUE(frames.empty());
+  EXPECT_EQ(splitter->buffered(), 14U);
+  splitter->feed(to_bytes("\r\nLEKA x\r\ntail"), frames);
+  ASSERT_EQ(frames.size(), 2U);
+  EXPECT_TRUE(frames[0].valid);
+  EXPECT_EQ(frames[0].kind, "reply");
+  EXPECT_EQ(frames[0].raw, to_bytes("LEKA name=leka\r\n"));
+  EXPECT_EQ(frames[1].raw, to_bytes("LEKA x\r\n"));
+  splitter->finish(frames);
+  ASSERT_EQ(frames.size(), 3U);
+  EXPECT_FALSE(frames[2].valid);
+  EXPECT_EQ(frames[2].raw, to_bytes("tail"));
+  // A run with no line end is bounded like a command frame.
+  auto bounded = leka->splitter_for(Direction::to_client);
+  frames.clear();
+  bounded->feed(Bytes(300, 'x'), frames);
+  ASSERT_EQ(frames.size(), 2U);
+  EXPECT_FALSE(frames[0].valid);
+  EXPECT_EQ(frames[0].raw.size(), 128U);
+  EXPECT_EQ(bounded->buffered(), 44U);
+  // The robot's side still gets command frames.
+  auto to_robot = leka->splitter_for(Direction::to_car);
+  frames.clear();
+  to_robot->feed(Bytes{0x2A, 0x2B, 0x2C, 0x2D, 0x01, 0x70, 0x70}, frames);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_EQ(frames[0].kind, "info");
+}
+
 TEST(ProtocolAdapter, RawMakesEachWriteOneFrameAndHoldsNothing) {
   auto splitter = protocol_adapter("raw")->splitter();
   std::vector<WireFrame> frames;
