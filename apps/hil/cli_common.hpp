@@ -101,5 +101,7 @@ void register_proxy(CLI::App& app, std::function<int()>& run);
 
 /// Registers `hil world` (check, render, default).
 void register_world(CLI::App& app, std::function<int()>& run);
+/// `hil mock`: standalone mock cars in real time (apps/hil/mock_command.cpp).
+void register_mock(CLI::App& app, std::function<int()>& run);
 
 }  // namespace hil::apps

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   hil::apps::register_leka(commands);
   hil::apps::register_proxy(app, run);
   hil::apps::register_world(app, run);
+  hil::apps::register_mock(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&

@@ -1,0 +1,311 @@
+// hil mock: standalone mock cars for the desk, in real time, until Ctrl-C.
+
+#include <sys/ioctl.h>
+#include <unistd.h>
+#include <asio/io_context.hpp>
+#include <asio/signal_set.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "apps/hil/cli_common.hpp"
+#include "link/asio_executor.hpp"
+#include "link/faults/profile_yaml.hpp"
+#include "mocks/behaviour_yaml.hpp"
+#include "mocks/car.hpp"
+#include "mocks/server.hpp"
+#include "sim/arena_yaml.hpp"
+
+namespace hil::apps {
+namespace {
+
+struct MockArgs {
+  std::string car;
+  std::string bind = "127.0.0.1";
+  std::optional<std::uint16_t> port;
+  std::string pty;
+  std::optional<unsigned> baud;
+  unsigned reset_ms = 0;
+  std::string world;
+  std::string faults;
+  std::string behaviours;
+  std::string wire_log;
+  std::optional<std::uint64_t> seed;
+  std::size_t count = 1;
+  std::string auth;
+  std::optional<double> data_hz;
+  bool quiet = false;
+  bool no_status = false;
+};
+
+// "/tmp/hil-arduino0" -> "/tmp/hil-arduino1" for car 1; a path that does not
+// end in a number gets "-<index>" appended.
+std::string nth_path(const std::string& first, std::size_t index) {
+  if (index == 0) return first;
+  std::size_t digits = first.size();
+  while (digits > 0 && std::isdigit(static_cast<unsigned char>(first[digits - 1])) != 0)
+    --digits;
+  if (digits == first.size()) return first + "-" + std::to_string(index);
+  return first.substr(0, digits) + std::to_string(std::stoull(first.substr(digits)) + index);
+}
+
+link::Endpoint endpoint_for(const MockArgs& args, mocks::CarKind kind, std::size_t index) {
+  link::Endpoint e = mocks::default_endpoint(kind, index);
+  if (auto* tcp = std::get_if<link::TcpEndpoint>(&e)) {
+    tcp->host = args.bind;
+    if (args.port) {
+      tcp->port = *args.port == 0 ? 0 : static_cast<std::uint16_t>(*args.port + index);
+    }
+  } else if (auto* pty = std::get_if<link::PtyEndpoint>(&e)) {
+    if (!args.pty.empty()) pty->path = nth_path(args.pty, index);
+    if (args.baud) pty->baud = *args.baud;
+    pty->reset_on_open = link::milliseconds(args.reset_ms);
+  }
+  return e;
+}
+
+std::string how_to_connect(const link::Endpoint& listening, const std::string& address) {
+  if (const auto* pty = std::get_if<link::PtyEndpoint>(&listening)) {
+    std::string text = "open " + pty->path + " as a serial port";
+    if (pty->baud != 0) text += " at " + std::to_string(pty->baud) + " baud";
+    return text;
+  }
+  return "connect to " + address;
+}
+
+// The terminal's status line: redrawn in place; log lines are printed above it.
+class StatusLine {
+ public:
+  explicit StatusLine(bool enabled) : enabled_(enabled) {}
+  void log(const std::string& line) {
+    if (enabled_) std::cout << "\r\033[K";
+    std::cout << line << '\n';
+    if (enabled_) std::cout << last_;
+    std::cout << std::flush;
+  }
+  void show(const std::string& text) {
+    if (!enabled_) return;
+    last_ = fit(text);
+    std::cout << "\r\033[K" << text << std::flush;
+  }
+  void end() {
+    if (enabled_ && !last_.empty()) std::cout << '\n' << std::flush;
+    last_.clear();
+    enabled_ = false;
+  }
+  bool enabled() const { return enabled_; }
+
+ private:
+  // A line longer than the terminal would wrap and break the redraw in place.
+  static std::string fit(const std::string& text) {
+    winsize w{};
+    if (::ioctl(STDOUT_FILENO, TIOCGWINSZ, &w) != 0 || w.ws_col == 0) return text;
+    std::string out;
+    std::size_t columns = 0;
+    for (const char c : text) {
+      const bool starts_character = (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+      if (starts_character && ++columns >= w.ws_col) break;
+      out += c;
+    }
+    return out;
+  }
+
+  bool enabled_;
+  std::string last_;
+};
+
+struct RunningCar {
+  std::unique_ptr<mocks::MockCar> car;
+  std::unique_ptr<mocks::MockServer> server;
+};
+
+std::string status_text(const std::vector<RunningCar>& cars) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(2);
+  std::uint64_t in = 0;
+  std::uint64_t sent = 0;
+  std::uint64_t bad = 0;
+  std::uint64_t faults = 0;
+  std::size_t clients = 0;
+  for (const auto& c : cars) {
+    const auto& s = c.car->firmware().stats();
+    in += s.frames_in;
+    sent += s.frames_out;
+    bad += s.bad_frames;
+    faults += c.server->faults_injected();
+    if (c.server->client_connected()) ++clients;
+  }
+  if (cars.size() == 1) {
+    auto& c = cars.front();
+    const auto pose = c.car->vehicle().pose();
+    out << c.car->name() << " x " << pose.x_m << " y " << pose.y_m << " hdg "
+        << static_cast<int>(std::lround(pose.heading_rad * 180 / std::numbers::pi)) << "° | "
+        << c.car->firmware().summary() << " | client "
+        << (c.server->client_connected() ? "yes" : "no");
+  } else {
+    out << cars.size() << " cars | " << clients << " client(s)";
+  }
+  out << " | frames in " << in << " out " << sent << " bad " << bad << " | faults " << faults;
+  return out.str();
+}
+
+int run_mock(const MockArgs& args) {
+  const auto kind = mocks::parse_car_kind(args.car);
+  mocks::CarOptions base;
+  base.kind = *kind;
+  link::FaultProfile faults;
+  std::vector<mocks::Behaviour> behaviours;
+  try {
+    if (!args.world.empty()) base.arena = sim::load_arena(args.world);
+    if (!args.faults.empty()) faults = link::load_fault_profile(args.faults);
+    if (!args.behaviours.empty()) behaviours = mocks::load_behaviours(args.behaviours);
+  } catch (const std::exception& e) {
+    std::cerr << "hil mock: " << e.what() << '\n';
+    return 1;
+  }
+  if (!args.auth.empty()) {
+    if (args.auth.size() != protocol::wr8::kAuthTextBytes) {
+      std::cerr << "hil mock: --auth must be exactly " << protocol::wr8::kAuthTextBytes
+                << " characters, got " << args.auth.size() << " (\"" << args.auth << "\")\n";
+      return 2;
+    }
+    std::copy(args.auth.begin(), args.auth.end(), base.configs.wr8.profile.auth_text.begin());
+  }
+  if (args.data_hz) {
+    base.configs.wr8.data_period = std::chrono::duration_cast<link::Duration>(
+        std::chrono::duration<double>(1.0 / *args.data_hz));
+  }
+  const std::uint64_t seed = args.seed ? *args.seed : std::random_device{}();
+
+  asio::io_context io;
+  link::AsioExecutor executor(io);
+  link::TransportContext context{executor, &io};
+  StatusLine status(!args.no_status && ::isatty(STDOUT_FILENO) != 0);
+  const auto log = [&status](const std::string& line) { status.log(line); };
+
+  std::vector<RunningCar> cars;
+  for (std::size_t i = 0; i < args.count; ++i) {
+    mocks::CarOptions options = base;
+    options.name = "car" + std::to_string(i);
+    options.seed = mocks::car_seed(seed, i);
+    RunningCar running;
+    try {
+      running.car = std::make_unique<mocks::MockCar>(std::move(options));
+    } catch (const std::exception& e) {
+      std::cerr << "hil mock: cannot build the car: " << e.what() << '\n';
+      return 1;
+    }
+    for (const auto& b : behaviours)
+      running.car->firmware().arm(b);
+    mocks::ServerOptions server;
+    server.listen = endpoint_for(args, *kind, i);
+    server.faults = faults;
+    server.seed = mocks::car_seed(seed, i);
+    server.wire_log_path = args.wire_log;
+    server.name = running.car->name();
+    if (!args.quiet) server.log = log;
+    running.server =
+        std::make_unique<mocks::MockServer>(context, running.car->firmware(), std::move(server));
+    const auto listening = endpoint_for(args, *kind, i);
+    try {
+      running.server->start();
+    } catch (const std::exception& e) {
+      std::cerr << "hil mock: cannot listen on " << link::to_uri(listening) << ": " << e.what();
+      if (std::holds_alternative<link::TcpEndpoint>(listening))
+        std::cerr << " (is another hil mock running? choose another --port)";
+      std::cerr << '\n';
+      return 1;
+    }
+    std::cout << "hil mock " << args.car << ": " << running.car->name() << " "
+              << how_to_connect(listening, running.server->address()) << '\n';
+    cars.push_back(std::move(running));
+  }
+  if (args.bind != "127.0.0.1" && args.bind != "localhost" && args.bind != "::1" &&
+      !std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(*kind, 0))) {
+    std::cout << "note: listening on " << args.bind << ", reachable from other machines\n";
+  }
+  std::cout << "world " << (args.world.empty() ? "built-in warehouse" : args.world) << ", "
+            << faults.rules.size() << " fault rule(s), " << behaviours.size()
+            << " behaviour(s), seed " << seed << " (replay with --seed " << seed
+            << "); Ctrl-C stops" << std::endl;
+
+  // The status line is redrawn five times a second while it is on.
+  std::function<void()> redraw;
+  redraw = [&] {
+    if (!status.enabled()) return;
+    status.show(status_text(cars));
+    executor.call_after(link::milliseconds(200), redraw);
+  };
+  if (status.enabled()) redraw();
+
+  asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const std::error_code& ec, int) {
+    if (ec) return;
+    status.end();
+    std::uint64_t served = 0;
+    for (auto& c : cars) {
+      served += c.server->clients_served();
+      c.server->close();
+    }
+    std::cout << "hil mock: stopping (" << served << " client(s) served)" << std::endl;
+    executor.call_after(link::milliseconds(100), [&io] { io.stop(); });
+  });
+  io.run();
+  return 0;
+}
+
+}  // namespace
+
+void register_mock(CLI::App& app, std::function<int()>& run) {
+  auto args = std::make_shared<MockArgs>();
+  auto* cmd = app.add_subcommand(
+      "mock", "Run mock cars on this machine for a client or UI to talk to (real time)");
+  cmd->add_option("car", args->car, "Which car: logi, wr8 (TCP), arduino, leka (pty)")
+      ->required()
+      ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka"}));
+  cmd->add_option(
+      "--bind", args->bind,
+      "Address TCP cars listen on (default 127.0.0.1; 0.0.0.0 opens it to the network)");
+  cmd->add_option("--port", args->port,
+                  "First TCP port (default 9000 for logi, 9100 for wr8; car N uses PORT+N; 0 picks "
+                  "free ports)");
+  cmd->add_option(
+      "--pty", args->pty,
+      "Serial cars: symlink to the first pty (default /tmp/hil-<car>0; car N counts up)");
+  cmd->add_option("--baud", args->baud,
+                  "Serial cars: line rate (default 9600 for arduino, 115200 for leka; 0 unpaced)");
+  cmd->add_option("--reset-ms", args->reset_ms,
+                  "Serial cars: bytes sent this long after opening the port are lost, as when an "
+                  "Arduino resets (default 0)");
+  cmd->add_option("--world", args->world, "World file (default: the built-in warehouse)");
+  cmd->add_option("--faults", args->faults, "Fault profile (YAML, docs/faults.md)");
+  cmd->add_option("--behaviours", args->behaviours,
+                  "Scripted behaviours to arm at start (YAML, docs/mocks.md)");
+  cmd->add_option("--seed", args->seed,
+                  "Seed for sensor noise and faults (printed when chosen at random)");
+  cmd->add_option("--log", args->wire_log,
+                  "Write every byte of every connection to an NDJSON wire log");
+  cmd->add_option("--count", args->count, "Run N independent cars on consecutive ports or ptys")
+      ->check(CLI::Range(1, 64));
+  cmd->add_option("--auth", args->auth, "WR8: the 10-character authentication string");
+  cmd->add_option("--data-hz", args->data_hz, "WR8: DATA packets per second (default 10)")
+      ->check(CLI::Range(0.1, 1000.0));
+  cmd->add_flag("-q,--quiet", args->quiet, "No line per connection and fault");
+  cmd->add_flag("--no-status", args->no_status,
+                "No status line (it is off anyway when not a terminal)");
+  cmd->footer(
+      "Examples:\n"
+      "  hil mock logi                                 # LOGI car on tcp://127.0.0.1:9000\n"
+      "  hil mock wr8 --count 3 --port 9100            # three WR8 vehicles on 9100..9102\n"
+      "  hil mock arduino --pty /tmp/robot0            # open /tmp/robot0 at 9600 baud\n"
+      "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
+      "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
+  cmd->callback([&run, args] { run = [args] { return run_mock(*args); }; });
+}
+
+}  // namespace hil::apps

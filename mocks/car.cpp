@@ -1,0 +1,89 @@
+#include "mocks/car.hpp"
+
+#include <stdexcept>
+
+#include "sim/presets.hpp"
+#include "sim/random.hpp"
+
+namespace hil::mocks {
+
+std::string_view to_string(CarKind kind) {
+  switch (kind) {
+    case CarKind::logi:
+      return "logi";
+    case CarKind::wr8:
+      return "wr8";
+    case CarKind::arduino:
+      return "arduino";
+    case CarKind::leka:
+      return "leka";
+  }
+  return "?";
+}
+
+std::optional<CarKind> parse_car_kind(std::string_view text) {
+  for (const auto kind : {CarKind::logi, CarKind::wr8, CarKind::arduino, CarKind::leka}) {
+    if (text == to_string(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
+sim::VehicleDef vehicle_preset(CarKind kind) {
+  switch (kind) {
+    case CarKind::logi:
+      return sim::logi_car();
+    case CarKind::wr8:
+      return sim::wr8_vehicle();
+    case CarKind::arduino:
+      return sim::arduino_robot();
+    case CarKind::leka:
+      return sim::leka_robot();
+  }
+  throw std::invalid_argument("unknown car kind");
+}
+
+std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
+                                        const FirmwareConfigs& configs) {
+  switch (kind) {
+    case CarKind::logi:
+      return std::make_unique<LogiFirmware>(world, vehicle, configs.logi);
+    case CarKind::wr8:
+      return std::make_unique<Wr8Firmware>(world, vehicle, configs.wr8);
+    case CarKind::arduino:
+      return std::make_unique<ArduinoFirmware>(world, vehicle, configs.arduino);
+    case CarKind::leka:
+      return std::make_unique<LekaFirmware>(world, vehicle, configs.leka);
+  }
+  throw std::invalid_argument("unknown car kind");
+}
+
+MockCar::MockCar(CarOptions options) : kind_(options.kind), name_(options.name) {
+  world_ = std::make_unique<sim::World>(sim::WorldDef{std::move(options.arena), options.seed});
+  sim::VehicleDef def = vehicle_preset(kind_);
+  def.name = name_;
+  vehicle_ = &world_->add_vehicle(std::move(def));
+  firmware_ = make_firmware(kind_, *world_, *vehicle_, options.configs);
+}
+
+MockCar::~MockCar() = default;
+
+std::uint64_t car_seed(std::uint64_t run_seed, std::size_t index) {
+  return index == 0 ? run_seed : sim::mix_seed(run_seed, index);
+}
+
+link::Endpoint default_endpoint(CarKind kind, std::size_t index) {
+  const auto n = static_cast<std::uint16_t>(index);
+  switch (kind) {
+    case CarKind::logi:
+      return link::TcpEndpoint{"127.0.0.1", static_cast<std::uint16_t>(9000 + n)};
+    case CarKind::wr8:
+      return link::TcpEndpoint{"127.0.0.1", static_cast<std::uint16_t>(9100 + n)};
+    case CarKind::arduino:
+      return link::PtyEndpoint{"/tmp/hil-arduino" + std::to_string(index), 9600, {}};
+    case CarKind::leka:
+      return link::PtyEndpoint{"/tmp/hil-leka" + std::to_string(index), 115200, {}};
+  }
+  throw std::invalid_argument("unknown car kind");
+}
+
+}  // namespace hil::mocks

@@ -1,0 +1,84 @@
+#pragma once
+// A standalone mock car: its own world, the car's preset vehicle and its
+// firmware, built from one options struct (what `hil mock` runs, once per
+// --count).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "link/endpoint.hpp"
+#include "mocks/arduino.hpp"
+#include "mocks/firmware.hpp"
+#include "mocks/leka.hpp"
+#include "mocks/logi.hpp"
+#include "mocks/wr8.hpp"
+#include "sim/arena.hpp"
+#include "sim/world.hpp"
+
+namespace hil::mocks {
+
+enum class CarKind : std::uint8_t { logi, wr8, arduino, leka };
+
+/// "logi", "wr8", "arduino", "leka".
+std::string_view to_string(CarKind kind);
+std::optional<CarKind> parse_car_kind(std::string_view text);
+
+/// The car's vehicle preset (sim/presets.hpp).
+sim::VehicleDef vehicle_preset(CarKind kind);
+
+/// Firmware settings for every kind; only the car's own is used.
+struct FirmwareConfigs {
+  LogiConfig logi;
+  Wr8Config wr8;
+  ArduinoConfig arduino;
+  LekaConfig leka;
+};
+
+/// The firmware of `kind` for a vehicle already in `world` (a scenario's
+/// shared world, or a MockCar's own).
+std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
+                                        const FirmwareConfigs& configs = {});
+
+struct CarOptions {
+  CarKind kind = CarKind::logi;
+  sim::Arena arena = sim::default_warehouse_arena();
+  std::uint64_t seed = 1;  ///< sensor noise and sensor faults
+  std::string name = "car0";
+  FirmwareConfigs configs;
+};
+
+class MockCar {
+ public:
+  explicit MockCar(CarOptions options);
+  ~MockCar();
+  MockCar(const MockCar&) = delete;
+  MockCar& operator=(const MockCar&) = delete;
+
+  CarKind kind() const { return kind_; }
+  const std::string& name() const { return name_; }
+  sim::World& world() { return *world_; }
+  sim::Vehicle& vehicle() { return *vehicle_; }
+  Firmware& firmware() { return *firmware_; }
+
+ private:
+  CarKind kind_;
+  std::string name_;
+  std::unique_ptr<sim::World> world_;
+  sim::Vehicle* vehicle_ = nullptr;
+  std::unique_ptr<Firmware> firmware_;
+};
+
+/// The seed of car number `index` in a run seeded `run_seed`: car 0 uses the
+/// run seed itself (so one car replays with the seed printed), the others
+/// independent streams mixed from it.
+std::uint64_t car_seed(std::uint64_t run_seed, std::size_t index);
+
+/// Where car number `index` (0-based) of a kind listens by default:
+/// tcp://127.0.0.1:9000+index (LOGI), tcp://127.0.0.1:9100+index (WR8),
+/// pty:///tmp/hil-arduino<index>?baud=9600, pty:///tmp/hil-leka<index>?baud=115200.
+link::Endpoint default_endpoint(CarKind kind, std::size_t index);
+
+}  // namespace hil::mocks

@@ -1,0 +1,179 @@
+// hil mock as a desk user runs it: in the background, talked to over real
+// TCP and a real pty, stopped with Ctrl-C.
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace hil::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A file descriptor the test reads with bounded waits.
+class Fd {
+ public:
+  explicit Fd(int fd) : fd_(fd) {}
+  ~Fd() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  bool ok() const { return fd_ >= 0; }
+  void send(const std::string& text) {
+    ASSERT_EQ(::write(fd_, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  }
+  /// Reads until `text` has arrived (true) or `limit` passed or the peer closed.
+  bool read_until(const std::string& text, std::chrono::milliseconds limit = 10s) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (received.find(text) == std::string::npos) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return false;
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
+      char buf[512];
+      const ssize_t n = ::read(fd_, buf, sizeof buf);
+      if (n <= 0) return false;
+      received.append(buf, static_cast<std::size_t>(n));
+    }
+    return true;
+  }
+  std::string received;
+
+ private:
+  int fd_;
+};
+
+int tcp_connect(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+int port_in(const std::string& line) {
+  std::smatch m;
+  if (!std::regex_search(line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) return -1;
+  return std::stoi(m[1]);
+}
+
+TEST(HilMock, LogiCarAnswersOverTcpAndStopsCleanlyOnCtrlC) {
+  HilProcess mock({"mock", "logi", "--port", "0", "--seed", "7"});
+  ASSERT_TRUE(mock.started());
+  const auto line = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(line) << mock.output();
+  EXPECT_NE(mock.output().find("seed 7 (replay with --seed 7)"), std::string::npos);
+  Fd client(tcp_connect(port_in(*line)));
+  ASSERT_TRUE(client.ok());
+  client.send("LOGI:SP:050:D7#");
+  EXPECT_TRUE(client.read_until("FB:SP:1")) << client.received;
+  EXPECT_TRUE(client.read_until("STAT:SP:050")) << client.received;
+  EXPECT_TRUE(mock.wait_for_line("client connected")) << mock.output();
+  const auto status = mock.interrupt();
+  ASSERT_TRUE(status) << mock.output();
+  EXPECT_EQ(*status, 0);
+  EXPECT_NE(mock.output().find("stopping (1 client(s) served)"), std::string::npos)
+      << mock.output();
+  // Not a terminal: no status line in the output.
+  EXPECT_EQ(mock.output().find("\033[K"), std::string::npos);
+}
+
+TEST(HilMock, CountRunsIndependentCarsAndASecondClientIsTurnedAway) {
+  HilProcess mock({"mock", "logi", "--port", "0", "--count", "2"});
+  const auto first = mock.wait_for_line("car0 connect to");
+  const auto second = mock.wait_for_line("car1 connect to");
+  ASSERT_TRUE(first && second) << mock.output();
+  ASSERT_NE(port_in(*first), port_in(*second));
+  Fd a(tcp_connect(port_in(*first)));
+  Fd b(tcp_connect(port_in(*second)));
+  a.send("LOGI:MD:MAN:0C#");
+  b.send("LOGI:MD:MAN:0C#");
+  EXPECT_TRUE(a.read_until("FB:MD:1"));
+  EXPECT_TRUE(b.read_until("FB:MD:1"));
+  Fd extra(tcp_connect(port_in(*first)));
+  ASSERT_TRUE(extra.ok());
+  EXPECT_FALSE(extra.read_until("LOGI", 3s));  // closed by the car with no byte
+  EXPECT_TRUE(extra.received.empty());
+  EXPECT_TRUE(mock.wait_for_line("turned away a second client")) << mock.output();
+  EXPECT_EQ(mock.interrupt(), 0);
+}
+
+TEST(HilMock, ArduinoRobotAnswersOnAPty) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("hil-mock-cli-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "robot0").string();
+  HilProcess mock({"mock", "arduino", "--pty", path});
+  const auto line = mock.wait_for_line("as a serial port at 9600 baud");
+  ASSERT_TRUE(line) << mock.output();
+  EXPECT_NE(line->find(path), std::string::npos);
+  Fd port(::open(path.c_str(), O_RDWR | O_NOCTTY));
+  ASSERT_TRUE(port.ok());
+  port.send("^01|PING|*11$");
+  EXPECT_TRUE(port.read_until("^01|ACK|")) << port.received;
+  EXPECT_EQ(mock.interrupt(), 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
+  HilProcess mock({"mock", "wr8", "--port", "0", "--auth", "0123456789"});
+  const auto line = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(line) << mock.output();
+  Fd client(tcp_connect(port_in(*line)));
+  client.send(std::string("\x01") + "0123456789");
+  ASSERT_TRUE(client.read_until(std::string("\x02", 1))) << client.received.size();
+  EXPECT_EQ(mock.interrupt(), 0);
+}
+
+TEST(HilMock, BadInputIsAClearError) {
+  const auto world = run_hil("mock logi --world tests/apps/data/bad-world.yaml");
+  EXPECT_EQ(world.exit_code, 1);
+  EXPECT_NE(world.output.find("hil mock: tests/apps/data/bad-world.yaml:"), std::string::npos)
+      << world.output;
+  const auto auth = run_hil("mock wr8 --auth short");
+  EXPECT_EQ(auth.exit_code, 2);
+  EXPECT_NE(auth.output.find("--auth must be exactly 10 characters, got 5"), std::string::npos)
+      << auth.output;
+  const auto car = run_hil("mock tesla");
+  EXPECT_EQ(car.exit_code, 2);
+  const auto behaviours = run_hil("mock logi --behaviours /nonexistent.yaml");
+  EXPECT_EQ(behaviours.exit_code, 1);
+  EXPECT_NE(behaviours.output.find("/nonexistent.yaml: cannot read the file"), std::string::npos)
+      << behaviours.output;
+}
+
+TEST(HilMock, APortInUseIsReportedWithTheFix) {
+  HilProcess first({"mock", "logi", "--port", "0"});
+  const auto line = first.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(line) << first.output();
+  const auto second = run_hil("mock logi --port " + std::to_string(port_in(*line)));
+  EXPECT_EQ(second.exit_code, 1);
+  EXPECT_NE(
+      second.output.find("cannot listen on tcp://127.0.0.1:" + std::to_string(port_in(*line))),
+      std::string::npos)
+      << second.output;
+  EXPECT_NE(second.output.find("choose another --port"), std::string::npos);
+  EXPECT_EQ(first.interrupt(), 0);
+}
+
+}  // namespace
+}  // namespace hil::test
