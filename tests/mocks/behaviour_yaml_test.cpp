@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "mocks/behaviour_yaml.hpp"
 
 namespace hil::mocks {
@@ -92,6 +94,17 @@ TEST(BehaviourYaml, ErrorsNameTheFileLineColumnAndWhatWasExpected) {
                "description)");
   expect_error("behaviours: [\n", "b.yaml:2:1: not valid YAML: end of sequence flow not found");
   expect_error("- 3\n", "b.yaml:1:3: behaviour 1: must be a map with at least 'do'");
+}
+
+TEST(BehaviourYaml, EveryShippedBehavioursFileLoads) {
+  std::size_t files = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(HIL_SOURCE_DIR) + "/scenarios/behaviours")) {
+    if (entry.path().extension() != ".yaml") continue;
+    ++files;
+    EXPECT_FALSE(load_behaviours(entry.path().string()).empty()) << entry.path();
+  }
+  EXPECT_GE(files, 2u);
 }
 
 TEST(BehaviourYaml, AMissingFileIsAnError) {
