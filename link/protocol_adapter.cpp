@@ -130,7 +130,7 @@ class LogiAdapter final : public ProtocolAdapter {
     return make_splitter<logi::Message>(
         logi::Decoder{},
         [](const logi::Message& m, bool text) {
-          return KindAndText{kind_of(m), text ? logi::describe(m) : std::string()};
+          return KindAndText{protocol::logi::kind_of(m), text ? logi::describe(m) : std::string()};
         },
         with_text);
   }
@@ -165,21 +165,6 @@ class LogiAdapter final : public ProtocolAdapter {
     if (f.size() < header.size() + 5) return false;
     if (!std::equal(header.begin(), header.end(), f.begin())) return false;
     return f.back() == protocol::logi::kTail && f[f.size() - 4] == ':';
-  }
-
-  static std::string kind_of(const protocol::logi::Message& m) {
-    namespace logi = protocol::logi;
-    return std::visit(
-        protocol::Overloaded{
-            [](const logi::SetSpeed&) -> std::string { return "SP"; },
-            [](const logi::SetRun& v) -> std::string { return v.run ? "ST:RUN" : "ST:STOP"; },
-            [](const logi::SetStation&) -> std::string { return "GS"; },
-            [](const logi::SetMode& v) { return "MD:" + std::string(logi::to_string(v.mode)); },
-            [](const logi::Move& v) { return "MV:" + std::string(logi::to_string(v.direction)); },
-            [](const logi::Status&) -> std::string { return "STAT"; },
-            [](const logi::Feedback& v) { return "FB:" + std::string(logi::to_string(v.command)); },
-        },
-        m);
   }
 };
 

@@ -83,21 +83,6 @@ sim::MecanumWheels wheel_pattern(Direction d, double w) {
   return {};
 }
 
-/// The kind a command has for behaviours and fault rules ("ST:RUN", "MV:FWD", "SP").
-std::string kind_of(const logi::Message& m) {
-  return std::visit(
-      protocol::Overloaded{
-          [](const logi::SetSpeed&) -> std::string { return "SP"; },
-          [](const logi::SetRun& v) -> std::string { return v.run ? "ST:RUN" : "ST:STOP"; },
-          [](const logi::SetStation&) -> std::string { return "GS"; },
-          [](const logi::SetMode& v) { return "MD:" + std::string(logi::to_string(v.mode)); },
-          [](const logi::Move& v) { return "MV:" + std::string(logi::to_string(v.direction)); },
-          [](const logi::Status&) -> std::string { return "STAT"; },
-          [](const logi::Feedback& v) { return "FB:" + std::string(logi::to_string(v.command)); },
-      },
-      m);
-}
-
 }  // namespace
 
 std::string_view to_string(LogiRunEnd end) {
@@ -202,7 +187,7 @@ void LogiFirmware::handle_frame(Time now, const protocol::Frame<Message>& frame)
     return;
   }
   count_frame_in();
-  const std::string kind = kind_of(frame.message);
+  const std::string kind = logi::kind_of(frame.message);
   switch (dispose(now, kind)) {
     case Disposition::handle:
       answer(*command, execute(now, frame.message));

@@ -57,6 +57,19 @@ std::optional<Command> command_of(const Message& m) {
       m);
 }
 
+std::string kind_of(const Message& m) {
+  return std::visit(Overloaded{
+                        [](const SetSpeed&) -> std::string { return "SP"; },
+                        [](const SetRun& v) -> std::string { return v.run ? "ST:RUN" : "ST:STOP"; },
+                        [](const SetStation&) -> std::string { return "GS"; },
+                        [](const SetMode& v) { return "MD:" + std::string(to_string(v.mode)); },
+                        [](const Move& v) { return "MV:" + std::string(to_string(v.direction)); },
+                        [](const Status&) -> std::string { return "STAT"; },
+                        [](const Feedback& v) { return "FB:" + std::string(to_string(v.command)); },
+                    },
+                    m);
+}
+
 std::string describe(const Message& m) {
   std::ostringstream os;
   std::visit(Overloaded{[&](const SetSpeed& v) { os << "SetSpeed percent=" << v.percent; },

@@ -97,6 +97,11 @@ std::optional<Command> parse_command(std::string_view text);
 /// The command a feedback frame would answer for this message, if it is a command.
 std::optional<Command> command_of(const Message& m);
 
+/// The frame's kind as fault rules and mock behaviours match it: the payload
+/// code plus the argument of ST, MD and MV ("SP", "ST:RUN", "MV:FWD",
+/// "STAT", "FB:ST").
+std::string kind_of(const Message& m);
+
 /// One-line human description, e.g. "SetSpeed percent=50".
 std::string describe(const Message& m);
 

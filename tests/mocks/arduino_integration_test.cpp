@@ -28,6 +28,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/serial_support.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -36,35 +37,14 @@ namespace arduino = protocol::arduino;
 namespace fs = std::filesystem;
 using std::chrono::milliseconds;
 
-/// A fresh directory under the system's temporary directory, removed at the end.
-struct TempDir {
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "hil-arduino-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr)
-      throw std::system_error(errno, std::generic_category(), pattern);
-    path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  fs::path path;
-};
+using test::TempDir;
 
 /// A serial program's end of the port: open(2) on the symlink, raw mode at
 /// 9600 baud, and the answers decoded as the PC side decodes them.
 class SerialClient {
  public:
   SerialClient(asio::io_context& io, const std::string& path) : port_(io) {
-    const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
-    if (fd < 0) throw std::system_error(errno, std::generic_category(), path);
-    termios tio{};
-    ::tcgetattr(fd, &tio);
-    ::cfmakeraw(&tio);
-    ::cfsetispeed(&tio, B9600);
-    ::cfsetospeed(&tio, B9600);
-    ::tcsetattr(fd, TCSANOW, &tio);
-    port_.assign(fd);
+    port_.assign(test::open_serial_port(path, B9600));
     read();
   }
   ~SerialClient() { *alive_ = false; }
@@ -174,7 +154,7 @@ struct ArduinoOverPty : ::testing::Test {
     EXPECT_EQ(*answer, (arduino::Message{seq, arduino::Nack{code}})) << "answer to " << frame;
   }
 
-  TempDir dir;
+  TempDir dir{"hil-arduino"};
   asio::io_context io;
   link::AsioExecutor executor{io};
   link::TransportContext context{executor, &io};

@@ -28,6 +28,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/serial_support.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -38,35 +39,14 @@ using protocol::Bytes;
 
 const std::string kInfoLine = "LEKA name=leka firmware=1.0.0 buffer=128 state=ok\r\n";
 
-/// A fresh directory under the system's temporary directory, removed at the end.
-struct TempDir {
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "hil-leka-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr)
-      throw std::system_error(errno, std::generic_category(), pattern);
-    path = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  fs::path path;
-};
+using test::TempDir;
 
 /// The master's end of the port: open(2) on the symlink, raw mode, every
 /// byte the robot sends collected.
 class SerialClient {
  public:
   SerialClient(asio::io_context& io, const std::string& path) : port_(io) {
-    const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
-    if (fd < 0) throw std::system_error(errno, std::generic_category(), path);
-    termios tio{};
-    ::tcgetattr(fd, &tio);
-    ::cfmakeraw(&tio);
-    ::cfsetispeed(&tio, B115200);
-    ::cfsetospeed(&tio, B115200);
-    ::tcsetattr(fd, TCSANOW, &tio);
-    port_.assign(fd);
+    port_.assign(test::open_serial_port(path, B115200));
     read();
   }
   ~SerialClient() { *alive_ = false; }
@@ -115,7 +95,7 @@ struct LekaOverPty : ::testing::Test {
         << "the pty listener never saw the port open";
   }
 
-  TempDir dir;
+  TempDir dir{"hil-leka"};
   std::string path = (dir.path / "leka0").string();
   asio::io_context io;
   link::AsioExecutor executor{io};
