@@ -226,16 +226,21 @@ class ArduinoAdapter final : public ProtocolAdapter {
 
 class Wr8Adapter final : public ProtocolAdapter {
  public:
+  explicit Wr8Adapter(protocol::wr8::Profile profile = protocol::wr8::default_profile())
+      : profile_(std::make_shared<const protocol::wr8::Profile>(std::move(profile))) {}
+
   std::string_view name() const override { return "wr8"; }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace wr8 = protocol::wr8;
+    wr8::DecoderOptions options;
+    options.profile = *profile_;
     return make_splitter<wr8::Message>(
-        wr8::Decoder{},
-        [](const wr8::Message& m, bool text) {
+        wr8::Decoder{options},
+        [profile = profile_](const wr8::Message& m, bool text) {
           std::string kind(wr8::to_string(wr8::code_of(m)));
           std::replace(kind.begin(), kind.end(), '-', '_');  // AUTH-REPLY -> AUTH_REPLY
-          return KindAndText{std::move(kind), text ? wr8::describe(m) : std::string()};
+          return KindAndText{std::move(kind), text ? wr8::describe(m, *profile) : std::string()};
         },
         with_text);
   }
@@ -261,6 +266,10 @@ class Wr8Adapter final : public ProtocolAdapter {
   std::vector<std::string> field_names() const override {
     return {"payload", "body", "code", "coi"};
   }
+
+ private:
+  // Shared with the splitters' describe functions, which outlive no adapter copy.
+  std::shared_ptr<const protocol::wr8::Profile> profile_;
 };
 
 // ---------------------------------------------------------------- Leka
@@ -360,6 +369,10 @@ class LekaAdapter final : public ProtocolAdapter {
 };
 
 }  // namespace
+
+std::shared_ptr<const ProtocolAdapter> wr8_adapter(const protocol::wr8::Profile& profile) {
+  return std::make_shared<Wr8Adapter>(profile);
+}
 
 std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name) {
   if (name == "logi") return std::make_shared<LogiAdapter>();

@@ -13,6 +13,7 @@
 
 #include "link/faults/profile.hpp"
 #include "protocol/common/bytes.hpp"
+#include "protocol/wr8/profile.hpp"
 
 namespace hil::link {
 
@@ -69,5 +70,10 @@ class ProtocolAdapter {
 /// The adapter for a protocol name; throws std::invalid_argument naming the
 /// known protocols for an unknown one.
 std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name);
+
+/// The WR8 adapter for a firmware whose byte order, block sizes or DATA
+/// table differ from the default profile (protocol_adapter("wr8") uses the
+/// default).
+std::shared_ptr<const ProtocolAdapter> wr8_adapter(const protocol::wr8::Profile& profile);
 
 }  // namespace hil::link

@@ -10,6 +10,10 @@ Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), ve
 
 Firmware::~Firmware() = default;
 
+std::shared_ptr<const link::ProtocolAdapter> Firmware::adapter() const {
+  return link::protocol_adapter(protocol());
+}
+
 void Firmware::advance(Time now) {
   world_.advance_to(now);
   run_actions(now, script_.take_due(now));

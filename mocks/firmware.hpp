@@ -6,11 +6,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
 #include "link/byte_pipe.hpp"
+#include "link/protocol_adapter.hpp"
 #include "link/time.hpp"
 #include "mocks/behaviour.hpp"
 #include "protocol/common/bytes.hpp"
@@ -43,6 +45,10 @@ class Firmware {
 
   /// "logi", "wr8", "arduino" or "leka".
   virtual std::string_view protocol() const = 0;
+  /// How a link in front of this firmware frames its bytes (fault rules,
+  /// captures): protocol_adapter(protocol()) unless the firmware's own
+  /// settings change the framing (a WR8 profile).
+  virtual std::shared_ptr<const link::ProtocolAdapter> adapter() const;
 
   // ---- driver side: every call first advances the world to `now` ----
 

@@ -25,7 +25,7 @@ class FaultLogger final : public link::LinkObserver {
 
 MockServer::MockServer(link::TransportContext& context, Firmware& firmware, ServerOptions options)
     : context_(context), firmware_(firmware), options_(std::move(options)) {
-  if (!options_.protocol) options_.protocol = link::protocol_adapter(firmware_.protocol());
+  if (!options_.protocol) options_.protocol = firmware_.adapter();
   gate_ = std::make_unique<link::FaultInjector>(
       link::Direction::to_car, options_.protocol,
       link::for_direction(options_.faults, link::Direction::to_car), options_.seed);

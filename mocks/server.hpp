@@ -21,7 +21,7 @@ namespace hil::mocks {
 
 struct ServerOptions {
   link::Endpoint listen;  ///< tcp://, pty:// or mem://
-  /// Frame-aware faults and decoded captures; null: the firmware's protocol.
+  /// Frame-aware faults and decoded captures; null: the firmware's adapter().
   std::shared_ptr<const link::ProtocolAdapter> protocol;
   link::FaultProfile faults;  ///< rules for both directions of every client's link
   std::uint64_t seed = 0;     ///< client N's link uses seed + N - 1

@@ -141,6 +141,10 @@ class Wr8Firmware final : public Firmware {
   Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config config = {});
 
   std::string_view protocol() const override { return "wr8"; }
+  /// Frames the link by this vehicle's profile (byte order, block sizes, DATA table).
+  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
+    return link::wr8_adapter(config_.profile);
+  }
   std::string summary() const override;
 
   const Wr8State& state() const { return state_; }

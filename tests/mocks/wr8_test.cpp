@@ -1030,10 +1030,9 @@ TEST(Wr8Profile, ABigEndianEntriesProfileIsSpokenBothWays) {
   Wr8Config config;
   config.profile.byte_order = wr8::ByteOrder::big;
   config.profile.block_unit = wr8::BlockSizeUnit::entries;
-  // The server's frame-aware link splits WR8 by the default profile, so this
-  // car's bytes go through it unsplit.
+  // The server's link frames this car's bytes by its own profile
+  // (Wr8Firmware::adapter()), so a frame-aware link carries them whole.
   ServerOptions options;
-  options.protocol = link::protocol_adapter("raw");
   Gui gui(config, options);  // its GUI decodes with the same profile
   gui.authenticate();
   gui.run_until(at_ms(1000));
@@ -1060,7 +1059,6 @@ TEST(Wr8Profile, DataFollowsTheProfilesTypesForEachParameter) {
     if (row.code == wr8::data_code::battery) row.size_bytes = 2;
   }
   ServerOptions options;
-  options.protocol = link::protocol_adapter("raw");
   Gui gui(config, options);
   gui.authenticate();
   gui.run_until(at_ms(1000));

@@ -185,6 +185,31 @@ TEST(ProtocolAdapter, LekaRobotRepliesAreCutAtLineEnds) {
   EXPECT_EQ(frames[0].kind, "info");
 }
 
+TEST(ProtocolAdapter, Wr8AdapterFramesByTheVehiclesOwnProfile) {
+  namespace wr8 = protocol::wr8;
+  wr8::Profile profile;
+  profile.byte_order = wr8::ByteOrder::big;
+  profile.block_unit = wr8::BlockSizeUnit::entries;
+  const wr8::Task task{3, wr8::TaskCode::drive, {wr8::Word::from_i32(100)}};
+  const Bytes stream = concat({wr8::encode(task, profile), wr8::encode(task, profile)});
+  const auto split = [&](const std::shared_ptr<const ProtocolAdapter>& adapter) {
+    auto splitter = adapter->splitter();
+    std::vector<WireFrame> frames;
+    splitter->feed(stream, frames);
+    splitter->finish(frames);
+    return frames;
+  };
+  const auto own = split(wr8_adapter(profile));
+  ASSERT_EQ(own.size(), 2U);
+  EXPECT_TRUE(own[0].valid);
+  EXPECT_EQ(own[0].kind, "TASK");
+  EXPECT_EQ(own[0].raw, wr8::encode(task, profile));
+  // The default profile reads the size byte (1 entry) as 1 byte and cuts the
+  // packets in the wrong places.
+  const auto standard = split(protocol_adapter("wr8"));
+  EXPECT_FALSE(standard.size() == 2U && standard[0].valid && standard[1].valid);
+}
+
 TEST(ProtocolAdapter, RawMakesEachWriteOneFrameAndHoldsNothing) {
   auto splitter = protocol_adapter("raw")->splitter();
   std::vector<WireFrame> frames;
