@@ -1,49 +1,115 @@
 #!/usr/bin/env bash
-# Runs the decoder, proxy and simulation benchmarks on the default
-# (RelWithDebInfo) build and rewrites their sections of docs/performance.md
+# Runs the decoder, proxy, simulation and mock-car benchmarks on a
+# RelWithDebInfo build and rewrites their sections of docs/performance.md
 # with the results.
-# Usage: bench/run.sh   (run on an otherwise idle machine)
+# Usage: bench/run.sh [decoder] [proxy] [sim] [mock]
+#   With no section named, runs them all. Each section is rewritten only when
+#   its benchmark ran to the end, so one section can be refreshed alone
+#   (bench/run.sh mock). Run on an otherwise idle machine.
+#   HIL_BUILD_DIR=DIR builds and runs in an already configured build tree
+#   instead of the default preset's build/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake --preset default >/dev/null
-cmake --build --preset default --target decoder_bench proxy_bench sim_bench
-table=$(mktemp)
-proxy_table=$(mktemp)
-sim_table=$(mktemp)
-trap 'rm -f "$table" "$proxy_table" "$sim_table"' EXIT
-build/bench/decoder_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-  --hil_max_bytewise_ratio=5 --hil_markdown="$table"
 
-build/bench/proxy_bench --frames 20000 --mib 256 --protocol raw --markdown "$proxy_table"
-build/bench/proxy_bench --frames 20000 --mib 128 --protocol logi --markdown "$proxy_table"
+sections=("$@")
+[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock)
+for section in "${sections[@]}"; do
+  case $section in
+    decoder | proxy | sim | mock) ;;
+    *)
+      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock)" >&2
+      exit 2
+      ;;
+  esac
+done
 
-build/bench/sim_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-  --benchmark_enable_random_interleaving=true --hil_markdown="$sim_table"
-
+build=${HIL_BUILD_DIR:-build}
+[ -n "${HIL_BUILD_DIR:-}" ] || cmake --preset default >/dev/null
 doc=docs/performance.md
-begin='<!-- decoder-bench:begin -->'
-end='<!-- decoder-bench:end -->'
-{
-  sed "/$begin/q" "$doc"
-  echo
-  echo "Measured $(date -u +%Y-%m-%d) on $(nproc) core(s), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'),"
-  echo "with \`bench/run.sh\` (best of 5 repetitions, 1 MiB stream per iteration):"
-  echo
-  cat "$table"
-  echo
-  sed -n "/$end/,/proxy-bench:begin/p" "$doc"
-  echo
-  echo "Measured $(date -u +%Y-%m-%d) with \`bench/run.sh\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way):"
-  echo
-  cat "$proxy_table"
-  sed -n "/proxy-bench:end/,/sim-bench:begin/p" "$doc"
-  echo
-  echo "Measured $(date -u +%Y-%m-%d) on $(nproc) core(s), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //'),"
-  echo "with \`bench/run.sh\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
-  echo
-  cat "$sim_table"
-  echo
-  sed -n "/sim-bench:end/,\$p" "$doc"
-} > "$doc.new"
-mv "$doc.new" "$doc"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+today() { date -u +%Y-%m-%d; }
+machine() {
+  echo "$(nproc) core(s), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')"
+}
+
+# Replaces the lines between <!-- NAME:begin --> and <!-- NAME:end --> in the
+# page with the contents of FILE.
+splice() {
+  local name=$1 file=$2
+  local begin="<!-- $name:begin -->" end="<!-- $name:end -->"
+  if ! grep -qxF "$begin" "$doc" || ! grep -qxF "$end" "$doc"; then
+    echo "bench/run.sh: $doc has no '$begin' ... '$end' markers" >&2
+    exit 1
+  fi
+  awk -v begin="$begin" -v end="$end" -v file="$file" '
+    $0 == begin { print; while ((getline line < file) > 0) print line; skip = 1; next }
+    $0 == end { skip = 0 }
+    !skip { print }
+  ' "$doc" >"$doc.new"
+  mv "$doc.new" "$doc"
+}
+
+run_decoder() {
+  cmake --build "$build" --target decoder_bench
+  "$build"/bench/decoder_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --hil_max_bytewise_ratio=5 --hil_markdown="$work/decoder.md"
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh\` (best of 5 repetitions, 1 MiB stream per iteration):"
+    echo
+    cat "$work/decoder.md"
+    echo
+  } >"$work/decoder.section"
+  splice decoder-bench "$work/decoder.section"
+}
+
+run_proxy() {
+  cmake --build "$build" --target proxy_bench
+  "$build"/bench/proxy_bench --frames 20000 --mib 256 --protocol raw --markdown "$work/proxy.md"
+  "$build"/bench/proxy_bench --frames 20000 --mib 128 --protocol logi --markdown "$work/proxy.md"
+  {
+    echo
+    echo "Measured $(today) with \`bench/run.sh\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way):"
+    echo
+    cat "$work/proxy.md"
+  } >"$work/proxy.section"
+  splice proxy-bench "$work/proxy.section"
+}
+
+run_sim() {
+  cmake --build "$build" --target sim_bench
+  "$build"/bench/sim_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --benchmark_enable_random_interleaving=true --hil_markdown="$work/sim.md"
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
+    echo
+    cat "$work/sim.md"
+    echo
+  } >"$work/sim.section"
+  splice sim-bench "$work/sim.section"
+}
+
+run_mock() {
+  cmake --build "$build" --target mock_bench
+  "$build"/bench/mock_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --benchmark_enable_random_interleaving=true --hil_markdown="$work/mock.md"
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh mock\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
+    echo
+    cat "$work/mock.md"
+    echo
+  } >"$work/mock.section"
+  splice mock-bench "$work/mock.section"
+}
+
+for section in "${sections[@]}"; do
+  "run_$section"
+done
 echo "updated $doc"
