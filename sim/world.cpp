@@ -112,24 +112,62 @@ void World::build_arena() {
     add_box(-t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
     add_box(w + t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
   }
-  for (std::size_t i = 0; i < arena.obstacles.size(); ++i) {
-    const auto tag = fixture_tag(FixtureKind::obstacle, i);
-    if (const auto* box = std::get_if<BoxObstacle>(&arena.obstacles[i])) {
-      add_box(box->center_m.x_m, box->center_m.y_m, box->width_m / 2, box->height_m / 2,
-              box->angle_rad, tag);
-    } else {
-      const auto& circle = std::get<CircleObstacle>(arena.obstacles[i]);
-      b2CircleShape shape;
-      shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
-                    static_cast<float>(circle.center_m.y_m));
-      shape.m_radius = static_cast<float>(circle.radius_m);
-      b2FixtureDef fixture;
-      fixture.shape = &shape;
-      fixture.friction = 0.3f;
-      fixture.userData.pointer = tag;
-      ground->CreateFixture(&fixture);
-    }
+  ground_ = ground;
+  for (std::size_t i = 0; i < arena.obstacles.size(); ++i)
+    add_obstacle_fixture(i);
+}
+
+void World::add_obstacle_fixture(std::size_t index) {
+  const auto tag = fixture_tag(FixtureKind::obstacle, index);
+  b2FixtureDef fixture;
+  fixture.friction = 0.3f;
+  fixture.userData.pointer = tag;
+  b2PolygonShape box_shape;
+  b2CircleShape circle_shape;
+  if (const auto* box = std::get_if<BoxObstacle>(&def_.arena.obstacles[index])) {
+    box_shape.SetAsBox(
+        static_cast<float>(box->width_m / 2), static_cast<float>(box->height_m / 2),
+        b2Vec2(static_cast<float>(box->center_m.x_m), static_cast<float>(box->center_m.y_m)),
+        static_cast<float>(box->angle_rad));
+    fixture.shape = &box_shape;
+  } else {
+    const auto& circle = std::get<CircleObstacle>(def_.arena.obstacles[index]);
+    circle_shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
+                         static_cast<float>(circle.center_m.y_m));
+    circle_shape.m_radius = static_cast<float>(circle.radius_m);
+    fixture.shape = &circle_shape;
   }
+  if (obstacle_fixtures_.size() <= index) obstacle_fixtures_.resize(index + 1, nullptr);
+  obstacle_fixtures_[index] = ground_->CreateFixture(&fixture);
+}
+
+std::size_t World::add_obstacle(Obstacle obstacle) {
+  const bool usable = std::visit(
+      [](const auto& o) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(o)>, BoxObstacle>) {
+          return o.width_m > 0 && o.height_m > 0;
+        } else {
+          return o.radius_m > 0;
+        }
+      },
+      obstacle);
+  if (!usable) throw std::invalid_argument("an obstacle needs a positive size");
+  def_.arena.obstacles.push_back(std::move(obstacle));
+  const std::size_t index = def_.arena.obstacles.size() - 1;
+  add_obstacle_fixture(index);
+  return index;
+}
+
+bool World::remove_obstacle(std::size_t index) {
+  if (!obstacle_present(index)) return false;
+  // Box2D ends the contacts of the fixture here, so touching cars hear EndContact.
+  ground_->DestroyFixture(obstacle_fixtures_[index]);
+  obstacle_fixtures_[index] = nullptr;
+  return true;
+}
+
+bool World::obstacle_present(std::size_t index) const {
+  return index < obstacle_fixtures_.size() && obstacle_fixtures_[index] != nullptr;
 }
 
 Vehicle& World::add_vehicle(VehicleDef def) {
@@ -163,6 +201,8 @@ std::uint64_t World::state_hash() const {
   StateHasher hasher;
   hasher.add(steps_);
   hasher.add(static_cast<std::uint64_t>(vehicles_.size()));
+  for (std::size_t i = 0; i < obstacle_fixtures_.size(); ++i)
+    hasher.add(static_cast<std::uint64_t>(obstacle_present(i) ? i + 1 : 0));
   for (const auto& vehicle : vehicles_)
     vehicle->hash_state(hasher);
   return hasher.value();

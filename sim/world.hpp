@@ -14,6 +14,7 @@
 
 class b2World;
 class b2Body;
+class b2Fixture;
 
 namespace hil::sim {
 
@@ -71,6 +72,16 @@ class World {
   /// the same inputs are the determinism guarantee.
   std::uint64_t state_hash() const;
 
+  /// Puts an obstacle into the arena while the world runs (a parcel dropped
+  /// in a car's path). Returns its index in arena().obstacles. Throws
+  /// std::invalid_argument for a shape with no area.
+  std::size_t add_obstacle(Obstacle obstacle);
+  /// Takes an obstacle out again; false when it is not there. Its entry in
+  /// arena().obstacles stays (indices do not move); obstacle_present() says
+  /// whether it is in the world.
+  bool remove_obstacle(std::size_t index);
+  bool obstacle_present(std::size_t index) const;
+
   const Arena& arena() const { return def_.arena; }
   std::uint64_t seed() const { return def_.seed; }
   b2World& box2d() { return *b2_; }
@@ -82,10 +93,13 @@ class World {
   friend class Vehicle;
   class ContactListener;
   void build_arena();
+  void add_obstacle_fixture(std::size_t index);
 
   WorldDef def_;
   std::unique_ptr<b2World> b2_;
   std::unique_ptr<ContactListener> listener_;
+  b2Body* ground_ = nullptr;                   // walls and obstacles
+  std::vector<b2Fixture*> obstacle_fixtures_;  // per arena obstacle; null once removed
   std::vector<std::unique_ptr<Vehicle>> vehicles_;
   std::vector<ContactEvent> contacts_;
   std::int64_t steps_ = 0;
