@@ -3,11 +3,18 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 #include <asio/io_context.hpp>
+#include <asio/posix/stream_descriptor.hpp>
+#include <asio/read_until.hpp>
 #include <asio/signal_set.hpp>
+#include <asio/streambuf.hpp>
+
+#include <fcntl.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -40,6 +47,7 @@ struct MockArgs {
   std::optional<double> data_hz;
   bool quiet = false;
   bool no_status = false;
+  bool commands = false;
 };
 
 // "/tmp/hil-arduino0" -> "/tmp/hil-arduino1" for car 1; a path that does not
@@ -154,6 +162,133 @@ std::string status_text(const std::vector<RunningCar>& cars) {
   return out.str();
 }
 
+// Desk commands typed while the cars run: drop a parcel in front of a car,
+// take it away, fail the car, hang up on the client, pick the car up.
+class DeskConsole {
+ public:
+  DeskConsole(asio::io_context& io, std::vector<RunningCar>& cars,
+              std::function<void(const std::string&)> say)
+      : stdin_flags_(::fcntl(STDIN_FILENO, F_GETFL)),
+        input_(io, ::dup(STDIN_FILENO)),
+        cars_(cars),
+        say_(std::move(say)) {}
+  ~DeskConsole() { stop(); }
+  DeskConsole(const DeskConsole&) = delete;
+  DeskConsole& operator=(const DeskConsole&) = delete;
+
+  /// Whether desk commands can be read: stdin is a terminal this process
+  /// owns (not a background job), or `forced` (a pipe, for scripts).
+  static bool available(bool forced) {
+    if (forced) return true;
+    return ::isatty(STDIN_FILENO) != 0 && ::tcgetpgrp(STDIN_FILENO) == ::getpgrp();
+  }
+
+  void start() {
+    // Sent to `hil mock` put in the background later: the read fails
+    // instead of stopping the process, and the cars run on.
+    std::signal(SIGTTIN, SIG_IGN);
+    read();
+  }
+  void stop() {
+    if (!input_.is_open()) return;
+    std::error_code ec;
+    input_.close(ec);
+    // Asio made the shared file description non-blocking; the shell that
+    // gets the terminal back expects it as it was.
+    if (stdin_flags_ != -1) ::fcntl(STDIN_FILENO, F_SETFL, stdin_flags_);
+  }
+
+  static std::string help() {
+    return "commands: obstacle [CM] (a parcel CM ahead of the car's front, default 15) | clear "
+           "(take the parcels away) | fault | recover | hangup (close the client's connection) | "
+           "place X Y [DEG] | car N (which car the commands act on) | help";
+  }
+
+ private:
+  void read() {
+    asio::async_read_until(input_, buffer_, '\n', [this](std::error_code ec, std::size_t n) {
+      if (ec) return;  // stdin closed: the cars run on
+      std::string line(asio::buffers_begin(buffer_.data()),
+                       asio::buffers_begin(buffer_.data()) + static_cast<std::ptrdiff_t>(n));
+      buffer_.consume(n);
+      run(line);
+      read();
+    });
+  }
+
+  void run(const std::string& line) {
+    std::istringstream in(line);
+    std::string word;
+    if (!(in >> word)) return;
+    RunningCar& car = cars_.at(selected_);
+    auto& firmware = car.car->firmware();
+    auto& vehicle = car.car->vehicle();
+    const std::string who = car.car->name();
+    if (word == "help") {
+      say_(help());
+    } else if (word == "obstacle") {
+      double cm = 15;
+      if (!(in >> cm)) cm = 15;
+      if (cm < 0 || cm > 400) {
+        say_("obstacle: CM must be 0..400");
+        return;
+      }
+      const auto footprint = vehicle.chassis().footprint();
+      const double front_m = footprint.center_ahead_m + footprint.length_m / 2;
+      const double depth_m = 0.10;
+      const auto center = vehicle.pose().to_arena({front_m + cm / 100 + depth_m / 2, 0});
+      const auto index = car.car->world().add_obstacle(
+          sim::BoxObstacle{"parcel", center, depth_m, 0.30, vehicle.pose().heading_rad});
+      parcels_[selected_].push_back(index);
+      say_(who + ": parcel dropped " + std::to_string(static_cast<int>(cm)) + " cm ahead");
+    } else if (word == "clear") {
+      std::size_t lifted = 0;
+      for (const auto index : parcels_[selected_])
+        if (car.car->world().remove_obstacle(index)) ++lifted;
+      parcels_[selected_].clear();
+      say_(who + ": " + std::to_string(lifted) + " parcel(s) taken away");
+    } else if (word == "fault") {
+      firmware.arm(mocks::Behaviour{"desk fault", {}, mocks::EnterFault{}});
+      say_(who + ": fault state");
+    } else if (word == "recover") {
+      firmware.arm(mocks::Behaviour{"desk recover", {}, mocks::ClearFault{}});
+      say_(who + ": fault cleared");
+    } else if (word == "hangup") {
+      firmware.arm(mocks::Behaviour{"desk hangup", {}, mocks::CloseConnection{}});
+      say_(who + (firmware.connected() ? ": closing the client's connection" : ": no client"));
+    } else if (word == "place") {
+      double x = 0;
+      double y = 0;
+      double deg = 0;
+      if (!(in >> x >> y)) {
+        say_("place: give X Y in metres and optionally a heading in degrees");
+        return;
+      }
+      in >> deg;
+      vehicle.place(sim::Pose{x, y, deg * std::numbers::pi / 180});
+      say_(who + ": placed");
+    } else if (word == "car") {
+      std::size_t n = 0;
+      if (!(in >> n) || n >= cars_.size()) {
+        say_("car: give a number from 0 to " + std::to_string(cars_.size() - 1));
+        return;
+      }
+      selected_ = n;
+      say_("commands now act on " + cars_.at(n).car->name());
+    } else {
+      say_("unknown command '" + word + "' (" + help() + ")");
+    }
+  }
+
+  int stdin_flags_;
+  asio::posix::stream_descriptor input_;
+  asio::streambuf buffer_;
+  std::vector<RunningCar>& cars_;
+  std::function<void(const std::string&)> say_;
+  std::size_t selected_ = 0;
+  std::map<std::size_t, std::vector<std::size_t>> parcels_;
+};
+
 int run_mock(const MockArgs& args) {
   const auto kind = mocks::parse_car_kind(args.car);
   mocks::CarOptions base;
@@ -234,6 +369,20 @@ int run_mock(const MockArgs& args) {
             << " behaviour(s), seed " << seed << " (replay with --seed " << seed
             << "); Ctrl-C stops" << std::endl;
 
+  std::unique_ptr<DeskConsole> console;
+  if (DeskConsole::available(args.commands)) {
+    try {
+      console = std::make_unique<DeskConsole>(io, cars, log);
+    } catch (const std::system_error& e) {
+      std::cerr << "hil mock: --commands needs stdin to be a terminal or a pipe: " << e.what()
+                << '\n';
+      return 2;
+    }
+    std::cout << "type 'help' for desk commands (a parcel in front of the car, fault, hangup, ...)"
+              << std::endl;
+    console->start();
+  }
+
   // The status line is redrawn five times a second while it is on.
   std::function<void()> redraw;
   redraw = [&] {
@@ -252,6 +401,7 @@ int run_mock(const MockArgs& args) {
       served += c.server->clients_served();
       c.server->close();
     }
+    if (console) console->stop();
     std::cout << "hil mock: stopping (" << served << " client(s) served)" << std::endl;
     executor.call_after(link::milliseconds(100), [&io] { io.stop(); });
   });
@@ -296,6 +446,9 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--data-hz", args->data_hz, "WR8: DATA packets per second (default 10)")
       ->check(CLI::Range(0.1, 1000.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No line per connection and fault");
+  cmd->add_flag("--commands", args->commands,
+                "Read desk commands from stdin even when it is not a terminal (they are read "
+                "from a terminal anyway; type 'help')");
   cmd->add_flag("--no-status", args->no_status,
                 "No status line (it is off anyway when not a terminal)");
   cmd->footer(

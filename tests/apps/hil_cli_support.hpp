@@ -48,12 +48,15 @@ class HilProcess {
   /// `args` are passed as they are (no shell); runs in the source tree.
   explicit HilProcess(const std::vector<std::string>& args) {
     int fds[2];
-    if (::pipe(fds) != 0) return;
+    int in[2];
+    if (::pipe(fds) != 0 || ::pipe(in) != 0) return;
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
     posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
+    posix_spawn_file_actions_adddup2(&actions, in[0], STDIN_FILENO);
     posix_spawn_file_actions_addclose(&actions, fds[0]);
+    posix_spawn_file_actions_addclose(&actions, in[1]);
     posix_spawn_file_actions_addchdir_np(&actions, HIL_SOURCE_DIR);
     std::vector<std::string> argv_strings{HIL_BINARY};
     argv_strings.insert(argv_strings.end(), args.begin(), args.end());
@@ -64,6 +67,8 @@ class HilProcess {
     if (posix_spawn(&pid_, HIL_BINARY, &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[1]);
+    ::close(in[0]);
+    in_fd_ = in[1];
     out_fd_ = fds[0];
     ::fcntl(out_fd_, F_SETFL, ::fcntl(out_fd_, F_GETFL) | O_NONBLOCK);
   }
@@ -73,11 +78,18 @@ class HilProcess {
       ::waitpid(pid_, nullptr, 0);
     }
     if (out_fd_ >= 0) ::close(out_fd_);
+    if (in_fd_ >= 0) ::close(in_fd_);
   }
   HilProcess(const HilProcess&) = delete;
   HilProcess& operator=(const HilProcess&) = delete;
 
   bool started() const { return pid_ > 0; }
+
+  /// Writes to the process's stdin (a pipe).
+  bool write_stdin(const std::string& text) {
+    return in_fd_ >= 0 &&
+           ::write(in_fd_, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  }
 
   /// Waits up to `limit` for a line containing `text`; returns the line.
   std::optional<std::string> wait_for_line(
@@ -135,6 +147,7 @@ class HilProcess {
 
   pid_t pid_ = -1;
   int out_fd_ = -1;
+  int in_fd_ = -1;
   std::string output_;
   std::size_t lines_seen_ = 0;
   std::optional<int> exit_code_;

@@ -144,6 +144,30 @@ TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
   EXPECT_EQ(mock.interrupt(), 0);
 }
 
+TEST(HilMock, DeskCommandsDropAParcelThatLocksTheCarAndTakeItAway) {
+  HilProcess mock({"mock", "logi", "--port", "0", "--commands"});
+  const auto line = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(line) << mock.output();
+  ASSERT_TRUE(mock.wait_for_line("type 'help' for desk commands"));
+  Fd client(tcp_connect(port_in(*line)));
+  client.send("LOGI:MD:MAN:0C#LOGI:MV:FWD:23#");
+  ASSERT_TRUE(client.read_until("FB:MV:1")) << client.received;
+  ASSERT_TRUE(mock.write_stdin("obstacle 10\n"));
+  EXPECT_TRUE(mock.wait_for_line("car0: parcel dropped 10 cm ahead")) << mock.output();
+  EXPECT_TRUE(client.read_until("OBS:1")) << client.received;
+  ASSERT_TRUE(mock.write_stdin("clear\n"));
+  EXPECT_TRUE(mock.wait_for_line("car0: 1 parcel(s) taken away")) << mock.output();
+  client.received.clear();
+  EXPECT_TRUE(client.read_until("OBS:0")) << client.received;
+  ASSERT_TRUE(mock.write_stdin("teleport\n"));
+  EXPECT_TRUE(mock.wait_for_line("unknown command 'teleport'")) << mock.output();
+  ASSERT_TRUE(mock.write_stdin("hangup\n"));
+  EXPECT_TRUE(mock.wait_for_line("car0: closing the client's connection")) << mock.output();
+  client.read_until("never", 5s);  // reads until the car closes the connection
+  EXPECT_TRUE(mock.wait_for_line("client gone")) << mock.output();
+  EXPECT_EQ(mock.interrupt(), 0);
+}
+
 TEST(HilMock, BadInputIsAClearError) {
   const auto world = run_hil("mock logi --world tests/apps/data/bad-world.yaml");
   EXPECT_EQ(world.exit_code, 1);
