@@ -1,0 +1,355 @@
+#include "client/arduino/client_core.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+#include <utility>
+
+namespace hil::client::arduino {
+
+namespace proto = protocol::arduino;
+
+namespace {
+
+Result outcome(ResultCode code, std::string detail) {
+  Result r;
+  r.code = code;
+  r.detail = std::move(detail);
+  return r;
+}
+
+}  // namespace
+
+std::string_view to_string(LinkState s) {
+  switch (s) {
+    case LinkState::closed:
+      return "CLOSED";
+    case LinkState::opening:
+      return "OPENING";
+    case LinkState::open:
+      return "OPEN";
+    case LinkState::degraded:
+      return "DEGRADED";
+    case LinkState::reconnecting:
+      return "RECONNECTING";
+    case LinkState::down:
+      return "DOWN";
+  }
+  return "?";
+}
+
+std::string_view to_string(ResultCode c) {
+  switch (c) {
+    case ResultCode::ok:
+      return "ok";
+    case ResultCode::nack:
+      return "nack";
+    case ResultCode::timeout:
+      return "timeout";
+    case ResultCode::link_down:
+      return "link_down";
+    case ResultCode::invalid_request:
+      return "invalid_request";
+  }
+  return "?";
+}
+
+ArduinoClientCore::ArduinoClientCore(ClientConfig config) : config_(config) {
+  if (config_.base_timeout <= Duration::zero() || config_.max_retries < 0 ||
+      config_.max_bad_cs_resends < 0 || config_.max_reconnect_attempts < 1 ||
+      config_.reconnect_ping_retries < 0 || config_.reconnect_base_delay < Duration::zero() ||
+      config_.health_check_interval < Duration::zero()) {
+    throw std::invalid_argument("ArduinoClientCore: a ClientConfig value is out of range");
+  }
+}
+
+Result ArduinoClientCore::lost_result(const Inflight& lost, ResultCode code,
+                                      const std::string& detail) {
+  Result r = outcome(code, detail);
+  r.attempts = lost.attempt + 1;
+  r.bad_cs_resends = lost.bad_cs_resends;
+  r.seq = lost.seq;
+  return r;
+}
+
+Duration ArduinoClientCore::timeout_of(int attempt) const {
+  return config_.base_timeout * (std::int64_t{1} << attempt);
+}
+
+void ArduinoClientCore::open(Time now) {
+  if (state_ != LinkState::closed && state_ != LinkState::down) return;
+  reconnect_failures_ = 0;
+  set_state(now, LinkState::opening, "open requested");
+  actions_.push_back(OpenPort{});
+}
+
+void ArduinoClientCore::close(Time now) {
+  if (connected_) actions_.push_back(ClosePort{});
+  connected_ = false;
+  reconnect_due_.reset();
+  fail_all(now, ResultCode::link_down, "the port was closed");
+  if (state_ != LinkState::closed) set_state(now, LinkState::closed, "close requested");
+}
+
+RequestId ArduinoClientCore::request(Time now, proto::Body body) {
+  const RequestId id = next_id_++;
+  if (!proto::is_request(body)) {
+    complete(id, outcome(ResultCode::invalid_request, "ACK and NACK are not requests"));
+    return id;
+  }
+  try {
+    (void)proto::encode({0, body});
+  } catch (const std::invalid_argument& e) {
+    complete(id, outcome(ResultCode::invalid_request, e.what()));
+    return id;
+  }
+  if (state_ == LinkState::closed || state_ == LinkState::down) {
+    complete(id, outcome(ResultCode::link_down,
+                         std::string("the link is ") + std::string(to_string(state_))));
+    return id;
+  }
+  queue_.push_back({id, Purpose::user, std::move(body)});
+  pump(now);
+  return id;
+}
+
+RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
+  proto::Envelope envelope;
+  const auto colon = token.find(':');
+  const std::string_view cmd = token.substr(0, colon);
+  envelope.cmd.reserve(cmd.size());
+  for (char c : cmd)
+    envelope.cmd += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (colon != std::string_view::npos) envelope.payload = std::string(token.substr(colon + 1));
+  auto typed = proto::to_message(envelope);
+  if (auto* error = std::get_if<proto::PayloadError>(&typed)) {
+    const RequestId id = next_id_++;
+    complete(id, outcome(ResultCode::invalid_request, error->detail));
+    return id;
+  }
+  return request(now, std::get<proto::Message>(typed).body);
+}
+
+void ArduinoClientCore::on_connected(Time now) {
+  connected_ = true;
+  decoder_ = proto::Decoder{};
+  if (state_ == LinkState::opening) {
+    last_exchange_ = now;
+    set_state(now, LinkState::open, "port open");
+    pump(now);
+  } else if (state_ == LinkState::reconnecting) {
+    // The reopened port must answer a PING before requests flow again.
+    inflight_.emplace();
+    inflight_->pending = {0, Purpose::reconnect_check, proto::Ping{}};
+    inflight_->max_retries = config_.reconnect_ping_retries;
+    inflight_->seq = next_seq_++;
+    inflight_->frame = proto::encode({inflight_->seq, proto::Ping{}});
+    send_current(now);
+  }
+}
+
+void ArduinoClientCore::on_connect_failed(Time now, std::string_view why) {
+  connected_ = false;
+  if (state_ == LinkState::opening) {
+    set_state(now, LinkState::down, "the port did not open: " + std::string(why));
+    fail_all(now, ResultCode::link_down, "the port did not open");
+  } else if (state_ == LinkState::reconnecting) {
+    reconnect_failed(now, "the port did not reopen: " + std::string(why));
+  }
+}
+
+void ArduinoClientCore::on_closed(Time now) {
+  if (!connected_) return;
+  connected_ = false;
+  if (inflight_ && inflight_->pending.purpose == Purpose::reconnect_check) {
+    inflight_.reset();
+    reconnect_failed(now, "the port closed during the reconnect check");
+    return;
+  }
+  if (inflight_) {
+    const Inflight lost = *std::exchange(inflight_, std::nullopt);
+    if (lost.pending.purpose == Purpose::user) {
+      complete(lost.pending.id,
+               lost_result(lost, ResultCode::link_down, "the port closed before the answer"));
+    }
+  }
+  if (state_ == LinkState::open) link_failed(now, "the port closed");
+}
+
+void ArduinoClientCore::on_bytes(Time now, ByteView bytes) {
+  if (!connected_) return;
+  items_.clear();
+  decoder_.feed(bytes, items_);
+  for (auto& item : items_) {
+    if (auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item)) {
+      events_.push_back(FrameReceived{frame->raw, frame->message.seq, true});
+      handle_message(now, frame->message);
+    } else {
+      auto& error = std::get<protocol::DecodeError>(item);
+      // Line noise between frames is not an answer; anything frame-shaped
+      // that fails to decode is a parse error the timeout will retry.
+      if (error.kind != protocol::ErrorKind::garbage) ++parse_errors_;
+      events_.push_back(FrameReceived{error.raw, proto::sequence_of(error.raw), false});
+    }
+  }
+}
+
+void ArduinoClientCore::handle_message(Time now, const proto::Message& m) {
+  if (!inflight_ || m.seq != inflight_->seq || proto::is_request(m.body)) {
+    ++stale_frames_;
+    return;
+  }
+  if (const auto* ack = std::get_if<proto::Ack>(&m.body)) {
+    Result r = outcome(ResultCode::ok, "");
+    r.info = ack->info;
+    finish(now, std::move(r));
+    return;
+  }
+  const auto& nack = std::get<proto::Nack>(m.body);
+  const auto* code = std::get_if<proto::NackCode>(&nack.error);
+  if (code != nullptr && *code == proto::NackCode::bad_cs &&
+      inflight_->bad_cs_resends < config_.max_bad_cs_resends) {
+    ++inflight_->bad_cs_resends;
+    send_current(now);
+    return;
+  }
+  Result r = outcome(ResultCode::nack, "the robot refused the request");
+  r.nack = nack;
+  finish(now, std::move(r));
+}
+
+void ArduinoClientCore::on_timer(Time now) {
+  if (inflight_ && now >= inflight_->deadline) {
+    if (inflight_->attempt < inflight_->max_retries) {
+      ++inflight_->attempt;
+      send_current(now);
+    } else {
+      finish(now, outcome(ResultCode::timeout, "no answer after every attempt"));
+    }
+  }
+  if (reconnect_due_ && now >= *reconnect_due_) {
+    reconnect_due_.reset();
+    if (state_ != LinkState::reconnecting) {
+      set_state(now, LinkState::reconnecting, "reopening the port");
+    }
+    actions_.push_back(OpenPort{});
+  }
+  if (state_ == LinkState::open && connected_ && !inflight_ && queue_.empty() &&
+      config_.health_check_interval > Duration::zero() &&
+      now >= last_exchange_ + config_.health_check_interval) {
+    queue_.push_back({0, Purpose::health_check, proto::Ping{}});
+  }
+  pump(now);
+}
+
+std::optional<Time> ArduinoClientCore::next_wakeup() const {
+  std::optional<Time> due;
+  auto consider = [&](Time t) {
+    if (!due || t < *due) due = t;
+  };
+  if (inflight_) consider(inflight_->deadline);
+  if (reconnect_due_) consider(*reconnect_due_);
+  if (state_ == LinkState::open && connected_ && !inflight_ && queue_.empty() &&
+      config_.health_check_interval > Duration::zero()) {
+    consider(last_exchange_ + config_.health_check_interval);
+  }
+  return due;
+}
+
+std::vector<Action> ArduinoClientCore::take_actions() {
+  return std::exchange(actions_, {});
+}
+std::vector<Event> ArduinoClientCore::take_events() {
+  return std::exchange(events_, {});
+}
+
+void ArduinoClientCore::pump(Time now) {
+  if (inflight_ || state_ != LinkState::open || !connected_ || queue_.empty()) return;
+  Pending next = std::move(queue_.front());
+  queue_.pop_front();
+  inflight_.emplace();
+  inflight_->pending = std::move(next);
+  inflight_->max_retries = config_.max_retries;
+  inflight_->seq = next_seq_++;  // wraps FF -> 00 as an 8-bit value
+  inflight_->frame = proto::encode({inflight_->seq, inflight_->pending.body});
+  send_current(now);
+}
+
+void ArduinoClientCore::send_current(Time now) {
+  inflight_->deadline = now + timeout_of(inflight_->attempt);
+  actions_.push_back(SendFrame{inflight_->frame, inflight_->seq});
+}
+
+void ArduinoClientCore::finish(Time now, Result result) {
+  const Inflight done = *std::exchange(inflight_, std::nullopt);
+  result.attempts = done.attempt + 1;
+  result.bad_cs_resends = done.bad_cs_resends;
+  result.seq = done.seq;
+  const bool answered = result.code != ResultCode::timeout;
+  switch (done.pending.purpose) {
+    case Purpose::user:
+      last_exchange_ = now;
+      complete(done.pending.id, result);
+      if (!answered) link_failed(now, "no answer to a request");
+      break;
+    case Purpose::health_check:
+      last_exchange_ = now;
+      if (!answered) link_failed(now, "no answer to the health check");
+      break;
+    case Purpose::reconnect_check:
+      if (result.code == ResultCode::ok) {
+        reconnect_failures_ = 0;
+        last_exchange_ = now;
+        set_state(now, LinkState::open, "the reopened port answered PING");
+      } else {
+        reconnect_failed(now, "no ACK to PING on the reopened port");
+      }
+      break;
+  }
+  pump(now);
+}
+
+void ArduinoClientCore::set_state(Time now, LinkState to, std::string reason) {
+  if (to == state_) return;
+  events_.push_back(LinkChanged{state_, to, now, std::move(reason)});
+  state_ = to;
+}
+
+void ArduinoClientCore::link_failed(Time now, std::string reason) {
+  if (state_ != LinkState::open) return;
+  set_state(now, LinkState::degraded, std::move(reason));
+  if (connected_) actions_.push_back(ClosePort{});
+  connected_ = false;
+  reconnect_failures_ = 0;
+  reconnect_due_ = now + config_.reconnect_base_delay;
+}
+
+void ArduinoClientCore::reconnect_failed(Time now, std::string reason) {
+  if (connected_) actions_.push_back(ClosePort{});
+  connected_ = false;
+  ++reconnect_failures_;
+  if (reconnect_failures_ >= config_.max_reconnect_attempts) {
+    set_state(now, LinkState::down, std::move(reason));
+    fail_all(now, ResultCode::link_down, "the link is DOWN");
+    return;
+  }
+  reconnect_due_ = now + config_.reconnect_base_delay * (std::int64_t{1} << reconnect_failures_);
+}
+
+void ArduinoClientCore::fail_all(Time /*now*/, ResultCode code, const std::string& detail) {
+  if (inflight_) {
+    const Inflight lost = *std::exchange(inflight_, std::nullopt);
+    if (lost.pending.purpose == Purpose::user) {
+      complete(lost.pending.id, lost_result(lost, code, detail));
+    }
+  }
+  for (auto& p : std::exchange(queue_, {})) {
+    if (p.purpose == Purpose::user) complete(p.id, outcome(code, detail));
+  }
+}
+
+void ArduinoClientCore::complete(RequestId id, Result result) {
+  events_.push_back(RequestDone{id, std::move(result)});
+}
+
+}  // namespace hil::client::arduino

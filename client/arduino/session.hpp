@@ -1,0 +1,92 @@
+#pragma once
+// Binds the Arduino client core to hil's transports under either driver:
+// opens the endpoint (pty://, tcp://, mem://), writes the core's frames,
+// feeds it what arrives, keeps one timer for its wakeup, and logs every frame.
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string_view>
+
+#include "client/arduino/client_core.hpp"
+#include "client/arduino/comm_log.hpp"
+#include "link/endpoint.hpp"
+#include "link/transport.hpp"
+
+namespace hil::client::arduino {
+
+class ArduinoSession {
+ public:
+  using Callback = std::function<void(const Result&)>;
+  using EventHandler = std::function<void(const Event&)>;
+  /// Wall-clock microseconds since the Unix epoch, for the log's timestamps.
+  using WallClock = std::function<std::int64_t()>;
+
+  /// `context` must outlive the session. Nothing happens until open().
+  ArduinoSession(link::TransportContext& context, link::Endpoint endpoint,
+                 ClientConfig config = {});
+  ~ArduinoSession();
+  ArduinoSession(const ArduinoSession&) = delete;
+  ArduinoSession& operator=(const ArduinoSession&) = delete;
+
+  void open();
+  void close();
+
+  /// Every event of the core (request results, link changes, frames in).
+  void set_event_handler(EventHandler handler) { on_event_ = std::move(handler); }
+  /// Replaces the wall clock used for log timestamps (tests pin it).
+  void set_wall_clock(WallClock clock) { wall_clock_ = std::move(clock); }
+
+  /// Queues a request; `done` runs on the executor with its result.
+  RequestId request(protocol::arduino::Body body, Callback done = {});
+  RequestId raw(std::string_view token, Callback done = {});
+  RequestId ping(Callback done = {}) { return request(protocol::arduino::Ping{}, std::move(done)); }
+  RequestId status(Callback done = {}) {
+    return request(protocol::arduino::StatusRequest{}, std::move(done));
+  }
+  RequestId set_v(int pwm, Callback done = {}) {
+    return request(protocol::arduino::SetSpeed{pwm}, std::move(done));
+  }
+  RequestId move_cm(int cm, Callback done = {}) {
+    return request(protocol::arduino::Move{cm}, std::move(done));
+  }
+  RequestId rotate_deg(int deg, Callback done = {}) {
+    return request(protocol::arduino::Rotate{deg}, std::move(done));
+  }
+  RequestId stop(Callback done = {}) { return request(protocol::arduino::Stop{}, std::move(done)); }
+  RequestId sonar(Callback done = {}) {
+    return request(protocol::arduino::SonarRead{}, std::move(done));
+  }
+  RequestId ir(Callback done = {}) { return request(protocol::arduino::IrRead{}, std::move(done)); }
+  RequestId help(Callback done = {}) { return request(protocol::arduino::Help{}, std::move(done)); }
+
+  LinkState state() const { return core_.state(); }
+  const ArduinoClientCore& core() const { return core_; }
+  CommLog& log() { return *log_; }
+  std::shared_ptr<CommLog> shared_log() const { return log_; }
+
+ private:
+  link::Time now() const { return context_.executor.now(); }
+  void drain();
+  void perform(Action& action);
+  void dispatch(Event& event);
+  void reschedule();
+  void drop_pipe();
+
+  link::TransportContext& context_;
+  link::Endpoint endpoint_;
+  ArduinoClientCore core_;
+  std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
+  link::BytePipePtr pipe_;
+  std::uint64_t generation_ = 0;  // callbacks from an older pipe are ignored
+  link::Executor::TimerId timer_ = 0;
+  std::optional<link::Time> timer_due_;
+  std::map<RequestId, Callback> callbacks_;
+  EventHandler on_event_;
+  WallClock wall_clock_;
+  bool draining_ = false;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace hil::client::arduino
