@@ -1,0 +1,441 @@
+#include "client/logi/core.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace hil::client::logi {
+
+std::string_view to_string(ConnectionState s) {
+  switch (s) {
+    case ConnectionState::disconnected:
+      return "Disconnected";
+    case ConnectionState::connecting:
+      return "Connecting";
+    case ConnectionState::connected:
+      return "Connected";
+    case ConnectionState::waiting_to_reconnect:
+      return "WaitingToReconnect";
+  }
+  return "?";
+}
+
+std::string_view to_string(CommandState s) {
+  switch (s) {
+    case CommandState::sent:
+      return "sent";
+    case CommandState::accepted:
+      return "accepted";
+    case CommandState::rejected:
+      return "rejected";
+    case CommandState::uncertain:
+      return "uncertain";
+    case CommandState::cancelled:
+      return "cancelled";
+  }
+  return "?";
+}
+
+std::string_view to_string(Refusal r) {
+  switch (r) {
+    case Refusal::none:
+      return "none";
+    case Refusal::not_connected:
+      return "not connected";
+    case Refusal::mode_speed_unconfirmed:
+      return "mode and speed not confirmed on this connection (send MD and SP)";
+    case Refusal::not_held:
+      return "no direction held";
+    case Refusal::unknown_request:
+      return "no such request awaits confirmation";
+    case Refusal::not_a_command:
+      return "not a command";
+  }
+  return "?";
+}
+
+LogiClientCore::LogiClientCore(ClientConfig config, std::shared_ptr<CommLog> log)
+    : config_(std::move(config)), log_(std::move(log)), decoder_(config_.decoder) {
+  if (config_.reconnect_delays.empty()) config_.reconnect_delays = {link::seconds(1)};
+  if (!log_) log_ = std::make_shared<CommLog>();
+}
+
+// ---- connection ----
+
+void LogiClientCore::connect(Time now) {
+  want_connected_ = true;
+  if (state_ == ConnectionState::connecting || state_ == ConnectionState::connected) return;
+  reconnect_at_.reset();
+  note(now, "connect");
+  set_state(ConnectionState::connecting, 0);
+  actions_.emplace_back(OpenConnection{});
+}
+
+void LogiClientCore::disconnect(Time now) {
+  want_connected_ = false;
+  reconnect_at_.reset();
+  reconnect_attempt_ = 0;
+  if (state_ == ConnectionState::connected || state_ == ConnectionState::connecting) {
+    actions_.emplace_back(CloseConnection{});
+  }
+  if (state_ == ConnectionState::disconnected) return;
+  note(now, "disconnect");
+  lost(now, "disconnected by the operator");
+  set_state(ConnectionState::disconnected);
+}
+
+void LogiClientCore::on_connected(Time now) {
+  if (state_ != ConnectionState::connecting) return;
+  reconnect_attempt_ = 0;
+  decoder_ = proto::Decoder(config_.decoder);
+  last_stat_ = now;
+  mode_confirmed_ = false;
+  speed_confirmed_ = false;
+  mode_.reset();
+  note(now, "connected");
+  set_state(ConnectionState::connected);
+}
+
+void LogiClientCore::on_connect_failed(Time now) {
+  if (state_ != ConnectionState::connecting) return;
+  note(now, "connect failed");
+  if (want_connected_) {
+    schedule_reconnect(now);
+  } else {
+    set_state(ConnectionState::disconnected);
+  }
+}
+
+void LogiClientCore::on_closed(Time now) {
+  if (state_ != ConnectionState::connected) return;
+  note(now, "connection lost");
+  lost(now, "connection lost");
+  if (want_connected_) {
+    schedule_reconnect(now);
+  } else {
+    set_state(ConnectionState::disconnected);
+  }
+}
+
+void LogiClientCore::schedule_reconnect(Time now) {
+  const auto& d = config_.reconnect_delays;
+  const auto index =
+      std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), d.size() - 1);
+  ++reconnect_attempt_;
+  reconnect_at_ = now + d[index];
+  note(now, "reconnect attempt " + std::to_string(reconnect_attempt_) + " in " +
+                link::format_ms(d[index]));
+  set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
+}
+
+void LogiClientCore::lost(Time now, std::string_view why) {
+  // The safe state: nothing held, nothing queued, movement needs a fresh
+  // confirmation of mode and speed on the next connection.
+  held_.reset();
+  keepalive_at_.reset();
+  for (auto* list : {&flight_, &queue_}) {
+    for (auto& p : *list) {
+      emit(CommandEvent{p.id, p.command, CommandState::cancelled, p.attempt, false});
+    }
+    list->clear();
+  }
+  awaiting_confirm_.clear();
+  mode_confirmed_ = false;
+  speed_confirmed_ = false;
+  mode_.reset();
+  decoder_ = proto::Decoder(config_.decoder);
+  note(now, std::string("safe state: ") + std::string(why));
+}
+
+void LogiClientCore::set_state(ConnectionState s, int attempt) {
+  if (s == state_) return;
+  state_ = s;
+  emit(ConnectionEvent{s, attempt});
+  update_movement();
+}
+
+bool LogiClientCore::movement_enabled() const {
+  return state_ == ConnectionState::connected && mode_confirmed_ && speed_confirmed_;
+}
+
+void LogiClientCore::update_movement() {
+  const bool enabled = movement_enabled();
+  if (movement_reported_ && movement_reported_value_ == enabled) return;
+  movement_reported_ = true;
+  movement_reported_value_ = enabled;
+  std::string reason;
+  if (!enabled) {
+    reason = state_ != ConnectionState::connected
+                 ? std::string(to_string(Refusal::not_connected))
+                 : std::string(to_string(Refusal::mode_speed_unconfirmed));
+  }
+  emit(MovementEvent{enabled, std::move(reason)});
+}
+
+void LogiClientCore::note(Time now, std::string text) {
+  log_->add(LogEntry{now, LogKind::note, {}, std::move(text)});
+}
+
+// ---- operator requests ----
+
+bool LogiClientCore::is_movement(const proto::Message& m) {
+  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction != proto::Direction::stop;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
+  return false;
+}
+
+bool LogiClientCore::retryable(const proto::Message& m) const {
+  if (std::holds_alternative<proto::SetSpeed>(m) || std::holds_alternative<proto::SetMode>(m)) {
+    return true;
+  }
+  const auto* mv = std::get_if<proto::Move>(&m);
+  return mv != nullptr && mv->direction == proto::Direction::stop;
+}
+
+bool LogiClientCore::resend_on_confirm(const proto::Message& m) {
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
+  return std::holds_alternative<proto::SetStation>(m);
+}
+
+SubmitResult LogiClientCore::submit(Time now, const proto::Message& command) {
+  if (!proto::command_of(command)) return {0, Refusal::not_a_command};
+  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (is_movement(command) && !(mode_confirmed_ && speed_confirmed_)) {
+    return {0, Refusal::mode_speed_unconfirmed};
+  }
+  if (std::holds_alternative<proto::SetMode>(command)) mode_confirmed_ = true;
+  if (std::holds_alternative<proto::SetSpeed>(command)) speed_confirmed_ = true;
+  update_movement();
+  const RequestId id = enqueue(now, command);
+  pump(now);
+  return {id, Refusal::none};
+}
+
+SubmitResult LogiClientCore::press(Time now, proto::Direction direction) {
+  auto result = submit(now, proto::Move{direction});
+  if (result && direction != proto::Direction::stop) {
+    held_ = direction;
+    if (config_.keepalive) keepalive_at_ = now + config_.keepalive_period;
+  }
+  return result;
+}
+
+SubmitResult LogiClientCore::release(Time now) {
+  if (!held_) return {0, Refusal::not_held};
+  held_.reset();
+  keepalive_at_.reset();
+  return submit(now, proto::Move{proto::Direction::stop});
+}
+
+SubmitResult LogiClientCore::emergency_stop(Time now) {
+  held_.reset();
+  keepalive_at_.reset();
+  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  // Queued motion would undo the stop once its turn came.
+  for (auto it = queue_.begin(); it != queue_.end();) {
+    if (is_movement(it->command)) {
+      emit(CommandEvent{it->id, it->command, CommandState::cancelled, it->attempt, false});
+      it = queue_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  note(now, "emergency stop");
+  // Written at once, beside whatever is in flight: a stop must not wait up
+  // to a feedback timeout (and its retries) behind an unanswered command.
+  Pending stop{next_id_++, proto::Move{proto::Direction::stop}};
+  stop.switch_mode_on_reject = false;
+  const RequestId id = stop.id;
+  send(now, std::move(stop));
+  if (mode_ != proto::Mode::manual) {
+    Pending st{next_id_++, proto::SetRun{false}};
+    send(now, std::move(st));
+  }
+  return {id, Refusal::none};
+}
+
+SubmitResult LogiClientCore::confirm_resend(Time now, RequestId request) {
+  auto it = std::find_if(awaiting_confirm_.begin(), awaiting_confirm_.end(),
+                         [&](const Pending& p) { return p.id == request; });
+  if (it == awaiting_confirm_.end()) return {0, Refusal::unknown_request};
+  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  Pending p = std::move(*it);
+  awaiting_confirm_.erase(it);
+  note(now, "operator confirmed resend of request " + std::to_string(request));
+  queue_.push_back(std::move(p));
+  pump(now);
+  return {request, Refusal::none};
+}
+
+// ---- dispatcher ----
+
+RequestId LogiClientCore::enqueue(Time /*now*/, proto::Message command, bool front,
+                                  bool switch_mode_on_reject) {
+  Pending p{next_id_++, std::move(command)};
+  p.switch_mode_on_reject = switch_mode_on_reject;
+  const RequestId id = p.id;
+  if (front) {
+    queue_.push_front(std::move(p));
+  } else {
+    queue_.push_back(std::move(p));
+  }
+  return id;
+}
+
+void LogiClientCore::pump(Time now) {
+  while (state_ == ConnectionState::connected && flight_.empty() && !queue_.empty()) {
+    Pending p = std::move(queue_.front());
+    queue_.pop_front();
+    send(now, std::move(p));
+  }
+}
+
+void LogiClientCore::send(Time now, Pending p) {
+  ++p.attempt;
+  p.deadline = now + config_.feedback_timeout;
+  const std::string text = proto::encode_text(p.command);
+  actions_.emplace_back(SendBytes{text});
+  std::string description = proto::describe(p.command) + " [request " + std::to_string(p.id);
+  if (p.attempt > 1) description += ", attempt " + std::to_string(p.attempt);
+  description += "]";
+  log_->add(LogEntry{now, LogKind::tx, text, std::move(description)});
+  emit(CommandEvent{p.id, p.command, CommandState::sent, p.attempt, false});
+  flight_.push_back(std::move(p));
+}
+
+void LogiClientCore::on_feedback(Time now, const proto::Feedback& fb) {
+  // Feedback comes in command order, so the oldest command of that code in
+  // flight is the one answered.
+  auto it = std::find_if(flight_.begin(), flight_.end(), [&](const Pending& p) {
+    return proto::command_of(p.command) == fb.command;
+  });
+  if (it == flight_.end()) {
+    emit(FeedbackEvent{0, fb});
+    return;
+  }
+  Pending p = std::move(*it);
+  flight_.erase(it);
+  emit(FeedbackEvent{p.id, fb});
+  if (fb.accepted) {
+    if (const auto* md = std::get_if<proto::SetMode>(&p.command)) mode_ = md->mode;
+    emit(CommandEvent{p.id, p.command, CommandState::accepted, p.attempt, false});
+  } else if (std::holds_alternative<proto::Move>(p.command) && p.switch_mode_on_reject &&
+             !p.mode_switch_done) {
+    emit(NoticeEvent{"Not in manual mode, switching to MAN"});
+    note(now, "Not in manual mode, switching to MAN");
+    p.mode_switch_done = true;
+    queue_.push_front(std::move(p));
+    enqueue(now, proto::SetMode{proto::Mode::manual}, true);
+  } else {
+    emit(CommandEvent{p.id, p.command, CommandState::rejected, p.attempt, false});
+  }
+  pump(now);
+}
+
+void LogiClientCore::on_timeout(Time now, Pending p) {
+  if (retryable(p.command) && p.attempt <= config_.max_retries) {
+    note(now, "no feedback for request " + std::to_string(p.id) + ", resending");
+    send(now, std::move(p));
+    return;
+  }
+  const bool confirm = resend_on_confirm(p.command);
+  note(now, "no feedback for request " + std::to_string(p.id) + ": uncertain" +
+                (confirm ? ", resent only when the operator confirms" : ""));
+  emit(CommandEvent{p.id, p.command, CommandState::uncertain, p.attempt, confirm});
+  if (confirm) {
+    p.attempt = 0;
+    awaiting_confirm_.push_back(std::move(p));
+  }
+}
+
+// ---- input ----
+
+void LogiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
+  if (state_ != ConnectionState::connected) return;
+  decoder_.feed(bytes, items_);
+  auto items = std::exchange(items_, {});
+  for (const auto& item : items) {
+    if (const auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item)) {
+      on_frame(now, *frame);
+    } else {
+      const auto& error = std::get<protocol::DecodeError>(item);
+      std::string description = std::string(protocol::to_string(error.kind));
+      if (!error.detail.empty()) description += ": " + error.detail;
+      log_->add(LogEntry{now, LogKind::parse_error, std::string(error.raw.begin(), error.raw.end()),
+                         std::move(description)});
+      emit(ParseErrorEvent{error});
+    }
+    if (state_ != ConnectionState::connected) break;
+  }
+  pump(now);
+}
+
+void LogiClientCore::on_frame(Time now, const protocol::Frame<proto::Message>& frame) {
+  log_->add(LogEntry{now, LogKind::rx, std::string(frame.raw.begin(), frame.raw.end()),
+                     proto::describe(frame.message)});
+  if (const auto* status = std::get_if<proto::Status>(&frame.message)) {
+    status_ = *status;
+    mode_ = status->mode;
+    last_stat_ = now;
+    if (stale_) {
+      stale_ = false;
+      note(now, "status fresh again");
+      emit(StaleEvent{false});
+    }
+    emit(StatusEvent{*status});
+  } else if (const auto* fb = std::get_if<proto::Feedback>(&frame.message)) {
+    on_feedback(now, *fb);
+  } else {
+    note(now, "the car sent a command frame; ignored");
+  }
+}
+
+// ---- time ----
+
+void LogiClientCore::on_timer(Time now) {
+  if (reconnect_at_ && now >= *reconnect_at_) {
+    reconnect_at_.reset();
+    note(now, "reconnect attempt " + std::to_string(reconnect_attempt_));
+    set_state(ConnectionState::connecting, reconnect_attempt_);
+    actions_.emplace_back(OpenConnection{});
+  }
+  for (;;) {
+    auto it = std::min_element(
+        flight_.begin(), flight_.end(),
+        [](const Pending& a, const Pending& b) { return a.deadline < b.deadline; });
+    if (it == flight_.end() || it->deadline > now) break;
+    Pending p = std::move(*it);
+    flight_.erase(it);
+    on_timeout(now, std::move(p));
+  }
+  if (state_ == ConnectionState::connected && !stale_ && last_stat_ &&
+      now >= *last_stat_ + config_.stale_after) {
+    stale_ = true;
+    note(now, "stale: no STAT for " + link::format_ms(now - *last_stat_));
+    emit(StaleEvent{true});
+  }
+  if (held_ && keepalive_at_ && now >= *keepalive_at_) {
+    // Only when the line is idle: a keepalive never queues behind a command.
+    if (state_ == ConnectionState::connected && queue_.empty() && flight_.empty()) {
+      enqueue(now, proto::Move{*held_});
+    }
+    while (*keepalive_at_ <= now)
+      *keepalive_at_ += config_.keepalive_period;
+  }
+  pump(now);
+}
+
+std::optional<Time> LogiClientCore::next_wakeup() const {
+  std::optional<Time> next = reconnect_at_;
+  auto consider = [&](Time t) {
+    if (!next || t < *next) next = t;
+  };
+  for (const auto& p : flight_)
+    consider(p.deadline);
+  if (state_ == ConnectionState::connected && !stale_ && last_stat_) {
+    consider(*last_stat_ + config_.stale_after);
+  }
+  if (held_ && keepalive_at_) consider(*keepalive_at_);
+  return next;
+}
+
+}  // namespace hil::client::logi

@@ -1,0 +1,236 @@
+#pragma once
+// The LOGI reference client's logic, sans-I/O: connection lifecycle with
+// reconnect, frame decoding, the one-in-flight command dispatcher with
+// feedback timeouts and retries, and the safety guard (docs/clients/logi.md).
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "client/logi/comm_log.hpp"
+#include "link/time.hpp"
+#include "protocol/common/bytes.hpp"
+#include "protocol/logi/codec.hpp"
+#include "protocol/logi/message.hpp"
+
+namespace hil::client::logi {
+
+using link::Duration;
+using link::Time;
+namespace proto = protocol::logi;
+
+/// Local id of one operator request; 0 is never used (unsolicited feedback).
+using RequestId = std::uint64_t;
+
+struct ClientConfig {
+  Duration feedback_timeout = link::milliseconds(800);
+  /// Resends after a timeout for SP, MD and MV:STOP (3 sends in all).
+  int max_retries = 2;
+  /// Delays before reconnect attempt 1, 2, 3...; the last repeats forever.
+  std::vector<Duration> reconnect_delays = {link::seconds(1), link::seconds(2), link::seconds(3)};
+  /// Without a STAT for this long the stale warning is raised.
+  Duration stale_after = link::seconds(2);
+  /// Repeat the held direction's MV while it is held (off: edge-triggered).
+  bool keepalive = false;
+  Duration keepalive_period = link::milliseconds(300);
+  proto::DecoderOptions decoder;
+};
+
+enum class ConnectionState : std::uint8_t {
+  disconnected,
+  connecting,
+  connected,
+  waiting_to_reconnect
+};
+std::string_view to_string(ConnectionState s);
+
+// ---- actions for the driver ----
+struct OpenConnection {
+  friend bool operator==(const OpenConnection&, const OpenConnection&) = default;
+};
+struct SendBytes {
+  std::string text;  ///< one complete frame
+  friend bool operator==(const SendBytes&, const SendBytes&) = default;
+};
+struct CloseConnection {
+  friend bool operator==(const CloseConnection&, const CloseConnection&) = default;
+};
+using Action = std::variant<OpenConnection, SendBytes, CloseConnection>;
+
+// ---- events for a UI ----
+struct ConnectionEvent {
+  ConnectionState state = ConnectionState::disconnected;
+  int attempt = 0;  ///< reconnect attempt number (0: operator's connect)
+};
+/// A decoded STAT.
+struct StatusEvent {
+  proto::Status status;
+};
+/// A decoded FB; `request` is 0 when no command in flight matched it.
+struct FeedbackEvent {
+  RequestId request = 0;
+  proto::Feedback feedback;
+};
+enum class CommandState : std::uint8_t {
+  sent,       ///< written to the car (again, for a retry)
+  accepted,   ///< FB:x:1
+  rejected,   ///< FB:x:0
+  uncertain,  ///< no FB within the timeout and no (further) automatic retry
+  cancelled,  ///< dropped unsent or abandoned: connection lost, emergency stop
+};
+std::string_view to_string(CommandState s);
+/// Progress of one request (each send, then its outcome).
+struct CommandEvent {
+  RequestId request = 0;
+  proto::Message command;
+  CommandState state = CommandState::sent;
+  int attempt = 1;  ///< 1 = first send
+  /// With `uncertain`: confirm_resend(request) will send it again.
+  bool resend_on_confirm = false;
+};
+struct StaleEvent {
+  bool stale = false;  ///< true: raised, false: cleared by a fresh STAT
+};
+/// Something the operator should be told ("Not in manual mode, switching to MAN").
+struct NoticeEvent {
+  std::string text;
+};
+struct ParseErrorEvent {
+  protocol::DecodeError error;
+};
+/// Whether movement controls should be enabled, and why not.
+struct MovementEvent {
+  bool enabled = false;
+  std::string reason;
+};
+using Event = std::variant<ConnectionEvent, StatusEvent, FeedbackEvent, CommandEvent, StaleEvent,
+                           NoticeEvent, ParseErrorEvent, MovementEvent>;
+
+/// Why an operator request was not taken.
+enum class Refusal : std::uint8_t {
+  none,
+  not_connected,           ///< nothing is sent while the link is down
+  mode_speed_unconfirmed,  ///< movement needs MD and SP from the operator on this connection
+  not_held,                ///< release() without a held direction
+  unknown_request,         ///< confirm_resend() for a request not awaiting confirmation
+  not_a_command,           ///< submit() of a STAT or FB
+};
+std::string_view to_string(Refusal r);
+
+struct SubmitResult {
+  RequestId request = 0;  ///< 0 when refused
+  Refusal refusal = Refusal::none;
+  explicit operator bool() const { return refusal == Refusal::none; }
+};
+
+class LogiClientCore {
+ public:
+  explicit LogiClientCore(ClientConfig config = {},
+                          std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
+
+  // ---- operator ----
+  /// Connects (at once, also from WaitingToReconnect); reconnects from then on.
+  void connect(Time now);
+  /// Closes and stays disconnected (no reconnect).
+  void disconnect(Time now);
+  /// Queues a command (SP, ST, GS, MD, MV). MV other than STOP and ST:RUN
+  /// count as movement.
+  SubmitResult submit(Time now, const proto::Message& command);
+  /// A direction button went down: MV:<dir>, held until release().
+  SubmitResult press(Time now, proto::Direction direction);
+  /// The held direction's button came up: MV:STOP.
+  SubmitResult release(Time now);
+  /// MV:STOP, then ST:STOP unless the car is known to be in MAN, written at
+  /// once ahead of the queue; queued movement is cancelled.
+  SubmitResult emergency_stop(Time now);
+  /// Resends an uncertain ST:RUN or GS (same request id).
+  SubmitResult confirm_resend(Time now, RequestId request);
+
+  // ---- driver ----
+  void on_connected(Time now);
+  void on_connect_failed(Time now);
+  void on_bytes(Time now, protocol::ByteView bytes);
+  /// The connection ended without the core asking (peer close, reset).
+  void on_closed(Time now);
+  /// Runs what is due (timeouts, reconnect, stale check, keepalive).
+  void on_timer(Time now);
+  std::optional<Time> next_wakeup() const;
+
+  std::vector<Action> take_actions() { return std::exchange(actions_, {}); }
+  std::vector<Event> take_events() { return std::exchange(events_, {}); }
+
+  // ---- state ----
+  ConnectionState state() const { return state_; }
+  bool movement_enabled() const;
+  bool stale() const { return stale_; }
+  std::optional<proto::Direction> held() const { return held_; }
+  /// The mode from the last STAT or accepted MD on this connection.
+  std::optional<proto::Mode> known_mode() const { return mode_; }
+  const std::optional<proto::Status>& last_status() const { return status_; }
+  std::size_t queued() const { return queue_.size(); }
+  std::size_t in_flight() const { return flight_.size(); }
+  const std::shared_ptr<CommLog>& log() const { return log_; }
+  const ClientConfig& config() const { return config_; }
+
+ private:
+  enum class Origin : std::uint8_t { operator_request, internal };
+  struct Pending {
+    RequestId id = 0;
+    proto::Message command;
+    int attempt = 0;                // sends so far
+    bool mode_switch_done = false;  // FB:MV:0 has already led to MD:MAN once
+    bool switch_mode_on_reject = true;
+    Time deadline{0};
+  };
+
+  RequestId enqueue(Time now, proto::Message command, bool front = false,
+                    bool switch_mode_on_reject = true);
+  void pump(Time now);
+  void send(Time now, Pending p);
+  void on_frame(Time now, const protocol::Frame<proto::Message>& frame);
+  void on_feedback(Time now, const proto::Feedback& fb);
+  void on_timeout(Time now, Pending p);
+  void lost(Time now, std::string_view why);
+  void schedule_reconnect(Time now);
+  void set_state(ConnectionState s, int attempt = 0);
+  void update_movement();
+  void note(Time now, std::string text);
+  void emit(Event e) { events_.push_back(std::move(e)); }
+  static bool is_movement(const proto::Message& m);
+  bool retryable(const proto::Message& m) const;
+  static bool resend_on_confirm(const proto::Message& m);
+
+  ClientConfig config_;
+  std::shared_ptr<CommLog> log_;
+  proto::Decoder decoder_;
+  std::vector<proto::Item> items_;
+  std::vector<Action> actions_;
+  std::vector<Event> events_;
+
+  ConnectionState state_ = ConnectionState::disconnected;
+  bool want_connected_ = false;
+  int reconnect_attempt_ = 0;  // attempts since the last successful connect
+  std::optional<Time> reconnect_at_;
+
+  RequestId next_id_ = 1;
+  std::deque<Pending> queue_;
+  std::deque<Pending> flight_;  // normally one; an emergency stop adds its frames
+  std::vector<Pending> awaiting_confirm_;
+
+  std::optional<proto::Direction> held_;
+  std::optional<Time> keepalive_at_;
+  bool mode_confirmed_ = false;
+  bool speed_confirmed_ = false;
+  std::optional<proto::Mode> mode_;
+  std::optional<proto::Status> status_;
+  std::optional<Time> last_stat_;
+  bool stale_ = false;
+  bool movement_reported_ = false;
+  bool movement_reported_value_ = false;
+};
+
+}  // namespace hil::client::logi
