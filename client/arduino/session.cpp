@@ -51,6 +51,13 @@ void ArduinoSession::drain() {
     auto actions = core_.take_actions();
     auto events = core_.take_events();
     if (actions.empty() && events.empty()) break;
+    // Frames in are logged before the frames they caused go out, so the log
+    // reads in wire order (a NACK BAD_CS, then its resend).
+    for (auto& e : events) {
+      if (auto* frame = std::get_if<FrameReceived>(&e)) {
+        log_->rx(wall_clock_(), std::string(frame->raw.begin(), frame->raw.end()), frame->seq);
+      }
+    }
     for (auto& a : actions)
       perform(a);
     for (auto& e : events)
@@ -102,9 +109,7 @@ void ArduinoSession::perform(Action& action) {
 }
 
 void ArduinoSession::dispatch(Event& event) {
-  if (auto* frame = std::get_if<FrameReceived>(&event)) {
-    log_->rx(wall_clock_(), std::string(frame->raw.begin(), frame->raw.end()), frame->seq);
-  } else if (auto* done = std::get_if<RequestDone>(&event)) {
+  if (auto* done = std::get_if<RequestDone>(&event)) {
     auto it = callbacks_.find(done->id);
     if (it != callbacks_.end()) {
       Callback callback = std::move(it->second);

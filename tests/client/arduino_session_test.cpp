@@ -1,0 +1,248 @@
+// The Arduino client session against the mock Arduino robot on mem:// in
+// virtual time: every helper, and each timing rule seen on the wire through
+// the session's frame log (stamped with the virtual clock).
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "client/arduino/session.hpp"
+#include "link/executor.hpp"
+#include "link/transport.hpp"
+#include "mocks/arduino.hpp"
+#include "mocks/server.hpp"
+#include "protocol/arduino/codec.hpp"
+#include "sim/presets.hpp"
+#include "sim/world.hpp"
+
+namespace hil::client::arduino {
+namespace {
+
+namespace proto = protocol::arduino;
+using link::milliseconds;
+using link::seconds;
+
+/// The mock robot behind mem://arduino and a session to it, in virtual time.
+struct SessionOnMem : ::testing::Test {
+  void start(ClientConfig config = {}, mocks::ServerOptions options = {}) {
+    world.emplace(sim::WorldDef{});
+    sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
+    firmware = std::make_unique<mocks::ArduinoFirmware>(*world, vehicle);
+    options.listen = link::MemEndpoint{"arduino"};
+    server = std::make_unique<mocks::MockServer>(context, *firmware, std::move(options));
+    server->start();
+    session = std::make_unique<ArduinoSession>(context, link::MemEndpoint{"arduino"}, config);
+    // Log times are the virtual clock in microseconds, so the log shows
+    // exactly when each frame went out.
+    session->set_wall_clock([this] { return executor.now().count() / 1000; });
+    session->set_event_handler([this](const Event& e) {
+      if (auto* l = std::get_if<LinkChanged>(&e)) changes.push_back(*l);
+    });
+    session->open();
+    executor.run_for(Duration::zero());
+    ASSERT_EQ(session->state(), LinkState::open);
+  }
+
+  /// Runs a request to its end; the result and when it came.
+  std::optional<Result> run(
+      const std::function<RequestId(ArduinoSession&, ArduinoSession::Callback)>& f,
+      Duration limit = seconds(30)) {
+    std::optional<Result> result;
+    f(*session, [&](const Result& r) {
+      result = r;
+      done_at = executor.now();
+    });
+    const Time end = executor.now() + limit;
+    while (!result && executor.now() < end) {
+      auto due = executor.next_due();
+      if (!due || *due > end) break;
+      executor.run_until(*due);
+    }
+    return result;
+  }
+
+  std::vector<Time> tx_times() const {
+    std::vector<Time> out;
+    for (auto& e : session->log().entries()) {
+      if (e.direction == LogDirection::tx) out.push_back(milliseconds(e.utc_us / 1000));
+    }
+    return out;
+  }
+
+  link::VirtualExecutor executor;
+  link::TransportContext context{executor};
+  std::optional<sim::World> world;
+  std::unique_ptr<mocks::ArduinoFirmware> firmware;
+  std::unique_ptr<mocks::MockServer> server;
+  std::unique_ptr<ArduinoSession> session;
+  std::vector<LinkChanged> changes;
+  Time done_at{0};
+};
+
+ClientConfig quiet() {
+  ClientConfig c;
+  c.health_check_interval = Duration::zero();
+  return c;
+}
+
+TEST_F(SessionOnMem, EveryHelperGetsTheRobotsAnswer) {
+  start(quiet());
+  auto ok = [](const std::optional<Result>& r) {
+    EXPECT_TRUE(r.has_value());
+    if (!r) return std::string();
+    EXPECT_EQ(r->code, ResultCode::ok) << r->detail;
+    return r->info;
+  };
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ping(cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.set_v(160, cb); })), "160");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.move_cm(10, cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.status(cb); })).rfind("MOVING M:10 PWM=160", 0),
+            0u);
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.stop(cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.raw("R:-90", cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.rotate_deg(30, cb); })), "OK");
+  const std::string sonar = ok(run([](auto& s, auto cb) { return s.sonar(cb); }));
+  EXPECT_FALSE(sonar.empty());
+  EXPECT_EQ(sonar.find_first_not_of("0123456789"), std::string::npos) << sonar;
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ir(cb); })).rfind("L=", 0), 0u);
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.help(cb); })),
+            mocks::ArduinoFirmware::help_text());
+  EXPECT_EQ(firmware->state().last_seq, std::optional<std::uint8_t>(0x09));
+  // Every frame in the log, both ways, with its SEQ.
+  const auto entries = session->log().entries();
+  ASSERT_EQ(entries.size(), 20u);
+  EXPECT_EQ(entries[0].raw, "^00|PING|*10$");
+  EXPECT_EQ(entries[1].raw, "^00|ACK|OK*4D$");
+  EXPECT_EQ(entries[1].direction, LogDirection::rx);
+  EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
+}
+
+TEST_F(SessionOnMem, ARejectedMoveComesBackAsItsNack) {
+  start(quiet());
+  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "M", .count = 1}});
+  auto r = run([](auto& s, auto cb) { return s.move_cm(20, cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::nack);
+  EXPECT_EQ(r->nack, (proto::Nack{std::string("BUSY")}));
+  EXPECT_EQ(r->attempts, 1);
+}
+
+TEST_F(SessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
+  mocks::ServerOptions options;
+  link::FaultRule rule;
+  rule.direction = link::DirectionFilter::to_client;
+  rule.trigger.first = 2;
+  rule.action = link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1};
+  options.faults.rules.push_back(rule);
+  start(quiet(), options);
+  const Time t0 = executor.now();
+  auto r = run([](auto& s, auto cb) { return s.ping(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::ok);
+  EXPECT_EQ(r->attempts, 3);
+  EXPECT_EQ(session->core().parse_errors(), 2u);
+  const auto tx = tx_times();
+  ASSERT_EQ(tx.size(), 3u);
+  EXPECT_EQ(tx[0], t0);
+  EXPECT_EQ(tx[1] - tx[0], milliseconds(600));
+  EXPECT_EQ(tx[2] - tx[1], milliseconds(1200));
+}
+
+TEST_F(SessionOnMem, ANackBadCsIsResentAtOnce) {
+  mocks::ServerOptions options;
+  link::FaultRule rule;
+  rule.direction = link::DirectionFilter::to_car;
+  rule.trigger.first = 1;
+  rule.action = link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1};
+  options.faults.rules.push_back(rule);
+  start(quiet(), options);
+  auto r = run([](auto& s, auto cb) { return s.set_v(200, cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::ok);
+  EXPECT_EQ(r->info, "200");
+  EXPECT_EQ(r->attempts, 1);
+  EXPECT_EQ(r->bad_cs_resends, 1);
+  const auto entries = session->log().entries();
+  ASSERT_EQ(entries.size(), 4u);
+  EXPECT_EQ(entries[1].raw, "^00|NACK|BAD_CS*0F$");
+  EXPECT_EQ(entries[2].direction, LogDirection::tx);
+  EXPECT_EQ(entries[2].raw, entries[0].raw);
+  EXPECT_EQ(entries[2].utc_us, entries[1].utc_us) << "resent the moment the NACK arrived";
+  EXPECT_EQ(firmware->state().pwm, 200);
+}
+
+TEST_F(SessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
+  start(quiet());
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{}});
+  const Time t0 = executor.now();
+  auto r = run([](auto& s, auto cb) { return s.sonar(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::timeout);
+  EXPECT_EQ(r->attempts, 4);
+  EXPECT_EQ(done_at - t0, milliseconds(9000));
+  const auto tx = tx_times();
+  ASSERT_EQ(tx.size(), 4u);
+  EXPECT_EQ(tx[1] - t0, milliseconds(600));
+  EXPECT_EQ(tx[2] - t0, milliseconds(1800));
+  EXPECT_EQ(tx[3] - t0, milliseconds(4200));
+}
+
+TEST_F(SessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
+  start(quiet());
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1}});
+  firmware->arm({.name = "",
+                 .when = {.at = milliseconds(100)},
+                 .action = mocks::SendBytes{proto::encode({0x7F, proto::Ack{"999"}})}});
+  const Time t0 = executor.now();
+  auto r = run([](auto& s, auto cb) { return s.sonar(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::ok);
+  EXPECT_NE(r->info, "999");
+  EXPECT_EQ(r->attempts, 2);
+  EXPECT_EQ(done_at - t0, milliseconds(600));
+  EXPECT_EQ(session->core().stale_frames(), 1u);
+}
+
+TEST_F(SessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
+  start();  // health check after 5 s of quiet
+  // The robot hears nothing for 10 s, then recovers.
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.duration = seconds(10)}});
+  executor.run_until(seconds(20));
+  ASSERT_EQ(changes.size(), 5u);
+  const std::vector<std::pair<LinkState, Time>> expected = {
+      {LinkState::opening, seconds(0)},
+      {LinkState::open, seconds(0)},
+      {LinkState::degraded, seconds(14)},  // PING at 5 s, 9 s of attempts
+      {LinkState::reconnecting, milliseconds(14500)},
+      {LinkState::open, milliseconds(14500)}};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(changes[i].to, expected[i].first) << i;
+    EXPECT_EQ(changes[i].at, expected[i].second) << i;
+  }
+  EXPECT_EQ(server->clients_served(), 2u);
+  EXPECT_EQ(firmware->state().boots, 3u) << "power-on and a reset per port opening";
+  auto r = run([](auto& s, auto cb) { return s.ping(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::ok);
+}
+
+TEST_F(SessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
+  ClientConfig config = quiet();
+  config.max_reconnect_attempts = 2;
+  start(config);
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{}});
+  auto r = run([](auto& s, auto cb) { return s.ping(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::timeout);
+  executor.run_until(seconds(60));
+  ASSERT_FALSE(changes.empty());
+  EXPECT_EQ(changes.back().to, LinkState::down);
+  // 9 s, +0.5 s, +4.2 s of reconnect PING, +1 s, +4.2 s.
+  EXPECT_EQ(changes.back().at, milliseconds(9000 + 500 + 4200 + 1000 + 4200));
+}
+
+}  // namespace
+}  // namespace hil::client::arduino
