@@ -1,0 +1,72 @@
+// The Arduino client session over a real pty at 9600 baud against the mock
+// robot, under the real-time driver. Waits are bounded and generous.
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <asio/io_context.hpp>
+
+#include "client/arduino/session.hpp"
+#include "link/asio_executor.hpp"
+#include "link/endpoint.hpp"
+#include "mocks/arduino.hpp"
+#include "mocks/server.hpp"
+#include "sim/presets.hpp"
+#include "sim/world.hpp"
+#include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/serial_support.hpp"
+
+namespace hil::client::arduino {
+namespace {
+
+TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) {
+  mocks::test::TempDir dir("hil-arduino-client");
+  const std::string uri = "pty://" + (dir.path / "arduino0").string() + "?baud=9600";
+  asio::io_context io;
+  link::AsioExecutor executor{io};
+  link::TransportContext context{executor, &io};
+  sim::World world(sim::WorldDef{});
+  sim::Vehicle& vehicle = world.add_vehicle(sim::arduino_robot());
+  mocks::ArduinoFirmware firmware(world, vehicle);
+  mocks::MockServer server(context, firmware, {.listen = link::parse_endpoint(uri)});
+  server.start();
+
+  ArduinoSession session(context, link::parse_endpoint(uri));
+  session.open();
+  ASSERT_TRUE(link::test::run_until(io, [&] { return session.state() == LinkState::open; }))
+      << "the port never opened";
+
+  auto run = [&](auto submit) {
+    std::optional<Result> result;
+    submit(session, [&](const Result& r) { result = r; });
+    EXPECT_TRUE(link::test::run_until(io, [&] { return result.has_value(); }));
+    return result.value_or(Result{});
+  };
+  auto ping = run([](auto& s, auto cb) { return s.ping(cb); });
+  EXPECT_EQ(ping.code, ResultCode::ok) << ping.detail;
+  EXPECT_EQ(ping.info, "OK");
+  auto v = run([](auto& s, auto cb) { return s.set_v(180, cb); });
+  EXPECT_EQ(v.info, "180");
+  auto status = run([](auto& s, auto cb) { return s.status(cb); });
+  EXPECT_EQ(status.info.rfind("IDLE PWM=180 ", 0), 0u) << status.info;
+  auto bad = run([](auto& s, auto cb) { return s.raw("R:99999", cb); });
+  EXPECT_EQ(bad.code, ResultCode::invalid_request);
+  auto turn = run([](auto& s, auto cb) { return s.raw("R:-90", cb); });
+  EXPECT_EQ(turn.info, "OK");
+  EXPECT_EQ(firmware.state().pwm, 180);
+
+  const auto entries = session.log().entries();
+  ASSERT_GE(entries.size(), 8u);
+  EXPECT_EQ(entries[0].raw, "^00|PING|*10$");
+  EXPECT_EQ(entries[0].direction, LogDirection::tx);
+  EXPECT_EQ(entries[1].direction, LogDirection::rx);
+  EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
+  session.close();
+  EXPECT_EQ(session.state(), LinkState::closed);
+}
+
+}  // namespace
+}  // namespace hil::client::arduino
