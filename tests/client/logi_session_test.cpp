@@ -1,0 +1,250 @@
+// The LOGI client session against the mock LOGI car on mem:// in virtual
+// time: the auto transport flow, retries against a car that ignores SP, the
+// switch to MAN, and the reconnect timeline after a reset connection.
+
+#include "client/logi/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "link/executor.hpp"
+#include "link/transport.hpp"
+#include "mocks/logi.hpp"
+#include "mocks/server.hpp"
+#include "sim/presets.hpp"
+#include "sim/world.hpp"
+
+namespace hil::client::logi {
+namespace {
+
+using link::milliseconds;
+using link::seconds;
+using proto::Direction;
+using proto::Mode;
+
+/// The mock car on mem://car and a session pointed at it, in virtual time.
+class VirtualBench {
+ public:
+  explicit VirtualBench(mocks::ServerOptions options = {}, ClientConfig config = {})
+      : vehicle_(world_.add_vehicle(sim::logi_car())), firmware_(world_, vehicle_) {
+    options.listen = link::MemEndpoint{"car"};
+    options.name = "logi";
+    server_ = std::make_unique<mocks::MockServer>(context_, firmware_, std::move(options));
+    server_->start();
+    session_ = std::make_unique<LogiSession>(
+        context_, link::MemEndpoint{"car"}, std::move(config),
+        [this](Time now, const Event& e) { events_.emplace_back(now, e); });
+  }
+
+  LogiSession& session() { return *session_; }
+  mocks::LogiFirmware& firmware() { return firmware_; }
+  mocks::MockServer& server() { return *server_; }
+  link::VirtualExecutor& executor() { return executor_; }
+  Time now() const { return executor_.now(); }
+  void run_until(Time t) { executor_.run_until(t); }
+  void run_for(link::Duration d) { executor_.run_for(d); }
+
+  /// Runs until `done()` holds, in 10 ms steps, for at most `limit`.
+  template <class Pred>
+  bool run_until(Pred done, link::Duration limit) {
+    const Time end = now() + limit;
+    while (!done()) {
+      if (now() >= end) return false;
+      executor_.run_for(milliseconds(10));
+    }
+    return true;
+  }
+
+  void connect() {
+    session_->connect();
+    executor_.run_for(milliseconds(1));
+    ASSERT_EQ(session_->core().state(), ConnectionState::connected);
+  }
+
+  template <class E>
+  std::vector<std::pair<Time, E>> of() const {
+    std::vector<std::pair<Time, E>> out;
+    for (auto& [t, e] : events_) {
+      if (auto* x = std::get_if<E>(&e)) out.emplace_back(t, *x);
+    }
+    return out;
+  }
+  std::vector<std::pair<Time, CommandEvent>> commands(CommandState state) const {
+    std::vector<std::pair<Time, CommandEvent>> out;
+    for (auto& [t, e] : of<CommandEvent>()) {
+      if (e.state == state) out.emplace_back(t, e);
+    }
+    return out;
+  }
+  /// (time, raw) of every frame the client sent.
+  std::vector<std::pair<Time, std::string>> sent() const {
+    std::vector<std::pair<Time, std::string>> out;
+    for (const auto& e : session_->log()->snapshot()) {
+      if (e.kind == LogKind::tx) out.emplace_back(e.at, e.raw);
+    }
+    return out;
+  }
+
+ private:
+  link::VirtualExecutor executor_;
+  link::TransportContext context_{executor_};
+  sim::World world_{sim::WorldDef{}};
+  sim::Vehicle& vehicle_;
+  mocks::LogiFirmware firmware_;
+  std::unique_ptr<mocks::MockServer> server_;
+  std::unique_ptr<LogiSession> session_;
+  std::vector<std::pair<Time, Event>> events_;
+};
+
+TEST(LogiSession, AutoTransportFlowToStation002Completes) {
+  VirtualBench b;
+  b.connect();
+  const auto sp = b.session().submit(proto::SetSpeed{50});
+  const auto md = b.session().submit(proto::SetMode{Mode::automatic});
+  const auto gs = b.session().submit(proto::SetStation{2});
+  const auto run = b.session().submit(proto::SetRun{true});
+  ASSERT_TRUE(sp && md && gs && run);
+  b.run_for(milliseconds(100));
+  std::vector<RequestId> accepted;
+  for (auto& [t, e] : b.commands(CommandState::accepted))
+    accepted.push_back(e.request);
+  EXPECT_EQ(accepted, (std::vector<RequestId>{sp.request, md.request, gs.request, run.request}));
+  EXPECT_TRUE(b.firmware().state().running);
+  bool saw_running = false;
+  ASSERT_TRUE(b.run_until(
+      [&] {
+        const auto& s = b.session().core().last_status();
+        if (s && s->running) saw_running = true;
+        return saw_running && s && !s->running;
+      },
+      seconds(60)));
+  const auto& s = *b.session().core().last_status();
+  EXPECT_EQ(s.station, 2);
+  EXPECT_EQ(b.firmware().state().arrivals, 1u);
+  EXPECT_EQ(b.firmware().state().last_run_end, mocks::LogiRunEnd::arrived);
+  EXPECT_FALSE(b.session().core().stale());
+  EXPECT_TRUE(b.of<ParseErrorEvent>().empty());
+}
+
+TEST(LogiSession, ACarThatIgnoresSpGetsTwoRetriesThenTheCommandIsUncertain) {
+  VirtualBench b;
+  b.firmware().arm(mocks::Behaviour{"deaf to SP", {}, mocks::Ignore{"SP", {}, {}}});
+  b.connect();
+  const Time t0 = b.now();
+  const auto sp = b.session().submit(proto::SetSpeed{30});
+  b.session().submit(proto::SetMode{Mode::manual});
+  b.run_for(seconds(3));
+  const auto tx = b.sent();
+  ASSERT_GE(tx.size(), 4u);
+  EXPECT_EQ(tx[0], (std::pair<Time, std::string>{t0, "LOGI:SP:030:D5#"}));
+  EXPECT_EQ(tx[1], (std::pair<Time, std::string>{t0 + milliseconds(800), "LOGI:SP:030:D5#"}));
+  EXPECT_EQ(tx[2], (std::pair<Time, std::string>{t0 + milliseconds(1600), "LOGI:SP:030:D5#"}));
+  EXPECT_EQ(tx[3], (std::pair<Time, std::string>{t0 + milliseconds(2400), "LOGI:MD:MAN:0C#"}));
+  const auto unc = b.commands(CommandState::uncertain);
+  ASSERT_EQ(unc.size(), 1u);
+  EXPECT_EQ(unc[0].first, t0 + milliseconds(2400));
+  EXPECT_EQ(unc[0].second.request, sp.request);
+  EXPECT_EQ(b.firmware().state().mode, Mode::manual) << "the queue went on after the SP";
+}
+
+TEST(LogiSession, AMoveInAutoSwitchesTheCarToManAndDrives) {
+  VirtualBench b;
+  b.connect();
+  b.session().submit(proto::SetSpeed{50});
+  b.session().submit(proto::SetMode{Mode::automatic});
+  b.run_for(milliseconds(10));
+  const auto mv = b.session().press(Direction::fwd);
+  ASSERT_TRUE(mv);
+  b.run_for(milliseconds(10));
+  ASSERT_EQ(b.of<NoticeEvent>().size(), 1u);
+  EXPECT_EQ(b.of<NoticeEvent>()[0].second.text, "Not in manual mode, switching to MAN");
+  EXPECT_EQ(b.firmware().state().mode, Mode::manual);
+  EXPECT_EQ(b.firmware().state().manual, Direction::fwd);
+  const auto acc = b.commands(CommandState::accepted);
+  ASSERT_FALSE(acc.empty());
+  EXPECT_EQ(acc.back().second.request, mv.request);
+  b.session().release();
+  b.run_for(milliseconds(10));
+  EXPECT_EQ(b.firmware().state().manual, Direction::stop);
+}
+
+TEST(LogiSession, EmergencyStopEndsAnAutoRun) {
+  VirtualBench b;
+  b.connect();
+  b.session().submit(proto::SetSpeed{50});
+  b.session().submit(proto::SetMode{Mode::automatic});
+  b.session().submit(proto::SetStation{2});
+  b.session().submit(proto::SetRun{true});
+  b.run_for(seconds(2));
+  ASSERT_TRUE(b.firmware().state().running);
+  b.session().emergency_stop();
+  b.run_for(milliseconds(10));
+  EXPECT_FALSE(b.firmware().state().running);
+  EXPECT_EQ(b.firmware().state().last_run_end, mocks::LogiRunEnd::stopped);
+}
+
+TEST(LogiSession, MutedTelemetryRaisesStaleAfter2sAndItClearsWhenStatReturns) {
+  VirtualBench b;
+  b.connect();
+  b.run_until(seconds(1));  // STATs at 500 ms and 1000 ms
+  b.firmware().arm(mocks::Behaviour{"mute", {}, mocks::MuteTelemetry{seconds(3)}});
+  b.run_until(seconds(6));
+  const auto stale = b.of<StaleEvent>();
+  ASSERT_EQ(stale.size(), 2u);
+  EXPECT_TRUE(stale[0].second.stale);
+  EXPECT_EQ(stale[0].first, seconds(3)) << "2 s after the STAT of 1000 ms";
+  EXPECT_FALSE(stale[1].second.stale);
+}
+
+TEST(LogiSession, AResetConnectionIsFollowedByReconnectAttemptsAt1s3s6s9s) {
+  VirtualBench b;
+  b.firmware().arm(mocks::Behaviour{"hang up", mocks::When{seconds(2), {}, 1},
+                                    mocks::CloseConnection{link::CloseMode::reset}});
+  b.connect();
+  b.session().submit(proto::SetSpeed{50});
+  b.session().submit(proto::SetMode{Mode::manual});
+  b.run_until(seconds(2));
+  ASSERT_NE(b.session().core().state(), ConnectionState::connected);
+  Time dropped{0};
+  for (auto& [t, e] : b.of<ConnectionEvent>()) {
+    if (e.state == ConnectionState::waiting_to_reconnect) {
+      dropped = t;
+      break;
+    }
+  }
+  EXPECT_EQ(dropped, seconds(2));
+  EXPECT_FALSE(b.session().core().movement_enabled());
+  b.server().close();  // the car is gone: every attempt is refused
+  b.run_until(seconds(12));
+  std::vector<Time> attempts;
+  for (auto& [t, e] : b.of<ConnectionEvent>()) {
+    if (e.state == ConnectionState::connecting && t > seconds(2)) attempts.push_back(t);
+  }
+  EXPECT_EQ(attempts, (std::vector<Time>{seconds(3), seconds(5), seconds(8), seconds(11)}));
+  // The car comes back: the next attempt connects, and movement waits for MD and SP.
+  b.server().start();
+  b.run_until(seconds(14) + milliseconds(1));
+  EXPECT_EQ(b.session().core().state(), ConnectionState::connected);
+  EXPECT_EQ(b.session().press(Direction::fwd).refusal, Refusal::mode_speed_unconfirmed);
+  b.session().submit(proto::SetMode{Mode::manual});
+  b.session().submit(proto::SetSpeed{40});
+  EXPECT_TRUE(b.session().press(Direction::fwd));
+  b.run_for(milliseconds(10));
+  EXPECT_EQ(b.firmware().state().manual, Direction::fwd);
+}
+
+TEST(LogiSession, DisconnectOnRequestStaysDisconnected) {
+  VirtualBench b;
+  b.connect();
+  b.session().disconnect();
+  b.run_for(seconds(10));
+  EXPECT_EQ(b.session().core().state(), ConnectionState::disconnected);
+  EXPECT_FALSE(b.server().client_connected());
+  EXPECT_EQ(b.server().clients_served(), 1u);
+}
+
+}  // namespace
+}  // namespace hil::client::logi
