@@ -26,7 +26,7 @@ using link::milliseconds;
 using link::seconds;
 
 /// The mock robot behind mem://arduino and a session to it, in virtual time.
-struct SessionOnMem : ::testing::Test {
+struct ArduinoSessionOnMem : ::testing::Test {
   void start(ClientConfig config = {}, mocks::ServerOptions options = {}) {
     world.emplace(sim::WorldDef{});
     sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
@@ -88,7 +88,7 @@ ClientConfig quiet() {
   return c;
 }
 
-TEST_F(SessionOnMem, EveryHelperGetsTheRobotsAnswer) {
+TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   start(quiet());
   auto ok = [](const std::optional<Result>& r) {
     EXPECT_TRUE(r.has_value());
@@ -120,7 +120,7 @@ TEST_F(SessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
 }
 
-TEST_F(SessionOnMem, ARejectedMoveComesBackAsItsNack) {
+TEST_F(ArduinoSessionOnMem, ARejectedMoveComesBackAsItsNack) {
   start(quiet());
   firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "M", .count = 1}});
   auto r = run([](auto& s, auto cb) { return s.move_cm(20, cb); });
@@ -130,7 +130,7 @@ TEST_F(SessionOnMem, ARejectedMoveComesBackAsItsNack) {
   EXPECT_EQ(r->attempts, 1);
 }
 
-TEST_F(SessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
+TEST_F(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
   mocks::ServerOptions options;
   link::FaultRule rule;
   rule.direction = link::DirectionFilter::to_client;
@@ -151,7 +151,7 @@ TEST_F(SessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
   EXPECT_EQ(tx[2] - tx[1], milliseconds(1200));
 }
 
-TEST_F(SessionOnMem, ANackBadCsIsResentAtOnce) {
+TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
   mocks::ServerOptions options;
   link::FaultRule rule;
   rule.direction = link::DirectionFilter::to_car;
@@ -174,7 +174,7 @@ TEST_F(SessionOnMem, ANackBadCsIsResentAtOnce) {
   EXPECT_EQ(firmware->state().pwm, 200);
 }
 
-TEST_F(SessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
+TEST_F(ArduinoSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
   start(quiet());
   firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{}});
   const Time t0 = executor.now();
@@ -190,7 +190,7 @@ TEST_F(SessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
   EXPECT_EQ(tx[3] - t0, milliseconds(4200));
 }
 
-TEST_F(SessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
+TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   start(quiet());
   firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1}});
   firmware->arm({.name = "",
@@ -206,7 +206,7 @@ TEST_F(SessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   EXPECT_EQ(session->core().stale_frames(), 1u);
 }
 
-TEST_F(SessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
+TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
   start();  // health check after 5 s of quiet
   // The robot hears nothing for 10 s, then recovers.
   firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.duration = seconds(10)}});
@@ -229,7 +229,7 @@ TEST_F(SessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotCome
   EXPECT_EQ(r->code, ResultCode::ok);
 }
 
-TEST_F(SessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
+TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
   ClientConfig config = quiet();
   config.max_reconnect_attempts = 2;
   start(config);
