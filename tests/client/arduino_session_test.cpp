@@ -244,5 +244,26 @@ TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
   EXPECT_EQ(changes.back().at, milliseconds(9000 + 500 + 4200 + 1000 + 4200));
 }
 
+TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueuedRequestsGoOut) {
+  start(quiet());
+  firmware->arm({.name = "", .when = {.at = seconds(1)}, .action = mocks::CloseConnection{}});
+  executor.run_until(seconds(1));
+  ASSERT_EQ(session->state(), LinkState::degraded);
+  EXPECT_EQ(changes.back().at, seconds(1));
+  std::optional<Result> queued;
+  session->sonar([&](const Result& r) {
+    queued = r;
+    done_at = executor.now();
+  });
+  executor.run_until(seconds(3));
+  EXPECT_EQ(session->state(), LinkState::open);
+  EXPECT_EQ(changes.back().at, milliseconds(1500));
+  ASSERT_TRUE(queued.has_value());
+  EXPECT_EQ(queued->code, ResultCode::ok);
+  EXPECT_EQ(done_at, milliseconds(1500)) << "sent right after the reconnect PING's ACK";
+  // The reconnect PING took the next SEQ, the queued request the one after.
+  EXPECT_EQ(queued->seq, std::optional<std::uint8_t>(0x01));
+}
+
 }  // namespace
 }  // namespace hil::client::arduino
