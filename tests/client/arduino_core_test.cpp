@@ -3,6 +3,7 @@
 // backoff, DOWN) checked at the exact nanosecond.
 
 #include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
 
 #include <string>
 #include <vector>
@@ -434,6 +435,57 @@ TEST(ArduinoClientCore, RequestsBeforeOpenOrAfterCloseEndAsLinkDown) {
     EXPECT_EQ(d.result.code, ResultCode::link_down);
   EXPECT_EQ(h.core.state(), LinkState::closed);
   EXPECT_EQ(h.closes.size(), 1u);
+}
+
+RC_GTEST_PROP(ArduinoClientCoreProperties, AnyChunkingOfNoiseStaleAndRightAnswersGivesTheSameResult,
+              (std::uint8_t first_seq, std::uint8_t stale_offset)) {
+  const auto info = *rc::gen::container<std::string>(
+      rc::gen::suchThat(rc::gen::inRange<char>(0x20, 0x7F), proto::is_field_char));
+  Harness h(no_health_check());
+  h.open_now();
+  // Use up SEQs so the request carries `first_seq`.
+  for (int i = 0; i < first_seq; ++i) {
+    h.submit([](auto& c, Time t) { return c.ping(t); });
+    h.answer(h.sent.back().seq, proto::Ack{"OK"});
+  }
+  h.done.clear();
+  h.submit([](auto& c, Time t) { return c.status(t); });
+  RC_ASSERT(h.sent.back().seq == first_seq);
+  const auto stale = static_cast<std::uint8_t>(first_seq + 1 + stale_offset % 255);
+  const std::string stream = "\r\n" + proto::encode_text({stale, proto::Ack{"stale"}}) +
+                             proto::encode_text({first_seq, proto::Ack{info}});
+  const auto bytes = protocol::to_bytes(stream);
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    const auto n = *rc::gen::inRange<std::size_t>(1, bytes.size() - at + 1);
+    h.core.on_bytes(h.now, ByteView(bytes).subspan(at, n));
+    h.collect();
+    at += n;
+  }
+  RC_ASSERT(h.done.size() == 1u);
+  RC_ASSERT(h.done[0].result.code == ResultCode::ok);
+  RC_ASSERT(h.done[0].result.info == info);
+  RC_ASSERT(h.done[0].result.attempts == 1);
+  RC_ASSERT(h.core.stale_frames() == 1u);
+}
+
+RC_GTEST_PROP(ArduinoClientCoreProperties,
+              TheAnswerAfterKLostAttemptsEndsTheRequestOnTheDoublingSchedule, ()) {
+  const int lost = *rc::gen::inRange(0, 4);
+  const auto base_ms = *rc::gen::inRange(1, 2000);
+  ClientConfig config = no_health_check();
+  config.base_timeout = milliseconds(base_ms);
+  Harness h(config);
+  h.open_now();
+  h.submit([](auto& c, Time t) { return c.ping(t); });
+  // Attempt k goes out at base * (2^k - 1).
+  const Time sent_at = milliseconds(base_ms) * ((1 << lost) - 1);
+  h.run_until(sent_at);
+  RC_ASSERT(h.sent.size() == static_cast<std::size_t>(lost + 1));
+  RC_ASSERT(h.sent.back().at == sent_at);
+  h.answer(0x00, proto::Ack{"OK"});
+  RC_ASSERT(h.done.size() == 1u);
+  RC_ASSERT(h.done[0].result.attempts == lost + 1);
 }
 
 }  // namespace
