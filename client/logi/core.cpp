@@ -231,14 +231,15 @@ SubmitResult LogiClientCore::emergency_stop(Time now) {
   keepalive_at_.reset();
   if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
   // Queued motion would undo the stop once its turn came.
-  for (auto it = queue_.begin(); it != queue_.end();) {
-    if (is_movement(it->command)) {
-      emit(CommandEvent{it->id, it->command, CommandState::cancelled, it->attempt, false});
-      it = queue_.erase(it);
+  std::deque<Pending> kept;
+  for (auto& p : queue_) {
+    if (is_movement(p.command)) {
+      emit(CommandEvent{p.id, p.command, CommandState::cancelled, p.attempt, false});
     } else {
-      ++it;
+      kept.push_back(std::move(p));
     }
   }
+  queue_ = std::move(kept);
   note(now, "emergency stop");
   // Written at once, beside whatever is in flight: a stop must not wait up
   // to a feedback timeout (and its retries) behind an unanswered command.
