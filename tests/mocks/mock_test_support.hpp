@@ -79,6 +79,8 @@ class VirtualCar {
   link::Time now() const { return executor_.now(); }
 
   link::VirtualExecutor& executor() { return executor_; }
+  /// For a client session of its own to connect to mem://car.
+  link::TransportContext& context() { return context_; }
   sim::World& world() { return world_; }
   sim::Vehicle& vehicle() { return vehicle_; }
   FirmwareT& firmware() { return *firmware_; }
