@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "link/executor.hpp"
+#include "link/faults/profile.hpp"
 #include "link/transport.hpp"
 #include "mocks/logi.hpp"
 #include "mocks/server.hpp"
@@ -244,6 +245,73 @@ TEST(LogiSession, DisconnectOnRequestStaysDisconnected) {
   EXPECT_EQ(b.session().core().state(), ConnectionState::disconnected);
   EXPECT_FALSE(b.server().client_connected());
   EXPECT_EQ(b.server().clients_served(), 1u);
+}
+
+TEST(LogiSession, FramesSplitIntoPiecesAndStuckTogetherAllArrive) {
+  mocks::ServerOptions options;
+  link::FaultRule split;
+  split.name = "split";
+  split.direction = link::DirectionFilter::to_client;
+  split.trigger.match = "STAT";
+  split.action = link::Fragment{{1, 3}, {milliseconds(1), milliseconds(2)}};
+  options.faults.rules.push_back(split);
+  link::FaultRule stick;
+  stick.name = "stick";
+  stick.direction = link::DirectionFilter::to_client;
+  stick.trigger.match = "FB";
+  stick.action = link::Coalesce{2, seconds(1)};
+  options.faults.rules.push_back(stick);
+  VirtualBench b(options);
+  b.connect();
+  b.session().submit(proto::SetSpeed{50});
+  b.session().submit(proto::SetMode{Mode::manual});
+  b.run_until(seconds(5) + milliseconds(100));  // the last STAT's pieces take a few ms
+  EXPECT_GE(b.server().faults_injected(), 11u) << "ten STATs split, FBs stuck together";
+  EXPECT_TRUE(b.of<ParseErrorEvent>().empty());
+  EXPECT_EQ(b.of<StatusEvent>().size(), 10u) << "STAT at 500 ms ... 5000 ms";
+  EXPECT_EQ(b.commands(CommandState::accepted).size(), 2u);
+  EXPECT_FALSE(b.session().core().stale());
+}
+
+TEST(LogiSession, AFrameWithABadChecksumIsDroppedAndLoggedAndTheLinkStaysUp) {
+  VirtualBench b;
+  b.firmware().arm(
+      mocks::Behaviour{"noise", mocks::When{seconds(1) + milliseconds(100), {}, 1},
+                       mocks::SendBytes{protocol::Bytes{'L', 'O', 'G', 'I', ':', 'F', 'B', ':', 'S',
+                                                        'P', ':', '1', ':', '0', '0', '#'}}});
+  b.connect();
+  b.run_until(seconds(2));
+  const auto errors = b.of<ParseErrorEvent>();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].first, seconds(1) + milliseconds(100));
+  EXPECT_EQ(errors[0].second.error.kind, protocol::ErrorKind::bad_checksum);
+  EXPECT_TRUE(b.of<FeedbackEvent>().empty());
+  EXPECT_NE(b.session().log()->export_text().find("ERR  LOGI:FB:SP:1:00#  bad_checksum"),
+            std::string::npos)
+      << b.session().log()->export_text();
+  EXPECT_EQ(b.session().core().state(), ConnectionState::connected);
+  EXPECT_EQ(b.of<StatusEvent>().size(), 4u);
+}
+
+TEST(LogiSession, KeepaliveRepeatsTheHeldMoveToTheCarEvery300ms) {
+  ClientConfig config;
+  config.keepalive = true;
+  VirtualBench b({}, config);
+  b.connect();
+  b.session().submit(proto::SetSpeed{50});
+  b.session().submit(proto::SetMode{Mode::manual});
+  b.run_until(milliseconds(100));
+  b.session().press(Direction::cw);
+  b.run_until(milliseconds(950));
+  b.session().release();
+  b.run_until(milliseconds(2000));
+  std::vector<Time> moves;
+  for (const auto& [t, raw] : b.sent()) {
+    if (raw == "LOGI:MV:CW:DC#") moves.push_back(t);
+  }
+  EXPECT_EQ(moves, (std::vector<Time>{milliseconds(100), milliseconds(400), milliseconds(700)}));
+  EXPECT_EQ(b.sent().back(), (std::pair<Time, std::string>{milliseconds(950), "LOGI:MV:STOP:88#"}));
+  EXPECT_EQ(b.firmware().state().manual, Direction::stop);
 }
 
 }  // namespace
