@@ -50,9 +50,10 @@ Link::Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions 
       o->on_fault(e);
   };
   injectors_[index(Direction::to_car)] = std::make_unique<FaultInjector>(
-      Direction::to_car, protocol, std::move(options.to_car), options.seed, sink);
-  injectors_[index(Direction::to_client)] = std::make_unique<FaultInjector>(
-      Direction::to_client, protocol, std::move(options.to_client), options.seed, sink);
+      Direction::to_car, protocol, std::move(options.to_car), options.seed, sink, executor.now());
+  injectors_[index(Direction::to_client)] =
+      std::make_unique<FaultInjector>(Direction::to_client, protocol, std::move(options.to_client),
+                                      options.seed, sink, executor.now());
 }
 
 Link::~Link() {
@@ -84,7 +85,8 @@ void Link::start() {
                                                     }});
   }
   // Timed rules (a reset at 7 s, a stall at 5 s) fire even on a quiet link.
-  for (const auto d : kDirections) schedule(d);
+  for (const auto d : kDirections)
+    schedule(d);
 }
 
 void Link::on_bytes(Direction d, ByteView bytes) {

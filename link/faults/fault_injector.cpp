@@ -535,8 +535,10 @@ struct FaultInjector::State {
 // ---------------------------------------------------------------- FaultInjector
 
 FaultInjector::FaultInjector(Direction direction, std::shared_ptr<const ProtocolAdapter> protocol,
-                             FaultProfile profile, std::uint64_t seed, FaultEventSink sink)
+                             FaultProfile profile, std::uint64_t seed, FaultEventSink sink,
+                             Time start)
     : state_(std::make_unique<State>(direction, std::move(protocol), seed, std::move(sink))) {
+  state_->last_now = start;
   state_->install(std::move(profile));
 }
 

@@ -47,9 +47,12 @@ using InjectorOutput = std::variant<Delivery, LinkBreak>;
 
 class FaultInjector {
  public:
-  /// `protocol` may be the raw adapter (every write is one frame).
+  /// `protocol` may be the raw adapter (every write is one frame). `start`
+  /// is the run time the connection began: time-triggered rules (a reset at
+  /// 7 s) whose time has already passed do not fire on a later connection.
   FaultInjector(Direction direction, std::shared_ptr<const ProtocolAdapter> protocol,
-                FaultProfile profile, std::uint64_t seed, FaultEventSink sink = {});
+                FaultProfile profile, std::uint64_t seed, FaultEventSink sink = {},
+                Time start = Time{0});
   ~FaultInjector();
   FaultInjector(FaultInjector&&) noexcept;
   FaultInjector& operator=(FaultInjector&&) noexcept;

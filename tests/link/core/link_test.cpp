@@ -147,6 +147,16 @@ TEST_F(LinkTest, ResetFaultAbortsBothSides) {
   EXPECT_EQ(recorder->close->mode, CloseMode::reset);
 }
 
+TEST_F(LinkTest, ATimedResetWhoseTimeHasPassedSparesALaterConnection) {
+  ex.run_until(Time(seconds(5)));  // a connection made after the rule's time
+  open("rules: []", "rules:\n  - kind: reset\n    at: 2s\n");
+  ex.run_until(Time(seconds(10)));
+  EXPECT_FALSE(at_client.closed.has_value());
+  EXPECT_FALSE(at_car.closed.has_value());
+  EXPECT_TRUE(recorder->faults.empty());
+  EXPECT_TRUE(link->is_open());
+}
+
 TEST(LinkSeed, SameSeedSameFaultsUnderTheLink) {
   const auto run_once = [](std::uint64_t seed) {
     VirtualExecutor ex;
