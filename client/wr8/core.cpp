@@ -1,0 +1,406 @@
+#include "client/wr8/core.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+namespace hil::client::wr8 {
+
+std::string_view to_string(ConnectionState s) {
+  switch (s) {
+    case ConnectionState::disconnected:
+      return "disconnected";
+    case ConnectionState::connecting:
+      return "connecting";
+    case ConnectionState::authenticating:
+      return "authenticating";
+    case ConnectionState::connected:
+      return "connected";
+    case ConnectionState::waiting_to_reconnect:
+      return "waiting_to_reconnect";
+  }
+  return "?";
+}
+
+std::string_view to_string(RequestState s) {
+  switch (s) {
+    case RequestState::sent:
+      return "sent";
+    case RequestState::started:
+      return "started";
+    case RequestState::completed:
+      return "completed";
+    case RequestState::error:
+      return "error";
+    case RequestState::timed_out:
+      return "timed_out";
+    case RequestState::cancelled:
+      return "cancelled";
+  }
+  return "?";
+}
+
+std::string_view to_string(Refusal r) {
+  switch (r) {
+    case Refusal::none:
+      return "none";
+    case Refusal::not_connected:
+      return "not_connected";
+    case Refusal::bad_request:
+      return "bad_request";
+    case Refusal::busy:
+      return "busy";
+  }
+  return "?";
+}
+
+namespace {
+
+proto::DecoderOptions decoder_options(const proto::Profile& profile) {
+  proto::DecoderOptions o;
+  o.profile = profile;
+  o.sender = proto::Sender::vehicle;
+  return o;
+}
+
+bool is_final(RequestState s) {
+  return s != RequestState::sent && s != RequestState::started;
+}
+
+}  // namespace
+
+Wr8ClientCore::Wr8ClientCore(ClientConfig config, std::shared_ptr<CommLog> log)
+    : config_(std::move(config)), log_(std::move(log)), decoder_(decoder_options(config_.profile)) {
+  if (config_.reconnect_delays.empty())
+    throw std::invalid_argument("wr8 client: reconnect_delays must not be empty");
+}
+
+void Wr8ClientCore::set_state(ConnectionState s, int attempt) {
+  if (s == state_) return;
+  state_ = s;
+  emit(ConnectionEvent{s, attempt});
+}
+
+void Wr8ClientCore::note(Time now, std::string text) {
+  log_->add({now, LogKind::note, {}, std::move(text)});
+}
+
+void Wr8ClientCore::connect(Time now) {
+  want_connected_ = true;
+  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
+      state_ == ConnectionState::connected)
+    return;
+  reconnect_at_.reset();
+  note(now, "connect");
+  set_state(ConnectionState::connecting, reconnect_attempt_);
+  actions_.push_back(OpenConnection{});
+}
+
+void Wr8ClientCore::disconnect(Time now) {
+  want_connected_ = false;
+  reconnect_at_.reset();
+  auth_deadline_.reset();
+  reconnect_attempt_ = 0;
+  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
+      state_ == ConnectionState::connected)
+    actions_.push_back(CloseConnection{});
+  cancel_all();
+  note(now, "disconnect");
+  set_state(ConnectionState::disconnected);
+}
+
+void Wr8ClientCore::on_connected(Time now) {
+  if (state_ != ConnectionState::connecting) return;
+  decoder_ = proto::Decoder(decoder_options(config_.profile));
+  set_state(ConnectionState::authenticating, reconnect_attempt_);
+  auth_deadline_ = now + config_.auth_timeout;
+  send(now, proto::Auth{config_.profile.auth_text});
+}
+
+void Wr8ClientCore::on_connect_failed(Time now) {
+  if (state_ != ConnectionState::connecting) return;
+  login_failed(now, "connect failed");
+}
+
+void Wr8ClientCore::login_failed(Time now, std::string reason) {
+  note(now, "connection failed: " + reason);
+  emit(LoginFailedEvent{std::move(reason)});
+  auth_deadline_.reset();
+  schedule_reconnect(now);
+}
+
+void Wr8ClientCore::on_closed(Time now) {
+  if (state_ == ConnectionState::authenticating) {
+    login_failed(now, "closed before AUTH-REPLY");
+  } else if (state_ == ConnectionState::connected) {
+    lost(now, "connection closed by the vehicle");
+  }
+}
+
+void Wr8ClientCore::lost(Time now, std::string_view why) {
+  note(now, std::string(why));
+  cancel_all();
+  schedule_reconnect(now);
+}
+
+void Wr8ClientCore::cancel_all() {
+  for (std::size_t coi = 0; coi < pending_.size(); ++coi) {
+    if (pending_[coi]) finish(static_cast<std::uint8_t>(coi), RequestState::cancelled);
+  }
+}
+
+void Wr8ClientCore::schedule_reconnect(Time now) {
+  if (!want_connected_) {
+    set_state(ConnectionState::disconnected);
+    return;
+  }
+  const auto& delays = config_.reconnect_delays;
+  const std::size_t i =
+      std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), delays.size() - 1);
+  ++reconnect_attempt_;
+  reconnect_at_ = now + delays[i];
+  set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
+}
+
+void Wr8ClientCore::on_bytes(Time now, protocol::ByteView bytes) {
+  if (state_ != ConnectionState::authenticating && state_ != ConnectionState::connected) return;
+  items_.clear();
+  decoder_.feed(bytes, items_);
+  for (const auto& item : items_) {
+    if (const auto* err = std::get_if<protocol::DecodeError>(&item)) {
+      log_->add({now, LogKind::parse_error, protocol::to_hex(err->raw),
+                 std::string(protocol::to_string(err->kind)) + ": " + err->detail});
+      emit(ParseErrorEvent{*err});
+      continue;
+    }
+    const auto& frame = std::get<protocol::Frame<proto::Message>>(item);
+    log_->add({now, LogKind::rx, protocol::to_hex(frame.raw),
+               proto::describe(frame.message, config_.profile)});
+    handle(now, frame.message);
+    // A login failure or close inside handle() ends this connection's bytes.
+    if (state_ != ConnectionState::authenticating && state_ != ConnectionState::connected) break;
+  }
+}
+
+void Wr8ClientCore::handle(Time now, const proto::Message& message) {
+  if (const auto* reply = std::get_if<proto::AuthReply>(&message)) {
+    if (state_ == ConnectionState::authenticating) {
+      auth_deadline_.reset();
+      reconnect_attempt_ = 0;
+      set_state(ConnectionState::connected);
+      emit(LoginEvent{*reply});
+    }
+    return;
+  }
+  if (state_ != ConnectionState::connected) {
+    note(now, "ignored before login");
+    return;
+  }
+  if (const auto* data = std::get_if<proto::Data>(&message)) {
+    LiveState live;
+    live.state = data->state;
+    live.timestamp_ms = data->timestamp_ms;
+    live.received = now;
+    for (const auto& v : data->values) {
+      const double x = value_of(v);
+      switch (v.code) {
+        case proto::data_code::odometry:
+          live.odometry_cm = x;
+          break;
+        case proto::data_code::speed:
+          live.speed_mps = x;
+          break;
+        case proto::data_code::wheel_angle:
+          live.wheel_angle_deg = x;
+          break;
+        case proto::data_code::battery:
+          live.battery_percent = x;
+          break;
+        default:
+          break;
+      }
+    }
+    live_ = live;
+    emit(TelemetryEvent{live});
+    if (stale_) {
+      stale_ = false;
+      emit(StaleEvent{false});
+    }
+  } else if (const auto* r = std::get_if<proto::Response>(&message)) {
+    on_response(now, *r);
+  } else if (const auto* s = std::get_if<proto::Settings>(&message)) {
+    auto& p = pending_[s->coi];
+    if (!p || p->kind != RequestKind::task || p->task != proto::TaskCode::get_settings) {
+      ignored(now, message);
+      return;
+    }
+    settings_ = s->params;
+    emit(SettingsEvent{s->coi, s->params});
+    if (!p->started) {
+      // SETTINGS is the first answer; completion must follow as for a started task.
+      p->started = true;
+      p->deadline = now + config_.completion_timeout[static_cast<std::size_t>(p->task)];
+    }
+  }
+}
+
+void Wr8ClientCore::on_response(Time now, const proto::Response& r) {
+  auto& p = pending_[r.coi];
+  if (!p) {
+    ignored(now, r);
+    return;
+  }
+  switch (r.code) {
+    case proto::ResponseCode::started:
+      if (p->started) {
+        ignored(now, r);
+        return;
+      }
+      p->started = true;
+      p->deadline = now + (p->kind == RequestKind::task
+                               ? config_.completion_timeout[static_cast<std::size_t>(p->task)]
+                               : config_.answer_timeout);
+      emit(RequestEvent{r.coi, p->kind, p->task, RequestState::started});
+      break;
+    case proto::ResponseCode::completed:
+      finish(r.coi, RequestState::completed);
+      break;
+    case proto::ResponseCode::error:
+      finish(r.coi, RequestState::error);
+      break;
+  }
+}
+
+void Wr8ClientCore::finish(std::uint8_t coi, RequestState state) {
+  auto& p = pending_[coi];
+  if (!p || !is_final(state)) return;
+  emit(RequestEvent{coi, p->kind, p->task, state});
+  p.reset();
+}
+
+void Wr8ClientCore::ignored(Time now, const proto::Message& message) {
+  note(now, "ignored (late or unknown COI): " + proto::describe(message, config_.profile));
+  emit(IgnoredEvent{message});
+}
+
+double Wr8ClientCore::value_of(const proto::DataValue& v) const {
+  const auto* row = config_.profile.data_parameter(v.code);
+  if (!row) return static_cast<double>(v.value.as_i32());
+  switch (row->type) {
+    case proto::ValueType::float32:
+      return static_cast<double>(v.value.as_f32());
+    case proto::ValueType::unsigned_int:
+      return static_cast<double>(v.value.bits);
+    case proto::ValueType::signed_int: {
+      // Narrow values sit in the low bits: shift up and back to extend the sign.
+      const int shift = 32 - 8 * row->size_bytes;
+      return static_cast<double>(static_cast<std::int32_t>(v.value.bits << shift) >> shift);
+    }
+  }
+  return 0;
+}
+
+void Wr8ClientCore::send(Time now, const proto::Message& message) {
+  protocol::Bytes bytes = proto::encode(message, config_.profile);
+  log_->add({now, LogKind::tx, protocol::to_hex(bytes), proto::describe(message, config_.profile)});
+  actions_.push_back(SendBytes{std::move(bytes)});
+}
+
+SubmitResult Wr8ClientCore::send_request(Time now, RequestKind kind, proto::TaskCode task,
+                                         const proto::Message& message) {
+  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  // The next free COI after the last one used, wrapping FF -> 00.
+  std::optional<std::uint8_t> coi;
+  for (int i = 0; i < 256; ++i) {
+    const auto c = static_cast<std::uint8_t>(next_coi_ + i);
+    if (!pending_[c]) {
+      coi = c;
+      break;
+    }
+  }
+  if (!coi) return {0, Refusal::busy};
+  proto::Message m = message;
+  if (auto* t = std::get_if<proto::Task>(&m)) t->coi = *coi;
+  if (auto* s = std::get_if<proto::Settings>(&m)) s->coi = *coi;
+  protocol::Bytes bytes;
+  try {
+    bytes = proto::encode(m, config_.profile);
+  } catch (const std::invalid_argument&) {
+    return {0, Refusal::bad_request};
+  }
+  log_->add({now, LogKind::tx, protocol::to_hex(bytes), proto::describe(m, config_.profile)});
+  actions_.push_back(SendBytes{std::move(bytes)});
+  next_coi_ = static_cast<std::uint8_t>(*coi + 1);
+  pending_[*coi] = Pending{kind, task, false, now + config_.answer_timeout};
+  emit(RequestEvent{*coi, kind, task, RequestState::sent});
+  return {*coi, Refusal::none};
+}
+
+SubmitResult Wr8ClientCore::task(Time now, proto::TaskCode code, std::vector<proto::Word> params) {
+  return send_request(now, RequestKind::task, code, proto::Task{0, code, std::move(params)});
+}
+
+SubmitResult Wr8ClientCore::drive(Time now, std::int32_t distance_cm) {
+  return task(now, proto::TaskCode::drive, {proto::Word::from_i32(distance_cm)});
+}
+
+SubmitResult Wr8ClientCore::turn(Time now, std::int32_t angle_deg) {
+  return task(now, proto::TaskCode::turn, {proto::Word::from_i32(angle_deg)});
+}
+
+SubmitResult Wr8ClientCore::get_settings(Time now) {
+  return task(now, proto::TaskCode::get_settings);
+}
+
+SubmitResult Wr8ClientCore::set_settings(Time now, std::vector<proto::Setting> settings) {
+  return send_request(now, RequestKind::settings, proto::TaskCode::check,
+                      proto::Settings{0, std::move(settings)});
+}
+
+std::size_t Wr8ClientCore::open_requests() const {
+  return static_cast<std::size_t>(
+      std::count_if(pending_.begin(), pending_.end(), [](const auto& p) { return p.has_value(); }));
+}
+
+void Wr8ClientCore::on_timer(Time now) {
+  if (reconnect_at_ && now >= *reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) {
+    reconnect_at_.reset();
+    note(now, "reconnect attempt " + std::to_string(reconnect_attempt_));
+    set_state(ConnectionState::connecting, reconnect_attempt_);
+    actions_.push_back(OpenConnection{});
+  }
+  if (auth_deadline_ && now >= *auth_deadline_ && state_ == ConnectionState::authenticating) {
+    actions_.push_back(CloseConnection{});
+    login_failed(now, "AUTH-REPLY timeout");
+  }
+  if (state_ != ConnectionState::connected) return;
+  for (std::size_t coi = 0; coi < pending_.size(); ++coi) {
+    if (pending_[coi] && now >= pending_[coi]->deadline) {
+      note(now, "COI " + std::to_string(coi) + " timed out");
+      finish(static_cast<std::uint8_t>(coi), RequestState::timed_out);
+    }
+  }
+  if (!stale_ && live_ && now >= live_->received + config_.stale_after) {
+    stale_ = true;
+    note(now, "DATA stale");
+    emit(StaleEvent{true});
+  }
+}
+
+std::optional<Time> Wr8ClientCore::next_wakeup() const {
+  std::optional<Time> next;
+  auto take = [&next](Time t) {
+    if (!next || t < *next) next = t;
+  };
+  if (reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) take(*reconnect_at_);
+  if (auth_deadline_ && state_ == ConnectionState::authenticating) take(*auth_deadline_);
+  if (state_ == ConnectionState::connected) {
+    for (const auto& p : pending_) {
+      if (p) take(p->deadline);
+    }
+    if (!stale_ && live_) take(live_->received + config_.stale_after);
+  }
+  return next;
+}
+
+}  // namespace hil::client::wr8
