@@ -187,6 +187,7 @@ void Wr8ClientCore::handle(Time now, const proto::Message& message) {
     if (state_ == ConnectionState::authenticating) {
       auth_deadline_.reset();
       reconnect_attempt_ = 0;
+      last_data_.reset();
       set_state(ConnectionState::connected);
       emit(LoginEvent{*reply});
     }
@@ -221,6 +222,7 @@ void Wr8ClientCore::handle(Time now, const proto::Message& message) {
       }
     }
     live_ = live;
+    last_data_ = now;
     emit(TelemetryEvent{live});
     if (stale_) {
       stale_ = false;
@@ -380,7 +382,7 @@ void Wr8ClientCore::on_timer(Time now) {
       finish(static_cast<std::uint8_t>(coi), RequestState::timed_out);
     }
   }
-  if (!stale_ && live_ && now >= live_->received + config_.stale_after) {
+  if (!stale_ && last_data_ && now >= *last_data_ + config_.stale_after) {
     stale_ = true;
     note(now, "DATA stale");
     emit(StaleEvent{true});
@@ -398,7 +400,7 @@ std::optional<Time> Wr8ClientCore::next_wakeup() const {
     for (const auto& p : pending_) {
       if (p) take(p->deadline);
     }
-    if (!stale_ && live_) take(live_->received + config_.stale_after);
+    if (!stale_ && last_data_) take(*last_data_ + config_.stale_after);
   }
   return next;
 }

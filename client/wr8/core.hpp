@@ -224,6 +224,7 @@ class Wr8ClientCore {
   std::array<std::optional<Pending>, 256> pending_{};
 
   std::optional<LiveState> live_;
+  std::optional<Time> last_data_;  // on this connection: a new login waits for its own DATA
   bool stale_ = false;
   std::vector<proto::Setting> settings_;
 };

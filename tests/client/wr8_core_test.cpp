@@ -178,6 +178,20 @@ TEST(Wr8ClientCore, DataFillsTheLiveStateAndStopsBeingFreshAfter500Ms) {
   EXPECT_FALSE(stale[0].stale);
 }
 
+TEST(Wr8ClientCore, TheStaleTimerStartsAgainWithTheFirstDataAfterALogin) {
+  auto core = logged_in();
+  feed(core, milliseconds(100), proto::Data{proto::State::stop, 100, {}, {}});
+  core.on_closed(milliseconds(200));
+  core.on_timer(milliseconds(1200));
+  core.on_connected(milliseconds(1200));
+  feed(core, milliseconds(1200), proto::AuthReply{});
+  core.take_events();
+  // DATA of the old connection does not make the new one stale at once.
+  EXPECT_EQ(core.next_wakeup(), std::nullopt);
+  feed(core, milliseconds(1300), proto::Data{proto::State::stop, 1300, {}, {}});
+  EXPECT_EQ(core.next_wakeup(), milliseconds(1800));
+}
+
 TEST(Wr8ClientCore, ADriveIsMatchedByCoiThroughStartedAndCompleted) {
   auto core = logged_in();
   const auto r = core.drive(milliseconds(10), 100);
