@@ -30,7 +30,9 @@ TEST(LekaSessionOverPty, APacedBurstAndAnInfoReachTheRobotWhole) {
   sim::World world(sim::WorldDef{});
   sim::Vehicle& vehicle = world.add_vehicle(sim::leka_robot());
   mocks::LekaFirmware firmware(world, vehicle);
-  mocks::MockServer server(context, firmware, {.listen = link::parse_endpoint(uri)});
+  mocks::ServerOptions server_options;
+  server_options.listen = link::parse_endpoint(uri);
+  mocks::MockServer server(context, firmware, server_options);
   server.start();
 
   // A timeout that a loaded machine cannot miss.
