@@ -139,7 +139,7 @@ void ArduinoClientCore::on_connected(Time now) {
     pump(now);
   } else if (state_ == LinkState::reconnecting) {
     // The reopened port must answer a PING before requests flow again.
-    inflight_.emplace();
+    inflight_ = Inflight{};
     inflight_->pending = {0, Purpose::reconnect_check, proto::Ping{}};
     inflight_->max_retries = config_.reconnect_ping_retries;
     inflight_->seq = next_seq_++;
@@ -267,7 +267,7 @@ void ArduinoClientCore::pump(Time now) {
   if (inflight_ || state_ != LinkState::open || !connected_ || queue_.empty()) return;
   Pending next = std::move(queue_.front());
   queue_.pop_front();
-  inflight_.emplace();
+  inflight_ = Inflight{};
   inflight_->pending = std::move(next);
   inflight_->max_retries = config_.max_retries;
   inflight_->seq = next_seq_++;  // wraps FF -> 00 as an 8-bit value
