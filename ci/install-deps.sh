@@ -15,6 +15,7 @@ packages=(
   libyaml-cpp-dev            # fault profiles (and, later, scenarios and worlds)
   nlohmann-json3-dev         # NDJSON wire logs and timelines
   tshark                     # reads the pcap files hil writes (tested)
+  libncurses-dev             # the logi-client terminal UI
 )
 
 if [ "$(id -u)" -ne 0 ]; then

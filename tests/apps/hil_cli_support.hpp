@@ -1,5 +1,6 @@
 #pragma once
-// Runs the hil binary with arguments and captures its output and exit status.
+// Runs the hil binary (or another of hil's programs) with arguments and
+// captures its output and exit status.
 
 #include <fcntl.h>
 #include <poll.h>
@@ -46,7 +47,10 @@ inline CommandResult run_hil(const std::string& args) {
 class HilProcess {
  public:
   /// `args` are passed as they are (no shell); runs in the source tree.
-  explicit HilProcess(const std::vector<std::string>& args) {
+  explicit HilProcess(const std::vector<std::string>& args) : HilProcess(HIL_BINARY, args) {}
+
+  /// Runs `program` (a path, e.g. a reference client's binary) instead of hil.
+  HilProcess(const std::string& program, const std::vector<std::string>& args) {
     int fds[2];
     int in[2];
     if (::pipe(fds) != 0 || ::pipe(in) != 0) return;
@@ -58,13 +62,14 @@ class HilProcess {
     posix_spawn_file_actions_addclose(&actions, fds[0]);
     posix_spawn_file_actions_addclose(&actions, in[1]);
     posix_spawn_file_actions_addchdir_np(&actions, HIL_SOURCE_DIR);
-    std::vector<std::string> argv_strings{HIL_BINARY};
+    std::vector<std::string> argv_strings{program};
     argv_strings.insert(argv_strings.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (auto& a : argv_strings)
       argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (posix_spawn(&pid_, HIL_BINARY, &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    if (posix_spawn(&pid_, program.c_str(), &actions, nullptr, argv.data(), environ) != 0)
+      pid_ = -1;
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[1]);
     ::close(in[0]);
@@ -108,6 +113,31 @@ class HilProcess {
       }
       if (!read_some(deadline)) return std::nullopt;
     }
+  }
+
+  /// Closes the process's stdin, as Ctrl-D at a terminal does.
+  void close_stdin() {
+    if (in_fd_ >= 0) ::close(in_fd_);
+    in_fd_ = -1;
+  }
+
+  /// Waits up to `limit` for the process to exit by itself; its exit status
+  /// (128 + signal if a signal ended it), or nullopt if it is still running.
+  std::optional<int> wait_exit(std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+    if (exit_code_) return exit_code_;
+    if (pid_ <= 0) return std::nullopt;
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        while (read_some(std::chrono::steady_clock::now() + std::chrono::milliseconds(200))) {
+        }
+        return exit_code_;
+      }
+      read_some(std::chrono::steady_clock::now() + std::chrono::milliseconds(20));
+    }
+    return std::nullopt;
   }
 
   /// Sends SIGINT (Ctrl-C) and waits up to `limit` for the exit status.
