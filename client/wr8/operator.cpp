@@ -1,0 +1,476 @@
+#include "client/wr8/operator.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+namespace hil::client::wr8 {
+
+namespace {
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+struct Token {
+  std::string_view text;
+  std::size_t column = 1;  // 1-based
+};
+
+// Words separated by blanks; a `#` outside a word starts a comment.
+std::vector<Token> tokenize(std::string_view line) {
+  std::vector<Token> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    const char c = line[i];
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+      ++i;
+      continue;
+    }
+    if (c == '#') break;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' &&
+           line[i] != '\n')
+      ++i;
+    out.push_back({line.substr(start, i - start), start + 1});
+  }
+  return out;
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+std::optional<std::int32_t> parse_i32(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  std::int32_t v = 0;
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || p != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+// "500ms", "1s", "1.5s", "2min": a non-negative number and a unit.
+std::optional<Duration> parse_duration(std::string_view s) {
+  std::size_t n = 0;
+  while (n < s.size() && (std::isdigit(static_cast<unsigned char>(s[n])) || s[n] == '.'))
+    ++n;
+  if (n == 0) return std::nullopt;
+  double value = 0;
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + n, value);
+  if (ec != std::errc{} || p != s.data() + n || !std::isfinite(value)) return std::nullopt;
+  const std::string unit = lower(s.substr(n));
+  double ns_per_unit = 0;
+  if (unit == "ms") {
+    ns_per_unit = 1e6;
+  } else if (unit == "s") {
+    ns_per_unit = 1e9;
+  } else if (unit == "min") {
+    ns_per_unit = 60e9;
+  } else {
+    return std::nullopt;
+  }
+  const double ns = value * ns_per_unit;
+  if (ns > 1e18) return std::nullopt;
+  return Duration(static_cast<Duration::rep>(std::llround(ns)));
+}
+
+ParsedLine fail(std::size_t column, std::string message) {
+  return {std::nullopt, LineError{column, std::move(message)}};
+}
+
+ParsedLine ok(OperatorAction action) {
+  return {std::move(action), std::nullopt};
+}
+
+constexpr std::string_view kVocabulary =
+    "connect, disconnect, drive CM, turn DEG, task CODE [VALUE...], get-settings, "
+    "set NAME=VALUE..., wait DURATION, wait-data";
+
+std::string value_type_text(proto::ValueType type) {
+  switch (type) {
+    case proto::ValueType::float32:
+      return "a number";
+    case proto::ValueType::unsigned_int:
+      return "a whole number >= 0";
+    case proto::ValueType::signed_int:
+      break;
+  }
+  return "a whole number";
+}
+
+// The names `set` reads, as the CLI writes them.
+std::string setting_name(proto::SettingCode code) {
+  switch (code) {
+    case proto::SettingCode::p:
+      return "p";
+    case proto::SettingCode::i:
+      return "i";
+    case proto::SettingCode::d:
+      return "d";
+    case proto::SettingCode::servo_zero:
+      return "servo-zero";
+  }
+  return std::to_string(static_cast<int>(code));
+}
+
+}  // namespace
+
+std::string first_word(std::string_view line) {
+  const auto tokens = tokenize(line);
+  return tokens.empty() ? std::string() : lower(tokens.front().text);
+}
+
+ParsedLine parse_operator_line(std::string_view line, const proto::Profile& profile) {
+  const auto tokens = tokenize(line);
+  if (tokens.empty()) return {};
+  const std::string verb = lower(tokens[0].text);
+  const std::size_t end_column = line.size() + 1;
+  auto no_more = [&](std::size_t from, std::string_view what) -> std::optional<LineError> {
+    if (tokens.size() > from)
+      return LineError{tokens[from].column, "unexpected '" + std::string(tokens[from].text) +
+                                                "' after " + std::string(what)};
+    return std::nullopt;
+  };
+  auto bare = [&](OperatorAction action) -> ParsedLine {
+    if (auto e = no_more(1, verb)) return {std::nullopt, e};
+    return ok(std::move(action));
+  };
+  auto one_int = [&](std::string_view what) -> std::variant<std::int32_t, LineError> {
+    if (tokens.size() < 2)
+      return LineError{end_column, "expected " + std::string(what) + " after " + verb};
+    const auto v = parse_i32(tokens[1].text);
+    if (!v)
+      return LineError{tokens[1].column, "expected " + std::string(what) +
+                                             " (a whole number), got '" +
+                                             std::string(tokens[1].text) + "'"};
+    if (auto e = no_more(2, verb + " " + std::string(tokens[1].text))) return *e;
+    return *v;
+  };
+
+  if (verb == "connect") return bare(op::Connect{});
+  if (verb == "disconnect") return bare(op::Disconnect{});
+  if (verb == "get-settings") return bare(op::GetSettings{});
+  if (verb == "wait-data") return bare(op::WaitData{});
+  if (verb == "drive" || verb == "turn") {
+    const auto r = one_int(verb == "drive" ? "a distance in cm" : "an angle in degrees");
+    if (const auto* e = std::get_if<LineError>(&r)) return {std::nullopt, *e};
+    const std::int32_t v = std::get<std::int32_t>(r);
+    if (verb == "drive") return ok(op::Drive{v});
+    return ok(op::Turn{v});
+  }
+  if (verb == "wait") {
+    if (tokens.size() < 2) return fail(end_column, "expected a duration after wait (500ms, 1s)");
+    const auto d = parse_duration(tokens[1].text);
+    if (!d)
+      return fail(tokens[1].column, "expected a duration such as 500ms, 1s or 1.5s, got '" +
+                                        std::string(tokens[1].text) + "'");
+    if (auto e = no_more(2, "the duration")) return {std::nullopt, e};
+    return ok(op::Wait{*d});
+  }
+  if (verb == "task") {
+    if (tokens.size() < 2)
+      return fail(end_column,
+                  "expected a task code after task (check, drive, turn, blink, get-settings or "
+                  "0..4)");
+    const auto code = proto::parse_task(tokens[1].text);
+    if (!code)
+      return fail(tokens[1].column,
+                  "expected a task code (check, drive, turn, blink, get-settings or 0..4), got '" +
+                      std::string(tokens[1].text) + "'");
+    const auto type = profile.task_value_type[static_cast<std::size_t>(*code)];
+    op::RawTask task{*code, {}};
+    for (std::size_t i = 2; i < tokens.size(); ++i) {
+      const auto w = proto::parse_value(tokens[i].text, type);
+      if (!w)
+        return fail(tokens[i].column, "expected a parameter value (" + value_type_text(type) +
+                                          ", or 0x and up to 8 hex digits), got '" +
+                                          std::string(tokens[i].text) + "'");
+      task.params.push_back(*w);
+    }
+    return ok(std::move(task));
+  }
+  if (verb == "set") {
+    if (tokens.size() < 2)
+      return fail(end_column, "expected NAME=VALUE after set (names p, i, d, servo-zero)");
+    op::SetSettings set;
+    for (std::size_t i = 1; i < tokens.size(); ++i) {
+      const std::string_view t = tokens[i].text;
+      const auto eq = t.find('=');
+      if (eq == std::string_view::npos)
+        return fail(tokens[i].column, "expected NAME=VALUE, got '" + std::string(t) + "'");
+      const auto code = proto::parse_setting(t.substr(0, eq));
+      if (!code)
+        return fail(tokens[i].column,
+                    "expected a setting name (p, i, d, servo-zero or 0..3), got '" +
+                        std::string(t.substr(0, eq)) + "'");
+      const auto type = profile.setting_value_type[static_cast<std::size_t>(*code)];
+      const auto w = proto::parse_value(t.substr(eq + 1), type);
+      if (!w)
+        return fail(tokens[i].column + eq + 1, "expected a value for " + setting_name(*code) +
+                                                   " (" + value_type_text(type) + "), got '" +
+                                                   std::string(t.substr(eq + 1)) + "'");
+      set.settings.push_back({*code, *w});
+    }
+    return ok(std::move(set));
+  }
+  return fail(tokens[0].column, "unknown action '" + std::string(tokens[0].text) + "'; expected " +
+                                    std::string(kVocabulary));
+}
+
+std::string ScriptError::to_string() const {
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+}
+
+Script parse_operator_script(std::string_view text, std::string file,
+                             const proto::Profile& profile) {
+  Script script;
+  int number = 0;
+  while (!text.empty() || number == 0) {
+    ++number;
+    const auto nl = text.find('\n');
+    const std::string_view line = text.substr(0, nl);
+    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+    auto parsed = parse_operator_line(line, profile);
+    if (parsed.error) {
+      script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
+    } else if (parsed.action) {
+      script.steps.push_back({number, std::move(*parsed.action)});
+    }
+    if (nl == std::string_view::npos) break;
+  }
+  return script;
+}
+
+std::string format_duration(Duration d) {
+  const auto ns = d.count();
+  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
+  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6gms", link::to_ms(d));
+  return buf;
+}
+
+std::string format_settings(const std::vector<proto::Setting>& settings,
+                            const proto::Profile& profile) {
+  std::string out;
+  for (const auto& s : settings) {
+    if (!out.empty()) out += ' ';
+    out +=
+        setting_name(s.code) + "=" +
+        proto::format_value(s.value, profile.setting_value_type[static_cast<std::size_t>(s.code)]);
+  }
+  return out;
+}
+
+std::string to_text(const OperatorAction& action, const proto::Profile& profile) {
+  return std::visit(
+      Overloaded{
+          [](const op::Connect&) -> std::string { return "connect"; },
+          [](const op::Disconnect&) -> std::string { return "disconnect"; },
+          [](const op::Drive& a) { return "drive " + std::to_string(a.distance_cm); },
+          [](const op::Turn& a) { return "turn " + std::to_string(a.angle_deg); },
+          [&](const op::RawTask& a) {
+            std::string out = "task " + std::string(proto::to_string(a.code));
+            const auto type = profile.task_value_type[static_cast<std::size_t>(a.code)];
+            for (const auto& w : a.params)
+              out += " " + proto::format_value(w, type);
+            return out;
+          },
+          [](const op::GetSettings&) -> std::string { return "get-settings"; },
+          [&](const op::SetSettings& a) { return "set " + format_settings(a.settings, profile); },
+          [](const op::Wait& a) { return "wait " + format_duration(a.duration); },
+          [](const op::WaitData&) -> std::string { return "wait-data"; },
+      },
+      action);
+}
+
+// ---- runner ----
+
+OperatorRunner::OperatorRunner(link::Executor& executor, Wr8Session& session, RunnerOptions options)
+    : executor_(executor), session_(session), options_(options) {}
+
+OperatorRunner::~OperatorRunner() {
+  *alive_ = false;
+  if (current_ && current_->timer) executor_.cancel(*current_->timer);
+}
+
+void OperatorRunner::execute(OperatorAction action, Done done) {
+  if (current_) throw std::logic_error("OperatorRunner::execute while an action runs");
+  current_ = Current{std::move(action), executor_.now(), std::move(done), {}, false, {}, {}};
+  const auto& core = session_.core();
+  std::visit(
+      Overloaded{
+          [&](const op::Connect&) {
+            if (core.state() == ConnectionState::connected) {
+              finish(true, "already logged in");
+              return;
+            }
+            session_.connect();
+            arm_timer(options_.connect_timeout, [this] {
+              session_.disconnect();
+              finish(false, "not logged in within " + format_duration(options_.connect_timeout));
+            });
+          },
+          [&](const op::Disconnect&) {
+            session_.disconnect();
+            finish(true, "disconnected");
+          },
+          [&](const op::Drive& a) { start_request(session_.drive(a.distance_cm)); },
+          [&](const op::Turn& a) { start_request(session_.turn(a.angle_deg)); },
+          [&](const op::RawTask& a) { start_request(session_.task(a.code, a.params)); },
+          [&](const op::GetSettings&) { start_request(session_.get_settings()); },
+          [&](const op::SetSettings& a) { start_request(session_.set_settings(a.settings)); },
+          [&](const op::Wait& a) { arm_timer(a.duration, [this] { finish(true, ""); }); },
+          [&](const op::WaitData&) {
+            if (core.state() == ConnectionState::disconnected) {
+              finish(false, "not connected");
+              return;
+            }
+            arm_timer(options_.data_timeout, [this] {
+              finish(false, "no DATA within " + format_duration(options_.data_timeout));
+            });
+          },
+      },
+      current_->action);
+}
+
+void OperatorRunner::start_request(SubmitResult submitted) {
+  if (!submitted) {
+    std::string why(to_string(submitted.refusal));
+    for (char& c : why)
+      if (c == '_') c = ' ';
+    finish(false, "refused: " + why);
+    return;
+  }
+  current_->coi = submitted.coi;
+}
+
+void OperatorRunner::arm_timer(Duration after, std::function<void()> fire) {
+  std::weak_ptr<bool> alive = alive_;
+  current_->timer = executor_.call_after(after, [this, alive, fire = std::move(fire)] {
+    if (const auto a = alive.lock(); !a || !*a) return;
+    if (!current_) return;
+    current_->timer.reset();
+    fire();
+  });
+}
+
+void OperatorRunner::finish(bool ok, std::string detail) {
+  if (!current_) return;
+  if (current_->timer) executor_.cancel(*current_->timer);
+  ActionResult result{std::move(current_->action), current_->started, executor_.now(), ok,
+                      std::move(detail)};
+  Done done = std::move(current_->done);
+  current_.reset();
+  // Handed on from the executor, not from inside the session's event sink,
+  // so the next action never starts in the middle of the session's work.
+  std::weak_ptr<bool> alive = alive_;
+  executor_.post([alive, done = std::move(done), result = std::move(result)] {
+    if (const auto a = alive.lock(); !a || !*a) return;
+    if (done) done(result);
+  });
+}
+
+void OperatorRunner::on_request(const RequestEvent& r) {
+  if (!current_ || !current_->coi || *current_->coi != r.coi) return;
+  const auto& config = session_.core().config();
+  switch (r.state) {
+    case RequestState::sent:
+      return;
+    case RequestState::started:
+      current_->request_started = true;
+      return;
+    case RequestState::completed: {
+      std::string detail = "completed";
+      if (!current_->settings.empty()) detail = format_settings(current_->settings, config.profile);
+      finish(true, detail);
+      return;
+    }
+    case RequestState::error:
+      finish(false, "the vehicle answered error");
+      return;
+    case RequestState::timed_out: {
+      if (current_->request_started || !current_->settings.empty()) {
+        const Duration limit = r.kind == RequestKind::task
+                                   ? config.completion_timeout[static_cast<std::size_t>(r.task)]
+                                   : config.answer_timeout;
+        finish(false, "started but not completed within " + format_duration(limit));
+      } else {
+        finish(false, "no answer within " + format_duration(config.answer_timeout));
+      }
+      return;
+    }
+    case RequestState::cancelled:
+      finish(false, "the connection ended before the answer");
+      return;
+  }
+}
+
+void OperatorRunner::on_event(Time, const Event& event) {
+  if (!current_) return;
+  std::visit(Overloaded{
+                 [&](const LoginEvent& e) {
+                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
+                   finish(true, "logged in: device " + std::to_string(e.reply.device_code) +
+                                    ", id " + std::to_string(e.reply.device_id) + ", " +
+                                    std::string(proto::to_string(e.reply.state)));
+                 },
+                 [&](const LoginFailedEvent& e) {
+                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
+                   // A failed login is the operator's answer: stop the retries.
+                   session_.disconnect();
+                   finish(false, e.reason);
+                 },
+                 [&](const TelemetryEvent& e) {
+                   if (!std::holds_alternative<op::WaitData>(current_->action)) return;
+                   finish(true, "DATA " + std::string(proto::to_string(e.live.state)) + " at " +
+                                    std::to_string(e.live.timestamp_ms) + " ms");
+                 },
+                 [&](const ConnectionEvent& e) {
+                   if (std::holds_alternative<op::WaitData>(current_->action) &&
+                       e.state == ConnectionState::disconnected)
+                     finish(false, "disconnected");
+                 },
+                 [&](const SettingsEvent& e) {
+                   if (current_->coi && *current_->coi == e.coi) current_->settings = e.settings;
+                 },
+                 [&](const RequestEvent& r) { on_request(r); },
+                 [](const auto&) {},
+             },
+             event);
+}
+
+void OperatorRunner::run(std::vector<OperatorAction> actions, bool keep_going, Done each,
+                         std::function<void(bool)> finished) {
+  queue_ = std::move(actions);
+  next_ = 0;
+  keep_going_ = keep_going;
+  all_ok_ = true;
+  each_ = std::move(each);
+  finished_ = std::move(finished);
+  run_next();
+}
+
+void OperatorRunner::run_next() {
+  if (next_ >= queue_.size() || (!all_ok_ && !keep_going_)) {
+    auto finished = std::move(finished_);
+    if (finished) finished(all_ok_);
+    return;
+  }
+  execute(queue_[next_++], [this](const ActionResult& r) {
+    if (!r.ok) all_ok_ = false;
+    if (each_) each_(r);
+    run_next();
+  });
+}
+
+}  // namespace hil::client::wr8
