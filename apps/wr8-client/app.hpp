@@ -1,0 +1,45 @@
+#pragma once
+// wr8-client's command line and its run under the real-time driver: the
+// options, the actions they name, and the program's main loop.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "client/wr8/operator.hpp"
+
+namespace hil::apps::wr8_client {
+
+struct AppOptions {
+  std::string host = "127.0.0.1";
+  std::uint16_t port = 9100;
+  std::string auth;  ///< empty: the profile's default string
+  std::string log_path;
+  std::string script;
+  bool data = false;
+  bool keep_going = false;
+  double connect_timeout_s = 10;
+  std::vector<std::string> actions;  ///< one action per argument
+};
+
+struct ParsedArguments {
+  std::optional<AppOptions> options;  ///< nullopt: exit with `exit_code`
+  int exit_code = 0;
+};
+
+/// Reads the command line; prints help or usage errors itself.
+ParsedArguments parse_arguments(int argc, const char* const* argv);
+
+/// The batch's actions from the arguments or the script; nullopt after
+/// printing "file:line:col: message" for every bad line to `errors`.
+std::optional<std::vector<client::wr8::OperatorAction>> batch_actions(
+    const AppOptions& options, const client::wr8::proto::Profile& profile, std::ostream& errors);
+
+/// The session's configuration from the options (the login string).
+client::wr8::ClientConfig client_config(const AppOptions& options);
+
+/// Runs the program; returns its exit code.
+int run(const AppOptions& options);
+
+}  // namespace hil::apps::wr8_client

@@ -1,0 +1,325 @@
+#include "apps/wr8-client/console.hpp"
+
+#include <cctype>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+namespace hil::apps::wr8_client {
+
+namespace {
+
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+bool ends_with(const std::string& s, std::string_view suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string optional_value(const std::optional<double>& v, int decimals, std::string_view unit) {
+  if (!v) return "-";
+  return fixed(*v, decimals) + " " + std::string(unit);
+}
+
+std::string spaced(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    if (c == '_') c = ' ';
+  return out;
+}
+
+std::string trim(const std::string& s) {
+  std::size_t b = 0;
+  std::size_t e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b])))
+    ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1])))
+    --e;
+  return s.substr(b, e - b);
+}
+
+constexpr std::string_view kHelp =
+    "actions (run in order; each waits for its answer):\n"
+    "  connect                 open the connection and log in\n"
+    "  disconnect              close the connection\n"
+    "  drive CM                drive forward CM centimetres; waits for completed\n"
+    "  turn DEG                turn the wheels to DEG degrees (+ left); waits for completed\n"
+    "  task CODE [VALUE...]    any task (check, drive, turn, blink, get-settings or 0..4)\n"
+    "  get-settings            read P, I, D and servo zero\n"
+    "  set NAME=VALUE...       change settings (p, i, d, servo-zero)\n"
+    "  wait DURATION           pause (500ms, 1s, 1.5s)\n"
+    "  wait-data               wait for the next DATA packet\n"
+    "commands:\n"
+    "  state                   the live state from DATA\n"
+    "  log [N]                 the last N (20) lines of the communication log\n"
+    "  history                 the actions run so far and their results\n"
+    "  save-log PATH           write the communication log (.txt, .csv or .ndjson)\n"
+    "  help                    this text\n"
+    "  quit                    disconnect and leave (end of input does the same)\n";
+
+}  // namespace
+
+std::string export_log(const wr8::CommLog& log, const std::string& path) {
+  if (ends_with(path, ".csv")) return log.export_csv();
+  if (ends_with(path, ".ndjson") || ends_with(path, ".jsonl")) return log.export_ndjson();
+  return log.export_text();
+}
+
+bool save_log(const wr8::CommLog& log, const std::string& path, std::string& error) {
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (!file) {
+    error = "cannot write " + path;
+    return false;
+  }
+  file << export_log(log, path);
+  file.close();
+  if (!file) {
+    error = "cannot write " + path;
+    return false;
+  }
+  return true;
+}
+
+std::string format_live(const wr8::LiveState& live) {
+  return std::string(wr8::proto::to_string(live.state)) + "  odometry " +
+         optional_value(live.odometry_cm, 0, "cm") + "  speed " +
+         optional_value(live.speed_mps, 2, "m/s") + "  wheel angle " +
+         optional_value(live.wheel_angle_deg, 1, "deg") + "  battery " +
+         optional_value(live.battery_percent, 0, "%");
+}
+
+std::string format_state(const wr8::Wr8ClientCore& core, link::Time now) {
+  std::string out = "connection: " + spaced(wr8::to_string(core.state())) + "\n";
+  const auto& live = core.live();
+  if (!live) return out + "no DATA received yet\n";
+  out += "vehicle:    " + std::string(wr8::proto::to_string(live->state)) + ", timestamp " +
+         std::to_string(live->timestamp_ms) + " ms\n";
+  out += "odometry:   " + optional_value(live->odometry_cm, 0, "cm") + "\n";
+  out += "speed:      " + optional_value(live->speed_mps, 2, "m/s") + "\n";
+  out += "wheels:     " + optional_value(live->wheel_angle_deg, 1, "deg") + "\n";
+  out += "battery:    " + optional_value(live->battery_percent, 0, "%") + "\n";
+  out += "data age:   " + fixed(link::to_ms(now - live->received), 0) + " ms" +
+         (core.stale() ? " (stale)" : "") + "\n";
+  return out;
+}
+
+Wr8Console::Wr8Console(link::Executor& executor, wr8::Wr8Session& session,
+                       wr8::OperatorRunner& runner, std::ostream& out, ConsoleOptions options,
+                       Exit exit)
+    : executor_(executor),
+      session_(session),
+      runner_(runner),
+      out_(out),
+      options_(std::move(options)),
+      exit_(std::move(exit)) {}
+
+std::string Wr8Console::stamp(link::Time t) const {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%8.3f s", link::to_ms(t) / 1000.0);
+  return buf;
+}
+
+void Wr8Console::print(const std::string& text) {
+  if (prompted_) out_ << '\n';  // the prompt was waiting on its own line
+  prompted_ = false;
+  out_ << text << '\n' << std::flush;
+}
+
+void Wr8Console::prompt() {
+  if (!options_.prompt || exited_ || runner_.busy() || !pending_.empty() || prompted_) return;
+  out_ << "wr8> " << std::flush;
+  prompted_ = true;
+}
+
+void Wr8Console::on_event(link::Time now, const wr8::Event& event) {
+  if (exited_) return;
+  if (!options_.interactive) {
+    const auto* t = std::get_if<wr8::TelemetryEvent>(&event);
+    if (!options_.print_data || t == nullptr) return;
+    // On a change of state code, else at most once a second.
+    if (data_printed_at_ && data_printed_state_ == t->live.state &&
+        now - *data_printed_at_ < link::seconds(1))
+      return;
+    data_printed_at_ = now;
+    data_printed_state_ = t->live.state;
+    print(stamp(now) + "  data  " + format_live(t->live));
+    return;
+  }
+  std::visit(Overloaded{
+                 [&](const wr8::ConnectionEvent& e) {
+                   if (e.state == wr8::ConnectionState::waiting_to_reconnect)
+                     print(stamp(now) + "  connection lost; reconnecting (attempt " +
+                           std::to_string(e.attempt + 1) + ")");
+                   else if (e.state == wr8::ConnectionState::connecting && e.attempt > 0)
+                     print(stamp(now) + "  reconnect attempt " + std::to_string(e.attempt));
+                 },
+                 [&](const wr8::LoginEvent&) {},  // the connect action's result says it
+                 [&](const wr8::LoginFailedEvent& e) {
+                   print(stamp(now) + "  login failed: " + e.reason);
+                 },
+                 [&](const wr8::StaleEvent& e) {
+                   print(stamp(now) +
+                         (e.stale ? "  DATA stale: none for " +
+                                        wr8::format_duration(session_.core().config().stale_after)
+                                  : "  DATA flowing again"));
+                 },
+                 [&](const wr8::RequestEvent& e) {
+                   if (e.state == wr8::RequestState::sent) return;
+                   const std::string what =
+                       e.kind == wr8::RequestKind::task
+                           ? "task " + std::string(wr8::proto::to_string(e.task))
+                           : std::string("settings");
+                   print(stamp(now) + "  " + what + " (COI " + std::to_string(e.coi) + ") " +
+                         spaced(wr8::to_string(e.state)));
+                 },
+                 [&](const wr8::IgnoredEvent& e) {
+                   print(stamp(now) + "  ignored (late or unknown COI): " +
+                         wr8::proto::describe(e.message, session_.core().config().profile));
+                 },
+                 [&](const wr8::ParseErrorEvent& e) {
+                   print(stamp(now) + "  bad bytes received: " + e.error.detail);
+                 },
+                 [](const auto&) {},
+             },
+             event);
+  prompt();
+}
+
+void Wr8Console::result(const wr8::ActionResult& r) {
+  const std::string text = wr8::to_text(r.action, session_.core().config().profile);
+  char head[64];
+  std::snprintf(head, sizeof head, "%-24s %-4s", text.c_str(), r.ok ? "ok" : "FAIL");
+  std::string line = stamp(r.finished) + "  " + head;
+  if (!r.detail.empty()) line += "  " + r.detail;
+  history_.push_back(line);
+  print(line);
+}
+
+void Wr8Console::run_batch(std::vector<wr8::OperatorAction> actions) {
+  runner_.run(
+      std::move(actions), false, [this](const wr8::ActionResult& r) { result(r); },
+      [this](bool all_ok) { exit(all_ok ? kExitOk : kExitFailed); });
+}
+
+void Wr8Console::start() {
+  prompt();
+}
+
+void Wr8Console::line(std::string text) {
+  if (exited_) return;
+  prompted_ = false;  // the user's newline ended the prompt's line
+  pending_.push_back(std::move(text));
+  process();
+}
+
+void Wr8Console::end_of_input() {
+  input_ended_ = true;
+  process();
+}
+
+void Wr8Console::interrupt() {
+  if (exited_) return;
+  print("interrupted; disconnecting");
+  exit(kExitInterrupted);
+}
+
+void Wr8Console::process() {
+  while (!exited_ && !runner_.busy() && !pending_.empty()) {
+    const std::string text = std::move(pending_.front());
+    pending_.pop_front();
+    if (builtin(text)) continue;
+    auto parsed = wr8::parse_operator_line(text, session_.core().config().profile);
+    if (parsed.error) {
+      print("error: column " + std::to_string(parsed.error->column) + ": " + parsed.error->message);
+      continue;
+    }
+    if (!parsed.action) continue;
+    runner_.execute(std::move(*parsed.action), [this](const wr8::ActionResult& r) {
+      result(r);
+      process();
+    });
+  }
+  if (exited_) return;
+  if (input_ended_ && !runner_.busy() && pending_.empty()) {
+    exit(kExitOk);
+    return;
+  }
+  prompt();
+}
+
+bool Wr8Console::builtin(const std::string& raw) {
+  const std::string text = trim(raw);
+  const std::string word = wr8::first_word(text);
+  const std::string rest = trim(text.substr(std::min(text.size(), word.size())));
+  const auto& core = session_.core();
+  if (word == "state") {
+    std::string s = format_state(core, executor_.now());
+    s.pop_back();
+    print(s);
+  } else if (word == "log") {
+    std::size_t n = 20;
+    if (!rest.empty()) {
+      try {
+        n = std::stoul(rest);
+      } catch (...) {
+        print("error: log takes a number of lines, got '" + rest + "'");
+        return true;
+      }
+    }
+    const auto entries = core.log()->snapshot();
+    wr8::CommLog tail;
+    for (std::size_t i = entries.size() > n ? entries.size() - n : 0; i < entries.size(); ++i)
+      tail.add(entries[i]);
+    std::string s = tail.export_text();
+    if (!s.empty()) s.pop_back();
+    print(s.empty() ? "(the log is empty)" : s);
+  } else if (word == "history") {
+    if (history_.empty()) print("(no actions yet)");
+    for (const auto& h : history_)
+      print(h);
+  } else if (word == "save-log") {
+    if (rest.empty()) {
+      print("error: save-log needs a path (.txt, .csv or .ndjson)");
+      return true;
+    }
+    std::string error;
+    if (save_log(*core.log(), rest, error))
+      print("saved " + std::to_string(core.log()->snapshot().size()) + " log entries to " + rest);
+    else
+      print("error: " + error);
+  } else if (word == "help" || word == "?") {
+    std::string s(kHelp);
+    s.pop_back();
+    print(s);
+  } else if (word == "quit" || word == "exit") {
+    exit(kExitOk);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+void Wr8Console::exit(int code) {
+  if (exited_) return;
+  exited_ = true;
+  if (session_.core().state() != wr8::ConnectionState::disconnected) session_.disconnect();
+  if (!options_.log_path.empty()) {
+    std::string error;
+    if (!save_log(*session_.core().log(), options_.log_path, error)) print("error: " + error);
+  }
+  if (exit_) exit_(code);
+}
+
+}  // namespace hil::apps::wr8_client

@@ -1,0 +1,218 @@
+// wr8-client run as a user runs it, against `hil mock wr8` over real TCP:
+// a batch of actions, a wrong login string, the interactive mode through a
+// pipe, scripts (the shipped examples and a typo), nothing listening, and
+// Ctrl-C. Waits are bounded and generous; no upper bound on durations.
+
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace hil::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// The largest `odometry_cm=N` in a log.
+int max_odometry_cm(const std::string& log) {
+  static const std::regex re("odometry_cm=([0-9]+)");
+  int best = -1;
+  for (auto it = std::sregex_iterator(log.begin(), log.end(), re); it != std::sregex_iterator();
+       ++it)
+    best = std::max(best, std::stoi((*it)[1].str()));
+  return best;
+}
+
+/// A TCP port nobody listens on: bound by the kernel's choice, then released.
+std::string unused_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  addr.sin_port = 0;
+  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  ::close(fd);
+  return std::to_string(ntohs(addr.sin_port));
+}
+
+/// The mock vehicle on a free port and a temp dir for files.
+struct Wr8ClientCli : ::testing::Test {
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() /
+          ("hil-wr8-client-" + std::to_string(::getpid()) + "-" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir);
+  }
+  void TearDown() override {
+    if (mock) {
+      EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+    }
+    std::filesystem::remove_all(dir);
+  }
+
+  void start_mock() {
+    mock.emplace(std::vector<std::string>{"mock", "wr8", "--port", "0"});
+    const auto line = mock->wait_for_line("connect to tcp://");
+    ASSERT_TRUE(line) << mock->output();
+    port = line->substr(line->rfind(':') + 1);
+  }
+
+  /// wr8-client with `--port PORT` and `args`; waits for its exit.
+  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 20s) {
+    args.insert(args.begin(), {"--port", port});
+    HilProcess p(WR8_CLIENT_BINARY, args);
+    p.close_stdin();
+    CommandResult r;
+    r.exit_code = p.wait_exit(limit).value_or(-1);
+    r.output = p.output();
+    return r;
+  }
+
+  std::filesystem::path write(const std::string& name, const std::string& text) {
+    const auto path = dir / name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  std::filesystem::path dir;
+  std::optional<HilProcess> mock;
+  std::string port = "9100";
+};
+
+TEST_F(Wr8ClientCli, ABatchLogsInDrivesTurnsAndReadsTheSettings) {
+  start_mock();
+  const auto log = dir / "run.ndjson";
+  const auto r =
+      client({"--log", log.string(), "--data", "connect", "drive 30", "turn 10", "get-settings"});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +ok +logged in: device 8, id 1")))
+      << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("drive 30 +ok +completed"))) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("turn 10 +ok +completed"))) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output,
+                                std::regex("get-settings +ok +p=1.5 i=0.25 d=0.05 servo-zero=90")))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, " data  ")) << r.output;  // --data
+  // What the car did, from the DATA the client logged.
+  const std::string text = read_file(log);
+  EXPECT_TRUE(contains(text, "\"kind\":\"TX\"")) << text;
+  EXPECT_GE(max_odometry_cm(text), 29) << text;
+  EXPECT_TRUE(mock->wait_for_line("client")) << mock->output();
+}
+
+TEST_F(Wr8ClientCli, AWrongLoginStringFailsConnectWithTheReason) {
+  start_mock();
+  const auto r = client({"--auth", "WRONG-AUTH", "connect", "drive 10"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +FAIL +closed before AUTH-REPLY")))
+      << r.output;
+  EXPECT_FALSE(contains(r.output, "drive 10")) << r.output;  // the batch stopped
+}
+
+TEST_F(Wr8ClientCli, InteractiveThroughAPipeDrivesShowsStateAndSavesTheLog) {
+  start_mock();
+  const auto csv = dir / "session.csv";
+  HilProcess p(WR8_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(
+      p.write_stdin("connect\ndrive 20\nbogus 1\nstate\nsave-log " + csv.string() + "\nquit\n"));
+  const auto code = p.wait_exit(20s);
+  ASSERT_TRUE(code) << p.output();
+  EXPECT_EQ(*code, 0) << p.output();
+  const std::string& out = p.output();
+  EXPECT_FALSE(contains(out, "wr8> ")) << out;  // no prompt for a pipe
+  EXPECT_TRUE(std::regex_search(out, std::regex("task drive \\(COI 0\\) started"))) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex("drive 20 +ok +completed"))) << out;
+  EXPECT_TRUE(contains(out, "error: column 1: unknown action 'bogus'")) << out;
+  // The state printed after the drive has its distance.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("odometry: +([0-9]+) cm"))) << out;
+  EXPECT_GE(std::stoi(m[1].str()), 19) << out;
+  EXPECT_TRUE(contains(out, "connection: connected")) << out;
+  EXPECT_TRUE(contains(out, "battery:    100 %")) << out;
+  const std::string text = read_file(csv);
+  EXPECT_EQ(text.rfind("time_ms,kind,raw,description", 0), 0u) << text;
+  EXPECT_TRUE(contains(text, "\"01 48 49 4C 2D 57 52 38 2D 30 31\"")) << text;  // AUTH
+  EXPECT_TRUE(contains(text, "\"03 00 01 04 14 00 00 00\"")) << text;           // drive 20
+  EXPECT_TRUE(contains(text, "Response coi=0 completed")) << text;
+}
+
+TEST_F(Wr8ClientCli, EndOfInputEndsTheInteractiveModeWithZero) {
+  start_mock();
+  HilProcess p(WR8_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(p.write_stdin("connect\nwait 200ms\nhistory\n"));
+  p.close_stdin();
+  const auto code = p.wait_exit(20s);
+  ASSERT_TRUE(code) << p.output();
+  EXPECT_EQ(*code, 0) << p.output();
+  EXPECT_TRUE(std::regex_search(p.output(), std::regex("wait 200ms +ok"))) << p.output();
+}
+
+TEST_F(Wr8ClientCli, CtrlCDisconnectsAndExits130) {
+  start_mock();
+  HilProcess p(WR8_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(p.write_stdin("connect\n"));
+  ASSERT_TRUE(p.wait_for_line("logged in", 20s)) << p.output();
+  const auto code = p.interrupt(20s);
+  ASSERT_TRUE(code) << p.output();
+  EXPECT_EQ(*code, 130) << p.output();
+  EXPECT_TRUE(contains(p.output(), "interrupted")) << p.output();
+}
+
+TEST_F(Wr8ClientCli, TheShippedExampleScriptsRunAgainstTheMock) {
+  start_mock();
+  for (const char* name : {"drive-and-turn.wr8", "settings.wr8"}) {
+    const auto r = client({"--script", std::string("scenarios/clients/wr8-client/") + name});
+    EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.output;
+    EXPECT_FALSE(contains(r.output, "FAIL")) << r.output;
+  }
+}
+
+TEST_F(Wr8ClientCli, AScriptTypoExits2WithFileLineAndColumn) {
+  const auto script = write("typo.wr8", "connect\n  drve 30\nturn 10\n");
+  const auto r = client({"--script", script.string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, script.string() + ":2:3: unknown action 'drve'")) << r.output;
+  EXPECT_FALSE(contains(r.output, "connect ")) << r.output;  // nothing ran
+}
+
+TEST_F(Wr8ClientCli, BadUsageExits2) {
+  EXPECT_EQ(client({"--auth", "short", "connect"}).exit_code, 2);
+  const auto r = client({"connect", "drive far"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "argument 2:7: expected a distance in cm")) << r.output;
+}
+
+TEST_F(Wr8ClientCli, NothingListeningFailsConnectAndExits1) {
+  port = unused_port();
+  const auto r = client({"--connect-timeout", "5", "connect", "drive 10"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +FAIL +connect failed"))) << r.output;
+}
+
+}  // namespace
+}  // namespace hil::test
