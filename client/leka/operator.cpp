@@ -307,8 +307,9 @@ std::variant<Script, ScriptError> parse_each(const std::vector<std::string_view>
       return ScriptError{source, i + 1, e->column, e->message};
     auto& line = std::get<OperatorLine>(parsed);
     if (line.kind == OperatorLine::Kind::empty) continue;
-    std::string text(texts[i]);
-    while (!text.empty() && (text.back() == '\r' || text.back() == ' '))
+    // The line as shown in results: without its comment or trailing blanks.
+    std::string text(texts[i].substr(0, texts[i].find('#')));
+    while (!text.empty() && (text.back() == '\r' || text.back() == ' ' || text.back() == '\t'))
       text.pop_back();
     script.lines.push_back({i + 1, std::move(text), std::move(line)});
   }

@@ -229,7 +229,7 @@ TEST(LekaOperatorScript, ErrorsAreFileLineColumnAndBlankLinesCount) {
 }
 
 TEST(LekaOperatorScript, KeepsTheLinesThatDoSomethingWithTheirNumbers) {
-  auto parsed = parse_script("# demo\r\near all 255 0 0\r\n\nwait 1s\ninfo", "demo.leka");
+  auto parsed = parse_script("# demo\r\near all 255 0 0\r\n\nwait 1s\ninfo   # ask", "demo.leka");
   ASSERT_TRUE(std::holds_alternative<Script>(parsed));
   const auto& script = std::get<Script>(parsed);
   EXPECT_EQ(script.source, "demo.leka");
@@ -238,6 +238,7 @@ TEST(LekaOperatorScript, KeepsTheLinesThatDoSomethingWithTheirNumbers) {
   EXPECT_EQ(script.lines[0].text, "ear all 255 0 0");
   EXPECT_EQ(script.lines[1].number, 4u);
   EXPECT_EQ(script.lines[2].number, 5u);
+  EXPECT_EQ(script.lines[2].text, "info") << "shown without its comment";
   auto args = parse_lines({"info", "motor all 2 0"}, "arg");
   ASSERT_TRUE(std::holds_alternative<ScriptError>(args));
   EXPECT_EQ(std::get<ScriptError>(args).to_string(),

@@ -1,0 +1,344 @@
+#include "apps/leka-client/app.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <asio/io_context.hpp>
+#include <asio/signal_set.hpp>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "client/leka/session.hpp"
+#include "link/asio_executor.hpp"
+#include "link/transport.hpp"
+#include "protocol/common/bytes.hpp"
+
+namespace hil::apps::leka_client {
+
+namespace leka = client::leka;
+
+namespace {
+
+void warn(const std::string& text) {
+  std::cerr << text << std::endl;
+}
+
+std::string hex_of(protocol::ByteView bytes) {
+  static const char* digits = "0123456789ABCDEF";
+  std::string out;
+  for (std::uint8_t b : bytes) {
+    if (!out.empty()) out += ' ';
+    out += digits[b >> 4];
+    out += digits[b & 0xF];
+  }
+  return out;
+}
+
+std::string info_text(const leka::InfoReply& reply) {
+  std::string out = "info";
+  // The well-known fields first, in the robot's order, then any others.
+  for (const char* key : {"name", "firmware", "buffer", "state"}) {
+    auto it = reply.fields.find(key);
+    if (it != reply.fields.end()) out += " " + it->first + "=" + it->second;
+  }
+  for (const auto& [key, value] : reply.fields) {
+    if (key != "name" && key != "firmware" && key != "buffer" && key != "state")
+      out += " " + key + "=" + value;
+  }
+  return out;
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+}  // namespace
+
+ParsedArguments parse_arguments(int argc, const char* const* argv) {
+  AppOptions o;
+  CLI::App app{"leka-client: send command groups to the Leka robot, one line per group"};
+  app.add_option("-p,--port", o.port,
+                 "Serial device of the robot (/dev/ttyUSB0, /tmp/hil-leka0) or a hil endpoint "
+                 "(pty://PATH, tcp://HOST:PORT); not needed with --dry-run");
+  app.add_option("--baud", o.baud, "Line rate of the serial port (default 115200; 0 leaves it)")
+      ->check(CLI::Range(0u, 4000000u));
+  app.add_option("--log", o.log_path,
+                 "Write every frame sent and line received to FILE at exit (.txt, .csv or "
+                 ".ndjson)");
+  app.add_option("--script", o.script, "Run the groups of this file, one per line ('-' = stdin)");
+  app.add_flag("--dry-run", o.dry_run,
+               "Print each group's frames in hex and exit, without opening a port");
+  app.add_option("--info-timeout-ms", o.info_timeout_ms,
+                 "How long an info waits for the robot's answer (default 200)")
+      ->check(CLI::Range(1, 60000));
+  app.add_option("--frame-bytes", o.frame_bytes,
+                 "Largest frame, and the most bytes sent per 10 ms (default 64, half the "
+                 "robot's 128-byte buffer; more risks lost bytes)")
+      ->check(CLI::Range(12, 128));
+  app.add_option("groups", o.groups,
+                 "Command groups, one per argument, e.g. \"ear all 255 0 0; motor all 0 120\"");
+  app.footer(
+      "Commands (';' between commands of one group):\n"
+      "  info | stop led|motor|robot | ear all R G B | ear single LED(0..1) R G B\n"
+      "  belt all R G B | belt range FIRST LAST R G B | belt single LED(0..19) R G B\n"
+      "  motor all DIR SPEED | motor duo LSPIN LSPEED RSPIN RSPEED | motor left|right SPIN SPEED\n"
+      "  motivator ID(0x51..0x55) | guidance ID(0x41..0x4F) | wait 500ms|1s (alone on a line)\n"
+      "  Values are decimal or 0x hex; spins 0/forward or 1/backward; '#' starts a comment.\n"
+      "Exit status: 0 every group went out (and every info was answered), 1 a group failed\n"
+      "  (info unanswered, port gone or not opened), 2 bad usage or a script error\n"
+      "  (file:line:col), 130 interrupted (stop robot is sent first).\n"
+      "Examples:\n"
+      "  leka-client --port /tmp/hil-leka0 \"ear all 255 0 0; motor all 0 120\" info\n"
+      "  leka-client --port /tmp/hil-leka0 --script show.leka --log run.csv\n"
+      "  leka-client --dry-run \"belt single 0 255 0 0\"\n");
+  ParsedArguments out;
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    out.exit_code = app.exit(e) == 0 ? 0 : 2;
+    return out;
+  }
+  if (!o.script.empty() && !o.groups.empty()) {
+    warn("leka-client: give either --script or groups, not both");
+    out.exit_code = 2;
+    return out;
+  }
+  if (o.script.empty() && o.groups.empty()) {
+    warn("leka-client: nothing to send: give groups or --script FILE (see --help)");
+    out.exit_code = 2;
+    return out;
+  }
+  if (o.port.empty() && !o.dry_run) {
+    warn("leka-client: --port is required (or --dry-run)");
+    out.exit_code = 2;
+    return out;
+  }
+  if (!o.log_path.empty() && !log_format_for(o.log_path)) {
+    warn("leka-client: --log " + o.log_path + ": the name must end in .txt, .csv or .ndjson");
+    out.exit_code = 2;
+    return out;
+  }
+  out.options = std::move(o);
+  return out;
+}
+
+leka::ClientConfig config_for(const AppOptions& options) {
+  leka::ClientConfig config;
+  config.info_timeout = link::milliseconds(options.info_timeout_ms);
+  config.max_frame_bytes = static_cast<std::size_t>(options.frame_bytes);
+  config.bytes_per_period = static_cast<std::size_t>(options.frame_bytes);
+  return config;
+}
+
+link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
+  if (port.find("://") != std::string::npos) {
+    link::Endpoint e = link::parse_endpoint(port);
+    if (auto* pty = std::get_if<link::PtyEndpoint>(&e); pty && pty->baud == 0) pty->baud = baud;
+    return e;
+  }
+  if (port.empty()) throw link::EndpointError("--port needs a device path");
+  return link::PtyEndpoint{port, baud, link::Duration{0}};
+}
+
+std::optional<leka::LogFormat> log_format_for(const std::string& path) {
+  if (path.ends_with(".txt")) return leka::LogFormat::txt;
+  if (path.ends_with(".csv")) return leka::LogFormat::csv;
+  if (path.ends_with(".ndjson")) return leka::LogFormat::ndjson;
+  return std::nullopt;
+}
+
+std::variant<leka::Script, leka::ScriptError> load_script(const AppOptions& options,
+                                                          std::istream& in) {
+  if (options.script.empty()) return leka::parse_lines(options.groups, "arg");
+  std::stringstream text;
+  if (options.script == "-") {
+    text << in.rdbuf();
+  } else {
+    std::ifstream file(options.script, std::ios::binary);
+    if (!file)
+      return leka::ScriptError{options.script, 0, 0,
+                               std::string("cannot read the script: ") + std::strerror(errno)};
+    text << file.rdbuf();
+  }
+  return leka::parse_script(text.str(), options.script == "-" ? "stdin" : options.script);
+}
+
+std::string format_result(const std::string& source, const leka::LineResult& result,
+                          const leka::OperatorLine& line) {
+  std::string out = source + ":" + std::to_string(result.number) + ": ";
+  if (!result.ok) return out + "FAILED: " + result.error;
+  if (line.kind == leka::OperatorLine::Kind::wait) {
+    return out + "ok, waited " +
+           std::to_string(std::chrono::duration_cast<link::milliseconds>(line.wait).count()) +
+           " ms";
+  }
+  out += "ok, " + plural(line.commands, "command", "commands") + ", " +
+         plural(result.frames, "frame", "frames") + ", " + plural(result.bytes, "byte", "bytes") +
+         " sent";
+  for (const auto& info : result.infos)
+    out += "; " + info_text(info);
+  return out;
+}
+
+std::string dry_run_text(const leka::Script& script, const leka::ClientConfig& config) {
+  std::string out;
+  for (const auto& line : script.lines) {
+    out += script.source + ":" + std::to_string(line.number) + ": " + line.text + "\n";
+    for (const auto& frame : leka::frames_of(line.line, config))
+      out += "  " + hex_of(frame) + "\n";
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------- run
+
+namespace {
+
+// The whole run on the real-time driver: open, play the script, and close
+// after the last frame has left (or on a signal, after stop robot).
+class Run {
+ public:
+  Run(const AppOptions& options, leka::Script script, link::Endpoint endpoint)
+      : options_(options),
+        script_(std::move(script)),
+        executor_(io_),
+        context_{executor_, &io_},
+        session_(context_, std::move(endpoint), config_for(options)),
+        runner_(executor_, session_),
+        signals_(io_, SIGINT, SIGTERM) {
+    for (const auto& line : script_.lines)
+      lines_[line.number] = &line.line;
+  }
+
+  int go() {
+    signals_.async_wait([this](const std::error_code& ec, int) {
+      if (ec || finishing_) return;
+      runner_.cancel();
+      if (session_.is_open()) {
+        session_.send(leka::GroupBuilder{}.stop_robot());
+        warn("leka-client: interrupted; stop robot sent");
+      } else {
+        warn("leka-client: interrupted");
+      }
+      finish(130);
+    });
+    session_.open();
+    wait_for_open(link::Time(0));
+    io_.run();
+    return exit_code_;
+  }
+
+ private:
+  void wait_for_open(link::Duration waited) {
+    if (finishing_) return;
+    if (session_.is_open()) return start();
+    if (waited >= link::seconds(5)) {
+      warn("leka-client: cannot open " + options_.port + " (not open after 5 s)");
+      return finish(1);
+    }
+    executor_.call_after(link::milliseconds(10),
+                         [this, waited] { wait_for_open(waited + link::milliseconds(10)); });
+  }
+
+  void start() {
+    runner_.run(
+        script_,
+        [this](const leka::LineResult& r) {
+          const std::string text = format_result(script_.source, r, *lines_.at(r.number));
+          if (r.ok)
+            std::cout << text << std::endl;
+          else
+            warn(text);
+        },
+        [this](bool ok) { finish(ok ? 0 : 1); });
+  }
+
+  // Lets the queued frames leave (a stop robot included), then closes.
+  void finish(int code) {
+    if (!finishing_) {
+      finishing_ = true;
+      exit_code_ = code;
+    }
+    drain(link::Duration{0});
+  }
+
+  void drain(link::Duration waited) {
+    if (session_.is_open() && session_.core().queued_frames() > 0 && waited < link::seconds(1)) {
+      executor_.call_after(link::milliseconds(10),
+                           [this, waited] { drain(waited + link::milliseconds(10)); });
+      return;
+    }
+    // A short grace so the last write reaches the port before it closes.
+    executor_.call_after(link::milliseconds(50), [this] { close(); });
+  }
+
+  void close() {
+    session_.close();
+    signals_.cancel();
+    if (!options_.log_path.empty()) {
+      if (!session_.log().save(options_.log_path, *log_format_for(options_.log_path))) {
+        warn("leka-client: cannot write the log " + options_.log_path);
+        if (exit_code_ == 0) exit_code_ = 1;
+      }
+    }
+    io_.stop();
+  }
+
+  const AppOptions& options_;
+  leka::Script script_;
+  std::map<std::size_t, const leka::OperatorLine*> lines_;
+  asio::io_context io_;
+  link::AsioExecutor executor_;
+  link::TransportContext context_;
+  leka::LekaSession session_;
+  leka::ScriptRunner runner_;
+  asio::signal_set signals_;
+  bool finishing_ = false;
+  int exit_code_ = 0;
+};
+
+}  // namespace
+
+int run(const AppOptions& options) {
+  auto loaded = load_script(options, std::cin);
+  if (auto* e = std::get_if<leka::ScriptError>(&loaded)) {
+    if (e->line == 0)
+      warn("leka-client: " + e->source + ": " + e->message);
+    else
+      warn(e->to_string());
+    return 2;
+  }
+  auto& script = std::get<leka::Script>(loaded);
+  if (options.dry_run) {
+    std::cout << dry_run_text(script, config_for(options)) << std::flush;
+    return 0;
+  }
+  link::Endpoint endpoint;
+  try {
+    endpoint = endpoint_for_port(options.port, options.baud);
+  } catch (const link::EndpointError& e) {
+    warn(std::string("leka-client: --port: ") + e.what());
+    return 2;
+  }
+  // The session says nothing when a device cannot be opened; try it first
+  // so the user learns why.
+  if (const auto* pty = std::get_if<link::PtyEndpoint>(&endpoint)) {
+    const int fd = ::open(pty->path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+      warn("leka-client: cannot open " + pty->path + ": " + std::strerror(errno));
+      return 1;
+    }
+    ::close(fd);
+  }
+  Run run_state(options, std::move(script), std::move(endpoint));
+  return run_state.go();
+}
+
+}  // namespace hil::apps::leka_client

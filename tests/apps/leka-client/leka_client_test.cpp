@@ -1,0 +1,226 @@
+// leka-client run as a user runs it: against `hil mock leka` on a real pty
+// in a temporary folder, checking the program's output and exit code and
+// what the robot received (the mock's wire log). Waits are bounded.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace {
+
+using hil::test::HilProcess;
+
+struct TempDir {
+  TempDir() {
+    static int counter = 0;
+    path = std::filesystem::temp_directory_path() /
+           ("hil-leka-client-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+  std::filesystem::path path;
+};
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The "delivered to the car" records of the mock's wire log.
+std::vector<std::string> delivered_to_car(const std::string& wire_log) {
+  std::vector<std::string> out;
+  std::istringstream in(read_file(wire_log));
+  std::string line;
+  while (std::getline(in, line))
+    if (line.find("\"event\":\"delivered\"") != std::string::npos &&
+        line.find("\"dir\":\"to_car\"") != std::string::npos)
+      out.push_back(line);
+  return out;
+}
+
+bool any_contains(const std::vector<std::string>& lines, const std::string& text) {
+  for (const auto& l : lines)
+    if (l.find(text) != std::string::npos) return true;
+  return false;
+}
+
+// `hil mock leka` on a pty in `dir`, its wire log beside it.
+struct MockLeka {
+  explicit MockLeka(const TempDir& dir, std::vector<std::string> extra = {})
+      : device(dir.file("leka0")), wire_log(dir.file("wire.ndjson")) {
+    std::vector<std::string> args{"mock", "leka", "--pty", device, "--log", wire_log};
+    args.insert(args.end(), extra.begin(), extra.end());
+    process = std::make_unique<HilProcess>(args);
+    ready = process->wait_for_line("as a serial port at 115200 baud").has_value();
+  }
+  std::string device;
+  std::string wire_log;
+  std::unique_ptr<HilProcess> process;
+  bool ready = false;
+};
+
+const std::string kInfoTimeout = "--info-timeout-ms=5000";  // a loaded machine cannot miss it
+
+TEST(LekaClientBatch, GroupsSetLedsAndMotorsAndTheInfoIsPrinted) {
+  TempDir dir;
+  MockLeka mock(dir);
+  ASSERT_TRUE(mock.ready) << mock.process->output();
+  HilProcess client(LEKA_CLIENT_BINARY,
+                    {"--port", mock.device, kInfoTimeout, "--log", dir.file("run.csv"),
+                     "ear all 255 0 0; belt range 0 9 0 0 255; motor duo 1 200 0 200", "info"});
+  const auto code = client.wait_exit(std::chrono::seconds(20));
+  ASSERT_EQ(code, 0) << client.output();
+  EXPECT_NE(client.output().find("arg:1: ok, 3 commands, 1 frame, 21 bytes sent"),
+            std::string::npos)
+      << client.output();
+  EXPECT_NE(client.output().find(
+                "arg:2: ok, 1 command, 1 frame, 7 bytes sent; info name=leka firmware=1.0.0 "
+                "buffer=128 state=ok"),
+            std::string::npos)
+      << client.output();
+  // What the robot received: the group whole, then the info.
+  const auto received = delivered_to_car(mock.wire_log);
+  EXPECT_TRUE(any_contains(received,
+                           "2A 2B 2C 2D 0F 11 FF 00 00 14 00 09 00 00 FF 22 01 C8 00 "
+                           "C8 40"))
+      << read_file(mock.wire_log);
+  EXPECT_TRUE(any_contains(received, "motor.duo left=backward/200 right=forward/200"));
+  EXPECT_TRUE(any_contains(received, "2A 2B 2C 2D 01 70 70"));
+  // The client's own log holds both directions.
+  const std::string log = read_file(dir.file("run.csv"));
+  EXPECT_EQ(log.rfind("utc_us,direction,note,hex\n", 0), 0u) << log;
+  EXPECT_NE(log.find(",RX,LEKA name=leka"), std::string::npos) << log;
+  EXPECT_EQ(mock.process->interrupt(), 0);
+}
+
+TEST(LekaClientBatch, TheExampleShowScriptRunsAgainstTheMock) {
+  TempDir dir;
+  MockLeka mock(dir);
+  ASSERT_TRUE(mock.ready) << mock.process->output();
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", "pty://" + mock.device, kInfoTimeout, "--script",
+                                         "scenarios/clients/leka-client/show.leka"});
+  ASSERT_EQ(client.wait_exit(std::chrono::seconds(20)), 0) << client.output();
+  const std::string out = client.output();
+  EXPECT_NE(out.find("show.leka:7: ok, waited 300 ms"), std::string::npos) << out;
+  EXPECT_NE(out.find("show.leka:10: ok, 1 command, 1 frame, 7 bytes sent; info name=leka"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("show.leka:12: ok"), std::string::npos) << out;
+  const auto received = delivered_to_car(mock.wire_log);
+  EXPECT_TRUE(any_contains(received, "stop.robot + led.belt.single led=0 rgb=(255,255,255)"))
+      << read_file(mock.wire_log);
+  EXPECT_EQ(mock.process->interrupt(), 0);
+}
+
+TEST(LekaClientBatch, TheInfoReportsTheRobotsFaultState) {
+  TempDir dir;
+  MockLeka mock(dir, {"--commands"});
+  ASSERT_TRUE(mock.ready) << mock.process->output();
+  ASSERT_TRUE(mock.process->wait_for_line("type 'help' for desk commands"));
+  ASSERT_TRUE(mock.process->write_stdin("fault\n"));
+  ASSERT_TRUE(mock.process->wait_for_line("car0: fault state")) << mock.process->output();
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", mock.device, kInfoTimeout, "info"});
+  ASSERT_EQ(client.wait_exit(std::chrono::seconds(20)), 0) << client.output();
+  EXPECT_NE(client.output().find("state=fault"), std::string::npos) << client.output();
+  EXPECT_EQ(mock.process->interrupt(), 0);
+}
+
+TEST(LekaClientBatch, ScriptFromStdinAndAnInterruptSendsStopRobot) {
+  TempDir dir;
+  MockLeka mock(dir);
+  ASSERT_TRUE(mock.ready) << mock.process->output();
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", mock.device, kInfoTimeout, "--script", "-"});
+  ASSERT_TRUE(client.write_stdin("motor all 0 150\nwait 60s\nmotor all 0 10\n"));
+  client.close_stdin();
+  ASSERT_TRUE(client.wait_for_line("stdin:1: ok")) << client.output();
+  EXPECT_EQ(client.interrupt(std::chrono::seconds(10)), 130) << client.output();
+  EXPECT_NE(client.output().find("interrupted; stop robot sent"), std::string::npos)
+      << client.output();
+  // The robot got the stop (it is written before the port closes).
+  bool stopped = false;
+  for (int i = 0; i < 100 && !stopped; ++i) {
+    stopped = any_contains(delivered_to_car(mock.wire_log), "2A 2B 2C 2D 01 FF FF");
+    if (!stopped) ::usleep(100'000);
+  }
+  EXPECT_TRUE(stopped) << read_file(mock.wire_log);
+  EXPECT_FALSE(any_contains(delivered_to_car(mock.wire_log), "2A 2B 2C 2D 03 21 00 0A"));
+  EXPECT_EQ(mock.process->interrupt(), 0);
+}
+
+TEST(LekaClientBatch, DryRunPrintsTheSeedsExampleFramesByteForByte) {
+  HilProcess client(LEKA_CLIENT_BINARY, {"--dry-run", "--frame-bytes", "128", "--script",
+                                         "scenarios/clients/leka-client/seed-examples.leka"});
+  ASSERT_EQ(client.wait_exit(), 0) << client.output();
+  const std::string out = client.output();
+  EXPECT_NE(out.find("\n  2A 2B 2C 2D 05 15 00 FF 00 00 41\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("\n  2A 2B 2C 2D 01 70 70\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("\n  2A 2B 2C 2D 64 15 00 33 00 00 15 01 66 00 00 15 02 99 00 00 15 03 CC 00 "
+                     "00 15 04 FF 00 00 15 05 00 00 00 15 06 00 33 00 15 07 00 66 00 15 08 00 99 "
+                     "00 15 09 00 CC 00 15 0A 00 FF 00 15 0B 00 00 00 15 0C 00 00 33 15 0D 00 00 "
+                     "66 15 0E 00 00 99 15 0F 00 00 CC 15 10 FF 00 00 15 11 00 FF 00 15 12 00 00 "
+                     "FF 15 13 FF FF FF A8\n"),
+            std::string::npos)
+      << out;
+}
+
+TEST(LekaClientBatch, DryRunWithDefaultFramesSplitsTheBigGroup) {
+  HilProcess client(LEKA_CLIENT_BINARY,
+                    {"--dry-run", "--script", "scenarios/clients/leka-client/seed-examples.leka"});
+  ASSERT_EQ(client.wait_exit(), 0) << client.output();
+  const std::string out = client.output();
+  EXPECT_NE(out.find("\n  2A 2B 2C 2D 37 15 00 33 00 00"), std::string::npos) << out;
+  EXPECT_NE(out.find("\n  2A 2B 2C 2D 2D 15 0B 00 00 00"), std::string::npos) << out;
+}
+
+TEST(LekaClientBatch, ARangeErrorInAScriptIsExit2WithFileLineColumn) {
+  TempDir dir;
+  const std::string script = dir.file("bad.leka");
+  std::ofstream(script) << "# lights\near all 255 0 0\nbelt single 20 0 0 255\n";
+  // Nothing is opened: the script is checked first.
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", dir.file("nothing-here"), "--script", script});
+  ASSERT_EQ(client.wait_exit(), 2) << client.output();
+  EXPECT_NE(client.output().find(script + ":3:13: belt single: led must be 0..19, got 20"),
+            std::string::npos)
+      << client.output();
+}
+
+TEST(LekaClientBatch, AMissingDeviceIsAClearErrorAndExit1) {
+  TempDir dir;
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", dir.file("no-robot"), "info"});
+  ASSERT_EQ(client.wait_exit(), 1) << client.output();
+  EXPECT_NE(
+      client.output().find("cannot open " + dir.file("no-robot") + ": No such file or directory"),
+      std::string::npos)
+      << client.output();
+}
+
+TEST(LekaClientBatch, BadUsageIsExit2) {
+  HilProcess nothing(LEKA_CLIENT_BINARY, {"--port", "/tmp/x"});
+  EXPECT_EQ(nothing.wait_exit(), 2);
+  EXPECT_NE(nothing.output().find("nothing to send"), std::string::npos) << nothing.output();
+  HilProcess no_port(LEKA_CLIENT_BINARY, {"info"});
+  EXPECT_EQ(no_port.wait_exit(), 2);
+  HilProcess bad_log(LEKA_CLIENT_BINARY, {"--dry-run", "--log", "run.log", "info"});
+  EXPECT_EQ(bad_log.wait_exit(), 2);
+  EXPECT_NE(bad_log.output().find(".txt, .csv or .ndjson"), std::string::npos);
+  HilProcess bad_group(LEKA_CLIENT_BINARY, {"--dry-run", "info", "motor all 0 300"});
+  EXPECT_EQ(bad_group.wait_exit(), 2);
+  EXPECT_NE(bad_group.output().find("arg:2:13: motor all: speed must be 0..255, got 300"),
+            std::string::npos)
+      << bad_group.output();
+}
+
+}  // namespace
