@@ -138,7 +138,7 @@ void Wr8Console::print(const std::string& text) {
 }
 
 void Wr8Console::prompt() {
-  if (!options_.prompt || exited_ || runner_.busy() || !pending_.empty() || prompted_) return;
+  if (!options_.prompt || exited_ || running_ || !pending_.empty() || prompted_) return;
   out_ << "wr8> " << std::flush;
   prompted_ = true;
 }
@@ -236,7 +236,7 @@ void Wr8Console::interrupt() {
 }
 
 void Wr8Console::process() {
-  while (!exited_ && !runner_.busy() && !pending_.empty()) {
+  while (!exited_ && !running_ && !pending_.empty()) {
     const std::string text = std::move(pending_.front());
     pending_.pop_front();
     if (builtin(text)) continue;
@@ -246,13 +246,15 @@ void Wr8Console::process() {
       continue;
     }
     if (!parsed.action) continue;
+    running_ = true;
     runner_.execute(std::move(*parsed.action), [this](const wr8::ActionResult& r) {
+      running_ = false;
       result(r);
       process();
     });
   }
   if (exited_) return;
-  if (input_ended_ && !runner_.busy() && pending_.empty()) {
+  if (input_ended_ && !running_ && pending_.empty()) {
     exit(kExitOk);
     return;
   }

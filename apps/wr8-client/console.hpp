@@ -83,6 +83,7 @@ class Wr8Console {
   std::deque<std::string> pending_;
   bool input_ended_ = false;
   bool prompted_ = false;
+  bool running_ = false;  // an action of ours is under way (until its result is printed)
   std::vector<std::string> history_;  // the actions run, with their results
 
   // --data: the last DATA printed.
