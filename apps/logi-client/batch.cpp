@@ -1,0 +1,338 @@
+#include "apps/logi-client/batch.hpp"
+
+#include <asio/io_context.hpp>
+#include <asio/signal_set.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <iterator>
+#include <memory>
+#include <sstream>
+
+#include "client/logi/session.hpp"
+#include "link/asio_executor.hpp"
+#include "link/endpoint.hpp"
+#include "link/transport.hpp"
+
+namespace hil::apps::logi_client {
+
+namespace proto = hil::protocol::logi;
+using logi::ConnectionState;
+
+// ---- input ----
+
+LoadedScript load_script_file(const std::string& path) {
+  LoadedScript loaded;
+  std::string text;
+  std::string name = path;
+  if (path == "-") {
+    name = "<stdin>";
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+      loaded.error = path + ": cannot read the script";
+      return loaded;
+    }
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  auto script = logi::parse_operator_script(text, name);
+  if (!script.ok()) {
+    loaded.error = script.error->to_string();
+    return loaded;
+  }
+  loaded.steps = std::move(script.steps);
+  return loaded;
+}
+
+LoadedScript load_script_arguments(const std::vector<std::string>& actions) {
+  LoadedScript loaded;
+  for (std::size_t i = 0; i < actions.size(); ++i) {
+    const int number = static_cast<int>(i) + 1;
+    if (actions[i].find('\n') != std::string::npos) {
+      loaded.error = "<command line>:" + std::to_string(number) +
+                     ":1: one action per argument (this one has a line break)";
+      return loaded;
+    }
+    const auto parsed = logi::parse_operator_action(actions[i]);
+    if (parsed.error) {
+      loaded.error = logi::OperatorScriptError{"<command line>", number, parsed.error->column,
+                                               parsed.error->message}
+                         .to_string();
+      return loaded;
+    }
+    if (!parsed.action) continue;  // an empty or comment-only argument
+    std::string text = actions[i].substr(0, actions[i].find('#'));
+    text.erase(0, text.find_first_not_of(" \t\r"));
+    text.erase(text.find_last_not_of(" \t\r") + 1);
+    loaded.steps.push_back(logi::OperatorStep{number, text, *parsed.action});
+  }
+  return loaded;
+}
+
+// ---- log ----
+
+namespace {
+std::string extension_of(const std::string& path) {
+  return std::filesystem::path(path).extension().string();
+}
+}  // namespace
+
+std::optional<std::string> check_log_path(const std::string& path) {
+  const auto ext = extension_of(path);
+  if (ext == ".txt" || ext == ".csv" || ext == ".ndjson") return std::nullopt;
+  return "--log " + path + ": the format comes from the extension: .txt, .csv or .ndjson";
+}
+
+bool write_log(const logi::CommLog& log, const std::string& path, std::string& error) {
+  const auto ext = extension_of(path);
+  std::string text;
+  if (ext == ".csv") {
+    text = log.export_csv();
+  } else if (ext == ".ndjson") {
+    text = log.export_ndjson();
+  } else {
+    text = log.export_text();
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out || !out.write(text.data(), static_cast<std::streamsize>(text.size())) || !out.flush()) {
+    error = "cannot write the log to " + path;
+    return false;
+  }
+  return true;
+}
+
+// ---- reporting ----
+
+std::string stamp(logi::Time at) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "[%7.3f s]", std::chrono::duration<double>(at).count());
+  return buf;
+}
+
+std::string BatchReporter::result_line(const logi::ActionResult& result) {
+  std::string line = stamp(result.ended) + (result.ok ? " ok   " : " FAIL ") + result.text;
+  if (!result.ok) line += ": " + result.reason;
+  return line;
+}
+
+namespace {
+
+std::string status_text(const proto::Status& s) {
+  char station[8];
+  std::snprintf(station, sizeof station, "%03d", s.station);
+  std::string text =
+      "MODE " + std::string(proto::to_string(s.mode)) + "  RUN " + (s.running ? "1" : "0") +
+      "  STA " + station + "  SP " + std::to_string(s.speed_percent) + "  MAN " +
+      std::string(proto::to_string(s.manual)) + "  DIS " + std::to_string(s.distance_cm) + " cm";
+  if (s.obstacle) text += "  OBSTACLE";
+  return text;
+}
+
+bool operator_fields_differ(const proto::Status& a, const proto::Status& b) {
+  return a.mode != b.mode || a.running != b.running || a.station != b.station ||
+         a.speed_percent != b.speed_percent || a.manual != b.manual || a.obstacle != b.obstacle;
+}
+
+}  // namespace
+
+std::optional<std::string> BatchReporter::event_line(logi::Time now, const logi::Event& event) {
+  const std::string at = stamp(now);
+  if (const auto* c = std::get_if<logi::ConnectionEvent>(&event)) {
+    switch (c->state) {
+      case ConnectionState::connecting:
+        if (c->attempt == 0) return std::nullopt;
+        return at + " link reconnect attempt " + std::to_string(c->attempt);
+      case ConnectionState::connected:
+        return at + " link connected";
+      case ConnectionState::waiting_to_reconnect:
+        shown_.reset();
+        return at + " WARN not connected (lost or refused); reconnecting, attempt " +
+               std::to_string(c->attempt) + " pending";
+      case ConnectionState::disconnected:
+        shown_.reset();
+        return at + " link disconnected";
+    }
+    return std::nullopt;
+  }
+  if (const auto* s = std::get_if<logi::StatusEvent>(&event)) {
+    if (shown_ && !operator_fields_differ(*shown_, s->status)) return std::nullopt;
+    shown_ = s->status;
+    return at + " car  " + status_text(s->status);
+  }
+  if (const auto* s = std::get_if<logi::StaleEvent>(&event)) {
+    return at + (s->stale ? " WARN telemetry stale: no STAT for 2 s or more"
+                          : " car  telemetry fresh again");
+  }
+  if (const auto* n = std::get_if<logi::NoticeEvent>(&event)) {
+    return at + " note " + n->text;
+  }
+  if (const auto* p = std::get_if<logi::ParseErrorEvent>(&event)) {
+    std::string raw;
+    for (auto b : p->error.raw) {
+      if (b >= 0x20 && b < 0x7f) {
+        raw += static_cast<char>(b);
+      } else {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "\\x%02X", b);
+        raw += hex;
+      }
+    }
+    return at + " WARN dropped a bad frame from the car (" +
+           std::string(protocol::to_string(p->error.kind)) + "): " + raw;
+  }
+  if (const auto* f = std::get_if<logi::FeedbackEvent>(&event)) {
+    if (f->request != 0) return std::nullopt;
+    return at + " WARN feedback that answers nothing sent: FB:" +
+           std::string(proto::to_string(f->feedback.command)) + ":" +
+           (f->feedback.accepted ? "1" : "0");
+  }
+  if (const auto* c = std::get_if<logi::CommandEvent>(&event)) {
+    if (c->state == logi::CommandState::sent && c->attempt > 1) {
+      return at + " note no feedback yet: " + proto::kind_of(c->command) + " sent again (attempt " +
+             std::to_string(c->attempt) + ")";
+    }
+  }
+  return std::nullopt;
+}
+
+// ---- the run ----
+
+namespace {
+
+/// The program's run: session, runner, signals, and the way out.
+class BatchRun {
+ public:
+  BatchRun(const BatchOptions& options, std::vector<logi::OperatorStep> steps, std::ostream& out,
+           std::ostream& err)
+      : options_(options), out_(out), err_(err), signals_(io_, SIGINT, SIGTERM) {
+    logi::ClientConfig config;
+    config.keepalive = options.keepalive;
+    session_ = std::make_unique<logi::LogiSession>(
+        context_, link::TcpEndpoint{options.host, options.port}, config,
+        [this](logi::Time now, const logi::Event& e) { on_event(now, e); });
+    runner_ = std::make_unique<logi::OperatorRunner>(
+        *session_, executor_, std::move(steps), options.runner,
+        [this](const logi::ActionResult& r) { print(BatchReporter::result_line(r)); },
+        [this](const logi::RunSummary& s) {
+          // Leave the runner's callback before tearing anything down.
+          executor_.post([this, s] {
+            if (s.ok) {
+              shut_down(kExitOk, false);
+            } else {
+              shut_down(kExitActionFailed, true);
+            }
+          });
+        });
+  }
+
+  int run() {
+    signals_.async_wait([this](const std::error_code& ec, int signal) { on_signal(ec, signal); });
+    runner_->start();
+    io_.run();
+    if (!options_.log_path.empty()) {
+      std::string error;
+      if (!write_log(*session_->log(), options_.log_path, error)) {
+        err_ << "logi-client: " << error << '\n';
+      }
+    }
+    out_.flush();
+    return exit_code_;
+  }
+
+ private:
+  void print(const std::string& line) { out_ << line << std::endl; }
+
+  void on_event(logi::Time now, const logi::Event& e) {
+    if (auto line = reporter_.event_line(now, e)) print(*line);
+    if (runner_) runner_->on_event(now, e);
+  }
+
+  void on_signal(const std::error_code& ec, int signal) {
+    if (ec) return;
+    if (stopping_) {
+      // A second Ctrl-C: out now, without waiting for the car.
+      print(stamp(executor_.now()) + " interrupted again: leaving at once");
+      exit_code_ = kExitInterrupted;
+      io_.stop();
+      return;
+    }
+    print(stamp(executor_.now()) + " interrupted (" + (signal == SIGTERM ? "SIGTERM" : "SIGINT") +
+          "): stopping");
+    signals_.async_wait([this](const std::error_code& e, int s) { on_signal(e, s); });
+    runner_->cancel();
+    shut_down(kExitInterrupted, true);
+  }
+
+  bool car_may_be_moving() const {
+    const auto& core = session_->core();
+    if (core.held()) return true;
+    const auto& s = core.last_status();
+    return s && (s->running || s->manual != proto::Direction::stop);
+  }
+
+  /// Ends the run: an emergency stop first if asked and the car may be
+  /// moving, then disconnect and leave the io_context.
+  void shut_down(int code, bool stop_car) {
+    if (stopping_) return;
+    stopping_ = true;
+    exit_code_ = code;
+    runner_->cancel();  // no-op when the run already ended
+    const bool connected = session_->core().state() == ConnectionState::connected;
+    if (stop_car && connected && car_may_be_moving()) {
+      print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
+            (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
+      session_->emergency_stop();
+      // Wait for the car's answers (or their timeouts), within a bound.
+      stop_deadline_ = executor_.now() + link::seconds(3);
+      poll_stop();
+      return;
+    }
+    finish();
+  }
+
+  void poll_stop() {
+    const auto& core = session_->core();
+    const bool settled = core.in_flight() == 0 && core.queued() == 0;
+    if (settled || core.state() != ConnectionState::connected ||
+        executor_.now() >= stop_deadline_) {
+      finish();
+      return;
+    }
+    executor_.call_after(link::milliseconds(10), [this] { poll_stop(); });
+  }
+
+  void finish() {
+    session_->disconnect();
+    signals_.cancel();
+    executor_.post([this] { io_.stop(); });
+  }
+
+  const BatchOptions& options_;
+  std::ostream& out_;
+  std::ostream& err_;
+  asio::io_context io_;
+  link::AsioExecutor executor_{io_};
+  link::TransportContext context_{executor_, &io_};
+  asio::signal_set signals_;
+  std::unique_ptr<logi::LogiSession> session_;
+  std::unique_ptr<logi::OperatorRunner> runner_;
+  BatchReporter reporter_;
+  bool stopping_ = false;
+  int exit_code_ = kExitOk;
+  logi::Time stop_deadline_{0};
+};
+
+}  // namespace
+
+int run_batch(const BatchOptions& options, std::vector<logi::OperatorStep> steps, std::ostream& out,
+              std::ostream& err) {
+  BatchRun run(options, std::move(steps), out, err);
+  return run.run();
+}
+
+}  // namespace hil::apps::logi_client
