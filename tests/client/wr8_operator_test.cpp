@@ -292,6 +292,14 @@ TEST(Wr8OperatorRunner, ATaskBeforeConnectIsRefusedAsNotConnected) {
   EXPECT_EQ(r[0].finished, Time{0});
 }
 
+TEST(Wr8OperatorRunner, ARawTaskTheProfileCannotEncodeIsRefusedAsBadRequest) {
+  Bench bench;
+  const auto r = bench.run("connect\ntask drive\n");
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_FALSE(r[1].ok);
+  EXPECT_EQ(r[1].detail, "refused: bad request");
+}
+
 TEST(Wr8OperatorRunner, ARejectedLoginFailsConnectWithTheReasonAndStopsRetrying) {
   ClientConfig config;
   config.profile.auth_text = {'W', 'R', 'O', 'N', 'G', '-', 'A', 'U', 'T', 'H'};
