@@ -1,0 +1,311 @@
+#include "apps/arduino-client/app.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include <asio/io_context.hpp>
+#include <asio/posix/stream_descriptor.hpp>
+#include <asio/read_until.hpp>
+#include <asio/signal_set.hpp>
+#include <asio/streambuf.hpp>
+#include <cmath>
+#include <csignal>
+#include <functional>
+#include <iostream>
+#include <string_view>
+#include <utility>
+
+#include "client/arduino/session.hpp"
+#include "link/asio_executor.hpp"
+#include "link/transport.hpp"
+
+namespace hil::apps::arduino_client {
+
+namespace arduino = client::arduino;
+
+namespace {
+
+void say(const std::string& text) {
+  if (text.empty()) return;
+  std::cout << text << '\n' << std::flush;
+}
+
+void warn(const std::string& text) {
+  std::cerr << text << '\n' << std::flush;
+}
+
+/// The interactive loop: lines from stdin, parsed and queued on the runner.
+/// Reads through asio so the session keeps running while nothing is typed.
+class Repl {
+ public:
+  Repl(asio::io_context& io, arduino::OperatorRunner& runner, bool interactive,
+       std::function<void(int)> exit)
+      : stdin_flags_(::fcntl(STDIN_FILENO, F_GETFL)),
+        input_(io),
+        runner_(runner),
+        interactive_(interactive),
+        exit_(std::move(exit)) {}
+  ~Repl() { stop(); }
+  Repl(const Repl&) = delete;
+  Repl& operator=(const Repl&) = delete;
+
+  void start() {
+    const int fd = ::dup(STDIN_FILENO);
+    std::error_code ec;
+    if (fd >= 0) input_.assign(fd, ec);
+    if (fd < 0 || ec) {
+      if (fd >= 0) ::close(fd);
+      input_done_ = true;
+      on_idle();
+      return;
+    }
+    prompt();
+    read();
+  }
+
+  void stop() {
+    if (!input_.is_open()) return;
+    std::error_code ec;
+    input_.close(ec);
+    // Asio made the shared file description non-blocking; the shell that
+    // gets the terminal back expects it as it was.
+    if (stdin_flags_ != -1) ::fcntl(STDIN_FILENO, F_SETFL, stdin_flags_);
+  }
+
+  /// The runner has nothing left to do.
+  void on_idle() {
+    if (runner_.quit_requested() || input_done_) {
+      exit_(0);
+      return;
+    }
+    prompt();
+  }
+
+ private:
+  void prompt() {
+    if (!interactive_ || prompted_) return;
+    prompted_ = true;
+    std::cout << "arduino> " << std::flush;
+  }
+
+  void read() {
+    asio::async_read_until(input_, buffer_, '\n', [this](std::error_code ec, std::size_t n) {
+      if (ec) {
+        // End of input (Ctrl-D, the pipe closed) or stdin cannot be read:
+        // a last line without a newline still counts.
+        std::string rest(asio::buffers_begin(buffer_.data()), asio::buffers_end(buffer_.data()));
+        buffer_.consume(buffer_.size());
+        input_done_ = true;
+        if (!rest.empty()) handle(rest);
+        if (runner_.idle()) on_idle();
+        return;
+      }
+      std::string line(asio::buffers_begin(buffer_.data()),
+                       asio::buffers_begin(buffer_.data()) + static_cast<std::ptrdiff_t>(n));
+      buffer_.consume(n);
+      handle(line);
+      if (!runner_.halted()) read();
+    });
+  }
+
+  void handle(std::string line) {
+    while (!line.empty() && (line.back() == '\n' || line.back() == '\r'))
+      line.pop_back();
+    prompted_ = false;
+    const auto parsed = arduino::parse_operator_line(line);
+    if (parsed.error) {
+      warn("error: column " + std::to_string(parsed.error->column) + ": " + parsed.error->message);
+    } else if (parsed.command) {
+      runner_.add(*parsed.command);
+      return;  // the runner says when it is idle again
+    }
+    if (runner_.idle() && !input_done_) prompt();
+  }
+
+  int stdin_flags_;
+  asio::posix::stream_descriptor input_;
+  asio::streambuf buffer_;
+  arduino::OperatorRunner& runner_;
+  bool interactive_;
+  std::function<void(int)> exit_;
+  bool input_done_ = false;
+  bool prompted_ = false;
+};
+
+std::string link_change_text(const arduino::LinkChanged& change, const std::string& port) {
+  std::string text = "link " + std::string(arduino::to_string(change.to));
+  if (change.from == arduino::LinkState::opening && change.to == arduino::LinkState::down) {
+    return text + ": cannot open " + port + " (" + change.reason + ")";
+  }
+  if (!change.reason.empty() && change.to != arduino::LinkState::open) {
+    text += ": " + change.reason;
+  }
+  return text;
+}
+
+}  // namespace
+
+ParsedArguments parse_arguments(int argc, const char* const* argv) {
+  AppOptions o;
+  CLI::App app{"arduino-client: steer the Arduino serial robot (raw tokens, a script, or a REPL)"};
+  app.add_option("-p,--port", o.port,
+                 "Serial device (/dev/ttyUSB0, /tmp/hil-arduino0) or a hil endpoint (pty://..., "
+                 "tcp://HOST:PORT)")
+      ->required();
+  app.add_option("--baud", o.baud, "Line rate of the serial port (default 9600)")
+      ->check(CLI::Range(0u, 4000000u));
+  app.add_option("--timeout", o.timeout_s,
+                 "Seconds the first attempt waits for an answer; each retry doubles it "
+                 "(default 0.6)")
+      ->check(CLI::Range(0.001, 60.0));
+  app.add_option("--retries", o.retries, "Retries after the first attempt (default 3)")
+      ->check(CLI::Range(0, 10));
+  app.add_option("--log", o.log_path,
+                 "Write the frame log here at exit: .txt, .csv, .json or .ndjson");
+  app.add_option("--script", o.script, "Run the commands of this file, one per line");
+  app.add_flag("--keep-going", o.keep_going,
+               "Tokens and scripts: run every command even after one failed (exit 1 at the end)");
+  app.add_option("tokens", o.tokens,
+                 "Commands to run once each, e.g. PING \"V 160\" M:20 STATUS (no tokens and no "
+                 "script: the REPL)");
+  app.footer(
+      "Commands: PING STATUS V <0..255> M <cm> R <deg> S B I HELP (any case, 'V 160' or "
+      "'V:160'),\n"
+      "  history, save-log PATH, reconnect, wait 500ms|1s, quit/exit; '#' starts a comment.\n"
+      "Exit codes: 0 all went well, 1 a command failed (NACK, timeout, link down), 2 bad usage\n"
+      "  or a script line that does not parse, 130 interrupted.\n"
+      "Examples:\n"
+      "  arduino-client --port /dev/ttyUSB0\n"
+      "  arduino-client --port /tmp/hil-arduino0 PING \"V 160\" \"M 20\" STATUS\n"
+      "  arduino-client --port /tmp/hil-arduino0 --script square.txt --log run.csv\n");
+  ParsedArguments out;
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    out.exit_code = app.exit(e) == 0 ? 0 : 2;
+    return out;
+  }
+  if (!o.script.empty() && !o.tokens.empty()) {
+    warn("arduino-client: give either --script or command tokens, not both");
+    out.exit_code = 2;
+    return out;
+  }
+  out.options = std::move(o);
+  return out;
+}
+
+link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
+  if (port.find("://") != std::string::npos) {
+    link::Endpoint e = link::parse_endpoint(port);
+    if (auto* pty = std::get_if<link::PtyEndpoint>(&e); pty && pty->baud == 0) pty->baud = baud;
+    return e;
+  }
+  if (port.empty()) throw link::EndpointError("--port needs a device path");
+  return link::PtyEndpoint{port, baud, link::Duration{0}};
+}
+
+TokenCommands commands_from_tokens(const std::vector<std::string>& tokens) {
+  TokenCommands out;
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    const auto parsed = arduino::parse_operator_line(tokens[i]);
+    if (parsed.error) {
+      out.errors.push_back("argument " + std::to_string(i + 1) + " '" + tokens[i] + "', column " +
+                           std::to_string(parsed.error->column) + ": " + parsed.error->message);
+    } else if (parsed.command) {
+      out.commands.push_back(*parsed.command);
+    }
+  }
+  return out;
+}
+
+int run(const AppOptions& options) {
+  // Everything is parsed before the port is touched: a typo costs nothing.
+  std::vector<arduino::OperatorCommand> batch;
+  const bool is_batch = !options.script.empty() || !options.tokens.empty();
+  if (!options.script.empty()) {
+    const auto script = arduino::load_script(options.script);
+    for (const auto& e : script.errors)
+      warn(e.to_string());
+    if (!script.ok()) return 2;
+    batch = script.commands();
+  } else if (!options.tokens.empty()) {
+    auto tokens = commands_from_tokens(options.tokens);
+    for (const auto& e : tokens.errors)
+      warn("arduino-client: " + e);
+    if (!tokens.errors.empty()) return 2;
+    batch = std::move(tokens.commands);
+  }
+  link::Endpoint endpoint;
+  try {
+    endpoint = endpoint_for_port(options.port, options.baud);
+  } catch (const link::EndpointError& e) {
+    warn(std::string("arduino-client: --port: ") + e.what());
+    return 2;
+  }
+
+  arduino::ClientConfig config;
+  config.base_timeout =
+      link::Duration(static_cast<link::Duration::rep>(std::llround(options.timeout_s * 1e9)));
+  config.max_retries = options.retries;
+
+  asio::io_context io;
+  link::AsioExecutor executor{io};
+  link::TransportContext context{executor, &io};
+  arduino::ArduinoSession session(context, endpoint, config);
+  arduino::OperatorRunner runner(session, executor,
+                                 {.keep_going = options.keep_going || !is_batch});
+
+  std::optional<int> exit_code;
+  auto finish = [&](int code) {
+    if (exit_code) return;
+    exit_code = code;
+    io.stop();
+  };
+
+  runner.set_event_handler([&](const arduino::Event& event) {
+    const auto* change = std::get_if<arduino::LinkChanged>(&event);
+    // OPENING and CLOSED are the program's own doing; the rest is news.
+    if (change == nullptr || change->to == arduino::LinkState::opening ||
+        change->to == arduino::LinkState::closed) {
+      return;
+    }
+    warn(link_change_text(*change, options.port));
+  });
+  runner.set_outcome_handler(
+      [](const arduino::CommandOutcome& outcome) { say(arduino::describe_outcome(outcome)); });
+
+  asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](std::error_code ec, int) {
+    if (!ec) finish(130);
+  });
+
+  std::unique_ptr<Repl> repl;
+  session.open();
+  if (is_batch) {
+    runner.set_idle_handler([&] { finish(runner.failures() == 0 ? 0 : 1); });
+    runner.add(batch);
+  } else {
+    const bool interactive = ::isatty(STDIN_FILENO) != 0;
+    repl = std::make_unique<Repl>(io, runner, interactive, finish);
+    runner.set_idle_handler([&] { repl->on_idle(); });
+    repl->start();
+  }
+  if (!exit_code) io.run();
+
+  if (repl) repl->stop();
+  runner.set_idle_handler({});
+  runner.set_outcome_handler({});
+  session.close();
+  if (!options.log_path.empty()) {
+    const auto format = arduino::CommLog::format_for(options.log_path);
+    if (!session.log().save(options.log_path, format)) {
+      warn("arduino-client: cannot write the log to " + options.log_path);
+      if (exit_code == 0) exit_code = 1;
+    }
+  }
+  return exit_code.value_or(0);
+}
+
+}  // namespace hil::apps::arduino_client

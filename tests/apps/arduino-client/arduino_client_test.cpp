@@ -1,0 +1,248 @@
+// arduino-client run as a user runs it, against `hil mock arduino` on a real
+// pty at 9600 baud: raw tokens, scripts, the REPL through a pipe, failures
+// and their exit codes. Waits are bounded and generous.
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/arduino-client/app.hpp"
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace hil::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// A temp dir with the mock robot on a pty in it.
+struct ArduinoClientCli : ::testing::Test {
+  void SetUp() override {
+    dir = std::filesystem::temp_directory_path() /
+          ("hil-arduino-client-" + std::to_string(::getpid()) + "-" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir);
+    port = (dir / "robot0").string();
+  }
+  void TearDown() override {
+    if (mock) {
+      EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+    }
+    std::filesystem::remove_all(dir);
+  }
+
+  void start_mock(std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{"mock", "arduino", "--pty", port};
+    args.insert(args.end(), extra.begin(), extra.end());
+    mock.emplace(args);
+    ASSERT_TRUE(mock->wait_for_line("as a serial port at 9600 baud")) << mock->output();
+  }
+
+  std::filesystem::path write(const std::string& name, const std::string& text) {
+    const auto path = dir / name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  /// Runs arduino-client with `args` (after --port) to its exit.
+  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 30s) {
+    args.insert(args.begin(), {"--port", port});
+    HilProcess process(ARDUINO_CLIENT_BINARY, args);
+    process.close_stdin();
+    CommandResult result;
+    const auto code = process.wait_exit(limit);
+    result.exit_code = code.value_or(-1);
+    result.output = process.output();
+    return result;
+  }
+
+  std::filesystem::path dir;
+  std::string port;
+  std::optional<HilProcess> mock;
+};
+
+TEST_F(ArduinoClientCli, RawTokensRunOnceEachAndTheStatusShowsTheSpeedSet) {
+  start_mock();
+  const auto r = client({"PING", "V 160", "STATUS"});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "PING -> ACK OK\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 160 -> ACK 160\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=160 ")) << r.output;
+  // The seed CLI's raw form works too, and the robot moves.
+  const auto move = client({"v:200", "M:20", "status"});
+  EXPECT_EQ(move.exit_code, 0) << move.output;
+  EXPECT_TRUE(contains(move.output, "STATUS -> ACK MOVING M:20 PWM=200 ")) << move.output;
+}
+
+TEST_F(ArduinoClientCli, AScriptRunsAndItsFrameLogIsWritten) {
+  start_mock();
+  const auto script = write("cmds.txt", "# speed, then look\nping\nV 120\n\nB\nstatus\n");
+  const auto log = dir / "run.csv";
+  const auto r = client({"--script", script.string(), "--log", log.string()});
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 120 -> ACK 120\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "B -> ACK ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=120 ")) << r.output;
+  const auto csv = read_file(log);
+  EXPECT_EQ(csv.rfind("time,direction,seq,raw,hex\n", 0), 0u) << csv;
+  EXPECT_TRUE(contains(csv, ",TX,01,^01|V|120*")) << csv;
+  EXPECT_TRUE(contains(csv, ",RX,01,^01|ACK|120*")) << csv;
+}
+
+TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
+  start_mock();
+  const std::filesystem::path examples =
+      std::filesystem::path(HIL_SOURCE_DIR) / "scenarios/clients/arduino-client";
+  for (const auto& name : {"sensors.txt", "square.txt"}) {
+    const auto r = client({"--script", (examples / name).string()});
+    EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.output;
+    EXPECT_FALSE(contains(r.output, "NACK")) << r.output;
+  }
+  const auto r = client({"STATUS"});
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=140 ")) << "a fresh boot: " << r.output;
+}
+
+TEST_F(ArduinoClientCli, TheReplReadsAPipeAndQueuesLinesInOrder) {
+  start_mock();
+  HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(repl.write_stdin("ping\n"));
+  ASSERT_TRUE(repl.wait_for_line("PING -> ACK OK")) << repl.output();
+  // Three lines at once: the second and third wait for the one before.
+  ASSERT_TRUE(repl.write_stdin("V 170\nM 10\nstatus\n"));
+  ASSERT_TRUE(repl.wait_for_line("V 170 -> ACK 170")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("M 10 -> ACK OK")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK MOVING M:10 PWM=170 ")) << repl.output();
+  // A bad line is an error and the REPL goes on.
+  ASSERT_TRUE(repl.write_stdin("V 300\n"));
+  const auto error = repl.wait_for_line("error: column 3:");
+  ASSERT_TRUE(error) << repl.output();
+  EXPECT_TRUE(contains(*error, "V needs a number 0..255, not '300'")) << *error;
+  ASSERT_TRUE(repl.write_stdin("history\n"));
+  ASSERT_TRUE(repl.wait_for_line("TX seq=00 ^00|PING|*10$")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("|ACK|MOVING M:10 PWM=170")) << repl.output();
+  const auto log = dir / "session.ndjson";
+  ASSERT_TRUE(repl.write_stdin("save-log " + log.string() + "\n"));
+  const auto saved = repl.wait_for_line(" frame(s) to " + log.string() + " (ndjson)");
+  ASSERT_TRUE(saved) << repl.output();
+  // 8 frames, and 2 more for each health-check PING a slow machine let in.
+  const int frames = std::stoi(saved->substr(saved->find("saved ") + 6));
+  EXPECT_GE(frames, 8) << *saved;
+  ASSERT_TRUE(repl.write_stdin("quit\n"));
+  EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
+  EXPECT_FALSE(contains(repl.output(), "arduino> ")) << "no prompt on a pipe";
+  const auto ndjson = read_file(log);
+  EXPECT_TRUE(contains(ndjson, R"("raw":"^00|PING|*10$")")) << ndjson;
+  EXPECT_TRUE(contains(ndjson, R"("direction":"RX")")) << ndjson;
+  EXPECT_EQ(std::count(ndjson.begin(), ndjson.end(), '\n'), frames) << ndjson;
+}
+
+TEST_F(ArduinoClientCli, TheReplEndsAtTheEndOfItsInputAfterTheLastReply) {
+  start_mock();
+  HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(repl.write_stdin("V 90\nstatus"));  // the last line has no newline
+  repl.close_stdin();
+  EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
+  EXPECT_TRUE(contains(repl.output(), "V 90 -> ACK 90\n")) << repl.output();
+  EXPECT_TRUE(contains(repl.output(), "STATUS -> ACK IDLE PWM=90 ")) << repl.output();
+}
+
+TEST_F(ArduinoClientCli, ReconnectReopensThePortAndTheBoardResets) {
+  start_mock();
+  HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
+  ASSERT_TRUE(repl.write_stdin("V 99\nreconnect\nstatus\n"));
+  ASSERT_TRUE(repl.wait_for_line("reconnected, link OPEN")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK IDLE PWM=140 ")) << repl.output();
+  EXPECT_EQ(repl.interrupt(), 130) << repl.output();
+}
+
+TEST_F(ArduinoClientCli, ANackedCommandExits1WithItsCodeAndStopsTheRun) {
+  const auto behaviours =
+      write("reject-v.yaml", "behaviours:\n  - do: reject\n    match: V\n    times: 1\n");
+  start_mock({"--behaviours", behaviours.string()});
+  const auto r = client({"PING", "V 160", "STATUS"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 160 -> NACK BUSY\n")) << r.output;
+  EXPECT_FALSE(contains(r.output, "STATUS ->")) << "the run stops at the failure: " << r.output;
+  // --keep-going runs the rest and still exits 1.
+  EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+  mock.reset();
+  start_mock({"--behaviours", behaviours.string()});
+  const auto all = client({"--keep-going", "V 160", "STATUS"});
+  EXPECT_EQ(all.exit_code, 1) << all.output;
+  EXPECT_TRUE(contains(all.output, "STATUS -> ACK IDLE PWM=140 ")) << all.output;
+}
+
+TEST_F(ArduinoClientCli, ATypoInAScriptExits2WithFileLineAndColumn) {
+  const auto script = write("typo.txt", "ping\nV 160\n  stauts\n");
+  const auto r = client({"--script", script.string()});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, script.string() + ":3:3: unknown command 'stauts'")) << r.output;
+  EXPECT_FALSE(contains(r.output, "PING ->")) << "nothing runs: " << r.output;
+  const auto token = client({"PING", "V 999"});
+  EXPECT_EQ(token.exit_code, 2) << token.output;
+  EXPECT_TRUE(contains(token.output, "argument 2 'V 999', column 3: V needs a number 0..255"))
+      << token.output;
+}
+
+TEST_F(ArduinoClientCli, APortThatDoesNotExistIsAClearErrorAndExit1) {
+  const auto r = client({"PING"});  // no mock: the pty path does not exist
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "link DOWN: cannot open " + port)) << r.output;
+  EXPECT_TRUE(contains(r.output, "PING -> LINK DOWN (")) << r.output;
+}
+
+TEST_F(ArduinoClientCli, BadUsageExits2AndHelpExits0) {
+  HilProcess no_port(ARDUINO_CLIENT_BINARY, {"PING"});
+  EXPECT_EQ(no_port.wait_exit(20s), 2) << no_port.output();
+  EXPECT_TRUE(contains(no_port.output(), "--port")) << no_port.output();
+  HilProcess both(ARDUINO_CLIENT_BINARY, {"--port", port, "--script", "x.txt", "PING"});
+  EXPECT_EQ(both.wait_exit(20s), 2) << both.output();
+  HilProcess help(ARDUINO_CLIENT_BINARY, {"--help"});
+  EXPECT_EQ(help.wait_exit(20s), 0) << help.output();
+  EXPECT_TRUE(contains(help.output(), "save-log")) << help.output();
+}
+
+TEST(ArduinoClientPort, ADevicePathIsASerialPortAndAUriIsTakenAsItIs) {
+  using apps::arduino_client::endpoint_for_port;
+  EXPECT_EQ(endpoint_for_port("/dev/ttyUSB0", 9600),
+            link::Endpoint(link::PtyEndpoint{"/dev/ttyUSB0", 9600, link::Duration{0}}));
+  EXPECT_EQ(endpoint_for_port("pty:///tmp/hil-arduino0", 115200),
+            link::Endpoint(link::PtyEndpoint{"/tmp/hil-arduino0", 115200, link::Duration{0}}));
+  EXPECT_EQ(endpoint_for_port("pty:///tmp/a?baud=300", 9600),
+            link::Endpoint(link::PtyEndpoint{"/tmp/a", 300, link::Duration{0}}));
+  EXPECT_EQ(endpoint_for_port("tcp://127.0.0.1:9200", 9600),
+            link::Endpoint(link::TcpEndpoint{"127.0.0.1", 9200}));
+  EXPECT_THROW(endpoint_for_port("ftp://x", 9600), link::EndpointError);
+}
+
+TEST(ArduinoClientTokens, EachArgumentIsOneCommandAndErrorsNameTheArgument) {
+  using apps::arduino_client::commands_from_tokens;
+  const auto ok = commands_from_tokens({"PING", "V:160", "m -20", "wait 1s"});
+  EXPECT_TRUE(ok.errors.empty());
+  EXPECT_EQ(ok.commands.size(), 4u);
+  const auto bad = commands_from_tokens({"PING", "V", "R x"});
+  ASSERT_EQ(bad.errors.size(), 2u);
+  EXPECT_EQ(bad.errors[0], "argument 2 'V', column 2: V needs a number 0..255");
+  EXPECT_EQ(bad.errors[1].rfind("argument 3 'R x', column 3: R needs an angle", 0), 0u);
+}
+
+}  // namespace
+}  // namespace hil::test

@@ -1,0 +1,458 @@
+// The Arduino operator language (every command, every error with its column,
+// scripts with file:line:col) and the runner that carries commands out on a
+// session against the mock robot on mem:// in virtual time, with exact times.
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <rapidcheck/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "client/arduino/operator.hpp"
+#include "link/executor.hpp"
+#include "link/transport.hpp"
+#include "mocks/arduino.hpp"
+#include "mocks/server.hpp"
+#include "sim/presets.hpp"
+#include "sim/world.hpp"
+
+namespace hil::client::arduino {
+namespace {
+
+namespace proto = protocol::arduino;
+using link::milliseconds;
+using link::seconds;
+
+OperatorCommand command_of(std::string_view line) {
+  const auto parsed = parse_operator_line(line);
+  EXPECT_TRUE(parsed.ok()) << line << ": " << parsed.error->message;
+  EXPECT_TRUE(parsed.command.has_value()) << line;
+  return parsed.command.value_or(QuitCommand{});
+}
+
+OperatorParseError error_of(std::string_view line) {
+  const auto parsed = parse_operator_line(line);
+  EXPECT_FALSE(parsed.ok()) << line << " parsed";
+  return parsed.error.value_or(OperatorParseError{});
+}
+
+// ---- parsing ----
+
+TEST(ArduinoOperatorParse, RawTokensAndTheirAliasesGiveTheSameRequests) {
+  const std::vector<std::pair<std::vector<std::string>, proto::Body>> cases = {
+      {{"PING", "ping", "Ping", "PING:"}, proto::Ping{}},
+      {{"STATUS", "status"}, proto::StatusRequest{}},
+      {{"V 160", "v 160", "V:160", "v:160", "  V   160  "}, proto::SetSpeed{160}},
+      {{"V 0", "V:+0"}, proto::SetSpeed{0}},
+      {{"V 255"}, proto::SetSpeed{255}},
+      {{"M 20", "m 20", "M:20", "M +20"}, proto::Move{20}},
+      {{"M -20", "m:-20"}, proto::Move{-20}},
+      {{"M -32768"}, proto::Move{-32768}},
+      {{"R -90", "r -90", "R:-90"}, proto::Rotate{-90}},
+      {{"R 32767"}, proto::Rotate{32767}},
+      {{"S", "s"}, proto::Stop{}},
+      {{"B", "b"}, proto::SonarRead{}},
+      {{"I", "i"}, proto::IrRead{}},
+      {{"HELP", "help"}, proto::Help{}},
+  };
+  for (const auto& [lines, body] : cases) {
+    for (const auto& line : lines) {
+      EXPECT_EQ(command_of(line), OperatorCommand(RobotRequest{body})) << line;
+    }
+  }
+}
+
+TEST(ArduinoOperatorParse, ClientSideCommandsAndWaits) {
+  EXPECT_EQ(command_of("history"), OperatorCommand(HistoryCommand{}));
+  EXPECT_EQ(command_of("HISTORY"), OperatorCommand(HistoryCommand{}));
+  EXPECT_EQ(command_of("save-log run.csv"), OperatorCommand(SaveLogCommand{"run.csv"}));
+  EXPECT_EQ(command_of("save-log  my logs/run 1.ndjson  # the path may hold spaces"),
+            OperatorCommand(SaveLogCommand{"my logs/run 1.ndjson"}));
+  EXPECT_EQ(command_of("reconnect"), OperatorCommand(ReconnectCommand{}));
+  EXPECT_EQ(command_of("quit"), OperatorCommand(QuitCommand{}));
+  EXPECT_EQ(command_of("exit"), OperatorCommand(QuitCommand{}));
+  EXPECT_EQ(command_of("wait 500ms"), OperatorCommand(WaitCommand{milliseconds(500)}));
+  EXPECT_EQ(command_of("wait 1s"), OperatorCommand(WaitCommand{seconds(1)}));
+  EXPECT_EQ(command_of("wait 1.5s"), OperatorCommand(WaitCommand{milliseconds(1500)}));
+  EXPECT_EQ(command_of("wait 0ms"), OperatorCommand(WaitCommand{milliseconds(0)}));
+}
+
+TEST(ArduinoOperatorParse, BlankLinesAndCommentsAreNoCommand) {
+  for (const std::string line : {"", "   ", "\t", "# a comment", "   # indented"}) {
+    const auto parsed = parse_operator_line(line);
+    EXPECT_TRUE(parsed.ok()) << line;
+    EXPECT_FALSE(parsed.command) << line;
+  }
+  EXPECT_EQ(command_of("PING # is it there?"), OperatorCommand(RobotRequest{proto::Ping{}}));
+  EXPECT_EQ(command_of("V 160# no space"), OperatorCommand(RobotRequest{proto::SetSpeed{160}}));
+}
+
+TEST(ArduinoOperatorParse, ErrorsSayTheColumnAndWhatWasExpected) {
+  struct Case {
+    std::string line;
+    std::size_t column;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"V 999", 3, "V needs a number 0..255, not '999'"},
+      {"V -1", 3, "V needs a number 0..255, not '-1'"},
+      {"V", 2, "V needs a number 0..255"},
+      {"V:", 3, "V needs a number 0..255"},
+      {"V:fast", 3, "V needs a number 0..255, not 'fast'"},
+      {"  v 1.5", 5, "V needs a number 0..255, not '1.5'"},
+      {"V 160 200", 7, "unexpected '200' after V 160"},
+      {"M 40000", 3, "M needs a distance in cm, a whole number -32768..32767, not '40000'"},
+      {"M", 2, "M needs a distance in cm, a whole number -32768..32767"},
+      {"R left", 3, "R needs an angle in degrees, a whole number -32768..32767, not 'left'"},
+      {"PING now", 6, "PING takes no argument, got 'now'"},
+      {"PING:x", 6, "PING takes no argument, got 'x'"},
+      {"status 2", 8, "STATUS takes no argument, got '2'"},
+      {"s 1", 3, "S takes no argument, got '1'"},
+      {"history all", 9, "history takes no argument, got 'all'"},
+      {"quit now", 6, "quit takes no argument, got 'now'"},
+      {"save-log", 9, "save-log needs a file path (.txt, .csv, .json)"},
+      {"wait", 5, "wait needs a duration such as 500ms or 1s"},
+      {"wait 5", 6, "wait needs a duration such as 500ms or 1s, not '5'"},
+      {"wait -1s", 6, "wait needs a duration such as 500ms or 1s, not '-1s'"},
+      {"wait 1s 2s", 9, "unexpected '2s' after wait"},
+      {"reconnect:1", 1, "a ':' goes only between V, M or R and its number"},
+      {"  jump 3", 3,
+       "unknown command 'jump' (expected PING, STATUS, V, M, R, S, B, I, HELP, history, "
+       "save-log, reconnect, wait or quit)"},
+  };
+  for (const auto& c : cases) {
+    const auto error = error_of(c.line);
+    EXPECT_EQ(error.column, c.column) << c.line;
+    EXPECT_EQ(error.message, c.message) << c.line;
+  }
+}
+
+RC_GTEST_PROP(ArduinoOperatorParse, EveryCommandReadsBackFromItsCanonicalText, ()) {
+  const auto pick = *rc::gen::inRange(0, 8);
+  OperatorCommand command;
+  switch (pick) {
+    case 0:
+      command = RobotRequest{proto::SetSpeed{*rc::gen::inRange(0, 256)}};
+      break;
+    case 1:
+      command = RobotRequest{proto::Move{*rc::gen::inRange(-32768, 32768)}};
+      break;
+    case 2:
+      command = RobotRequest{proto::Rotate{*rc::gen::inRange(-32768, 32768)}};
+      break;
+    case 3:
+      command = WaitCommand{milliseconds(*rc::gen::inRange(0, 100'000))};
+      break;
+    case 4:
+      command = RobotRequest{proto::StatusRequest{}};
+      break;
+    case 5:
+      command = HistoryCommand{};
+      break;
+    case 6:
+      command = SaveLogCommand{"log " + std::to_string(*rc::gen::inRange(0, 99)) + ".csv"};
+      break;
+    default:
+      command = ReconnectCommand{};
+      break;
+  }
+  const auto parsed = parse_operator_line(to_text(command));
+  RC_ASSERT(parsed.ok());
+  RC_ASSERT(parsed.command == std::optional<OperatorCommand>(command));
+}
+
+TEST(ArduinoOperatorScript, StepsKeepTheirLineNumbers) {
+  const auto script =
+      parse_script("# square\nping\n\nV 160\r\n  M 20  # forward\nwait 1s\nstatus", "sq.txt");
+  ASSERT_TRUE(script.ok());
+  ASSERT_EQ(script.steps.size(), 5u);
+  EXPECT_EQ(script.steps[0].line, 2u);
+  EXPECT_EQ(script.steps[1].line, 4u);
+  EXPECT_EQ(script.steps[1].command, OperatorCommand(RobotRequest{proto::SetSpeed{160}}));
+  EXPECT_EQ(script.steps[2].line, 5u);
+  EXPECT_EQ(script.steps[4].line, 7u);
+  EXPECT_EQ(script.commands().size(), 5u);
+}
+
+TEST(ArduinoOperatorScript, EveryBadLineIsReportedAsFileLineColumn) {
+  const auto script = parse_script("ping\nV 999\nstatus\n  wiat 1s\n", "cmds.txt");
+  EXPECT_FALSE(script.ok());
+  ASSERT_EQ(script.errors.size(), 2u);
+  EXPECT_EQ(script.errors[0].to_string(), "cmds.txt:2:3: V needs a number 0..255, not '999'");
+  EXPECT_EQ(script.errors[1].line, 4u);
+  EXPECT_EQ(script.errors[1].column, 3u);
+  EXPECT_EQ(script.errors[1].to_string().rfind("cmds.txt:4:3: unknown command 'wiat'", 0), 0u);
+}
+
+TEST(ArduinoOperatorScript, AMissingFileIsOneError) {
+  const auto script = load_script("/nonexistent/hil/cmds.txt");
+  ASSERT_EQ(script.errors.size(), 1u);
+  EXPECT_EQ(script.errors[0].to_string(), "/nonexistent/hil/cmds.txt: cannot read the script");
+}
+
+TEST(ArduinoOperatorScript, TheExampleScriptsParse) {
+  const std::filesystem::path dir =
+      std::filesystem::path(HIL_SOURCE_DIR) / "scenarios/clients/arduino-client";
+  std::size_t scripts = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".txt") continue;
+    ++scripts;
+    const auto script = load_script(entry.path().string());
+    EXPECT_TRUE(script.ok()) << (script.errors.empty() ? "" : script.errors[0].to_string());
+    EXPECT_FALSE(script.steps.empty()) << entry.path();
+  }
+  EXPECT_GE(scripts, 2u);
+}
+
+TEST(ArduinoOperatorDescribe, ResultsReadAsAPersonWouldSayThem) {
+  Result ok;
+  ok.info = "160";
+  EXPECT_EQ(describe_result(ok), "ACK 160");
+  Result empty;
+  EXPECT_EQ(describe_result(empty), "ACK");
+  Result nack;
+  nack.code = ResultCode::nack;
+  nack.nack = proto::Nack{proto::NackCode::bad_v};
+  EXPECT_EQ(describe_result(nack), "NACK BAD_V");
+  nack.nack = proto::Nack{std::string("BUSY")};
+  EXPECT_EQ(describe_result(nack), "NACK BUSY");
+  Result timeout;
+  timeout.code = ResultCode::timeout;
+  timeout.attempts = 4;
+  EXPECT_EQ(describe_result(timeout), "TIMEOUT (no answer after 4 attempts)");
+  CommandOutcome outcome;
+  outcome.command = RobotRequest{proto::SetSpeed{160}};
+  outcome.text = "ACK 160";
+  EXPECT_EQ(describe_outcome(outcome), "V 160 -> ACK 160");
+}
+
+// ---- the runner, against the mock robot in virtual time ----
+
+struct ArduinoOperatorRunner : ::testing::Test {
+  /// The robot on mem://arduino; `bytes_per_second` paces both directions.
+  void start(std::optional<std::uint64_t> bytes_per_second = std::nullopt,
+             OperatorRunner::Options options = {}) {
+    world.emplace(sim::WorldDef{});
+    sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
+    firmware = std::make_unique<mocks::ArduinoFirmware>(*world, vehicle);
+    mocks::ServerOptions server_options;
+    server_options.listen = link::MemEndpoint{"arduino"};
+    if (bytes_per_second) {
+      link::FaultRule rule;
+      rule.action = link::Bandwidth{*bytes_per_second};
+      server_options.faults.rules.push_back(rule);
+    }
+    server = std::make_unique<mocks::MockServer>(context, *firmware, std::move(server_options));
+    server->start();
+    connect("arduino", options);
+  }
+
+  void connect(const std::string& name, OperatorRunner::Options options = {}) {
+    session = std::make_unique<ArduinoSession>(context, link::MemEndpoint{name});
+    session->set_wall_clock([this] { return executor.now().count() / 1000; });
+    runner = std::make_unique<OperatorRunner>(*session, executor, options);
+    runner->set_outcome_handler([this](const CommandOutcome& o) { outcomes.push_back(o); });
+    runner->set_idle_handler([this] { ++idle_calls; });
+    runner->set_event_handler([this](const Event& e) {
+      if (auto* l = std::get_if<LinkChanged>(&e)) changes.push_back(*l);
+    });
+    session->open();
+    executor.run_for(Duration::zero());
+  }
+
+  /// Runs the executor until the runner is idle (or `limit` of virtual time).
+  void run_to_idle(Duration limit = seconds(60)) {
+    const Time end = executor.now() + limit;
+    while (!runner->idle() && executor.now() < end) {
+      auto due = executor.next_due();
+      if (!due || *due > end) break;
+      executor.run_until(*due);
+    }
+  }
+
+  void run_script(std::string_view text) {
+    const auto script = parse_script(text, "test.txt");
+    ASSERT_TRUE(script.ok()) << script.errors[0].to_string();
+    runner->add(script.commands());
+    run_to_idle();
+    ASSERT_TRUE(runner->idle());
+  }
+
+  std::vector<std::string> lines() const {
+    std::vector<std::string> out;
+    for (const auto& o : outcomes)
+      out.push_back(describe_outcome(o));
+    return out;
+  }
+
+  link::VirtualExecutor executor;
+  link::TransportContext context{executor};
+  std::optional<sim::World> world;
+  std::unique_ptr<mocks::ArduinoFirmware> firmware;
+  std::unique_ptr<mocks::MockServer> server;
+  std::unique_ptr<ArduinoSession> session;
+  std::unique_ptr<OperatorRunner> runner;
+  std::vector<CommandOutcome> outcomes;
+  std::vector<LinkChanged> changes;
+  int idle_calls = 0;
+};
+
+TEST_F(ArduinoOperatorRunner, PingWaitStatusEndsAtTheTimeTheLinePacingGives) {
+  // 1000 bytes per second: every byte is 1 ms on the line, each way.
+  start(1000);
+  const Time t0 = executor.now();
+  run_script("ping\nwait 1s\nstatus\n");
+  ASSERT_EQ(outcomes.size(), 3u);
+  // "^00|PING|*10$" is 13 bytes out, "^00|ACK|OK*4D$" 14 bytes back.
+  EXPECT_EQ(outcomes[0].text, "ACK OK");
+  EXPECT_EQ(outcomes[0].finished - t0, milliseconds(27));
+  EXPECT_EQ(outcomes[1].started - t0, milliseconds(27));
+  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(1027));
+  // "^01|STATUS|*..$" is 15 bytes, so the robot reads it at 1042 ms after
+  // its boot at the connection; the answer is the text plus 12 bytes of frame.
+  const auto& status = outcomes[2];
+  ASSERT_TRUE(status.ok) << status.text;
+  const std::string info = status.result->info;
+  EXPECT_EQ(info.rfind("IDLE PWM=140 UP_MS=1042 ", 0), 0u) << info;
+  EXPECT_EQ(status.finished - t0, milliseconds(1042 + static_cast<int>(info.size()) + 12));
+  EXPECT_EQ(runner->failures(), 0u);
+  EXPECT_EQ(runner->completed(), 3u);
+  EXPECT_GE(idle_calls, 1);
+}
+
+TEST_F(ArduinoOperatorRunner, EveryRequestIsCarriedOutAndAnswered) {
+  start();
+  run_script("PING\nV 160\nM 20\nstatus\nS\nR -90\nB\nI\nHELP\n");
+  const auto out = lines();
+  ASSERT_EQ(out.size(), 9u);
+  EXPECT_EQ(out[0], "PING -> ACK OK");
+  EXPECT_EQ(out[1], "V 160 -> ACK 160");
+  EXPECT_EQ(out[2], "M 20 -> ACK OK");
+  EXPECT_EQ(out[3].rfind("STATUS -> ACK MOVING M:20 PWM=160 ", 0), 0u) << out[3];
+  EXPECT_EQ(out[4], "S -> ACK OK");
+  EXPECT_EQ(out[5], "R -90 -> ACK OK");
+  EXPECT_EQ(out[6].rfind("B -> ACK ", 0), 0u) << out[6];
+  EXPECT_EQ(out[7].rfind("I -> ACK L=", 0), 0u) << out[7];
+  EXPECT_EQ(out[8].rfind("HELP -> ACK PING STATUS", 0), 0u) << out[8];
+  EXPECT_EQ(firmware->state().pwm, 160);
+}
+
+TEST_F(ArduinoOperatorRunner, AMoveScriptDrivesTheRobotForItsTimedDuration) {
+  start();
+  // M 50 runs 900 ms: polled at 899 ms it still moves, at 900 ms it is idle.
+  run_script("M 50\nwait 899ms\nSTATUS\nwait 1ms\nSTATUS\n");
+  ASSERT_EQ(outcomes.size(), 5u);
+  EXPECT_EQ(outcomes[2].result->info.rfind("MOVING M:50 ", 0), 0u) << outcomes[2].result->info;
+  EXPECT_EQ(outcomes[4].result->info.rfind("IDLE ", 0), 0u) << outcomes[4].result->info;
+}
+
+TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
+  start();
+  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "V", .count = 1}});
+  run_script("ping\nV 160\nstatus\n");
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_EQ(describe_outcome(outcomes[1]), "V 160 -> NACK BUSY");
+  EXPECT_FALSE(outcomes[1].ok);
+  EXPECT_TRUE(runner->halted());
+  EXPECT_EQ(runner->failures(), 1u);
+  EXPECT_EQ(session->log().size(), 4u) << "STATUS never went out";
+  runner->add(RobotRequest{proto::Ping{}});
+  EXPECT_EQ(session->log().size(), 4u) << "a halted runner takes no more";
+}
+
+TEST_F(ArduinoOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
+  start(std::nullopt, {.keep_going = true});
+  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "V", .count = 1}});
+  run_script("V 160\nV 170\nstatus\n");
+  const auto out = lines();
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0], "V 160 -> NACK BUSY");
+  EXPECT_EQ(out[1], "V 170 -> ACK 170");
+  EXPECT_EQ(out[2].rfind("STATUS -> ACK IDLE PWM=170 ", 0), 0u) << out[2];
+  EXPECT_EQ(runner->failures(), 1u);
+  EXPECT_FALSE(runner->halted());
+}
+
+TEST_F(ArduinoOperatorRunner, HistoryAndSaveLogShowTheFramesSoFar) {
+  start();
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("hil-arduino-operator-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto csv = (dir / "run.csv").string();
+  run_script("ping\nhistory\nsave-log " + csv + "\nsave-log /nonexistent/dir/run.txt\n");
+  ASSERT_EQ(outcomes.size(), 4u);
+  EXPECT_NE(outcomes[1].text.find(" TX seq=00 ^00|PING|*10$"), std::string::npos)
+      << outcomes[1].text;
+  EXPECT_NE(outcomes[1].text.find(" RX seq=00 ^00|ACK|OK*4D$"), std::string::npos)
+      << outcomes[1].text;
+  EXPECT_EQ(outcomes[2].text, "saved 2 frame(s) to " + csv + " (csv)");
+  std::ifstream in(csv);
+  std::stringstream content;
+  content << in.rdbuf();
+  EXPECT_EQ(content.str().rfind("time,direction,seq,raw,hex\n", 0), 0u) << content.str();
+  EXPECT_NE(content.str().find(",TX,00,^00|PING|*10$,"), std::string::npos) << content.str();
+  EXPECT_FALSE(outcomes[3].ok);
+  EXPECT_EQ(outcomes[3].text, "cannot write /nonexistent/dir/run.txt");
+  EXPECT_TRUE(runner->halted());
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
+  start();
+  const auto boots = firmware->state().boots;
+  run_script("V 200\nreconnect\nstatus\n");
+  ASSERT_EQ(outcomes.size(), 3u);
+  EXPECT_TRUE(outcomes[1].ok);
+  EXPECT_EQ(outcomes[1].text, "reconnected, link OPEN");
+  EXPECT_EQ(outcomes[1].finished - outcomes[1].started, milliseconds(500))
+      << "closed for the session's reconnect_base_delay";
+  EXPECT_EQ(outcomes[2].result->info.rfind("IDLE PWM=140 ", 0), 0u)
+      << "the board reset when the port opened: " << outcomes[2].result->info;
+  EXPECT_EQ(firmware->state().boots, boots + 1);
+  ASSERT_GE(changes.size(), 2u);
+  EXPECT_EQ(changes[changes.size() - 2].to, LinkState::opening);
+  EXPECT_EQ(changes.back().to, LinkState::open);
+}
+
+TEST_F(ArduinoOperatorRunner, QuitDropsWhatComesAfterIt) {
+  start();
+  run_script("ping\nquit\nV 100\n");
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_TRUE(runner->quit_requested());
+  EXPECT_TRUE(runner->halted());
+  EXPECT_EQ(runner->failures(), 0u);
+  EXPECT_EQ(firmware->state().pwm, 140);
+}
+
+TEST_F(ArduinoOperatorRunner, APortThatDoesNotOpenFailsTheRequestAndReconnect) {
+  connect("nobody-listens");
+  EXPECT_EQ(session->state(), LinkState::down);
+  runner->add(RobotRequest{proto::Ping{}});
+  run_to_idle();
+  ASSERT_EQ(outcomes.size(), 1u);
+  EXPECT_FALSE(outcomes[0].ok);
+  EXPECT_EQ(outcomes[0].text.rfind("LINK DOWN (", 0), 0u) << outcomes[0].text;
+}
+
+TEST_F(ArduinoOperatorRunner, ARequestQueuedWhileAWaitRunsGoesOutAfterIt) {
+  start();
+  runner->add(WaitCommand{milliseconds(300)});
+  const Time t0 = executor.now();
+  executor.run_for(milliseconds(100));
+  runner->add(RobotRequest{proto::StatusRequest{}});
+  EXPECT_EQ(session->log().size(), 0u) << "nothing goes out while the wait runs";
+  run_to_idle();
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_EQ(outcomes[1].started - t0, milliseconds(300));
+  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(300));
+}
+
+}  // namespace
+}  // namespace hil::client::arduino
