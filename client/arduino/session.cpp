@@ -7,16 +7,34 @@ namespace hil::client::arduino {
 
 ArduinoSession::ArduinoSession(link::TransportContext& context, link::Endpoint endpoint,
                                ClientConfig config)
-    : context_(context),
-      endpoint_(std::move(endpoint)),
-      core_(config),
-      wall_clock_([] { return link::wall_time_us(); }) {}
-
-ArduinoSession::~ArduinoSession() {
-  *alive_ = false;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  drop_pipe();
-}
+    : core_(config),
+      wall_clock_([] { return link::wall_time_us(); }),
+      binding_(context, std::move(endpoint),
+               {.connected =
+                    [this] {
+                      core_.on_connected(now());
+                      drain();
+                    },
+                .connect_failed =
+                    [this](std::error_code ec) {
+                      core_.on_connect_failed(now(), ec.message());
+                      drain();
+                    },
+                .bytes =
+                    [this](protocol::ByteView bytes) {
+                      core_.on_bytes(now(), bytes);
+                      drain();
+                    },
+                .closed =
+                    [this] {
+                      core_.on_closed(now());
+                      drain();
+                    },
+                .timer =
+                    [this] {
+                      core_.on_timer(now());
+                      drain();
+                    }}) {}
 
 void ArduinoSession::open() {
   core_.open(now());
@@ -44,13 +62,8 @@ RequestId ArduinoSession::raw(std::string_view token, Callback done) {
 }
 
 void ArduinoSession::drain() {
-  // Callbacks may submit requests; the outer loop picks up what they cause.
-  if (draining_) return;
-  draining_ = true;
-  for (;;) {
-    auto actions = core_.take_actions();
-    auto events = core_.take_events();
-    if (actions.empty() && events.empty()) break;
+  // Callbacks may submit requests; the loop picks up what they cause.
+  drain_core(core_, draining_, [this](auto& actions, auto& events) {
     // Frames in are logged before the frames they caused go out, so the log
     // reads in wire order (a NACK BAD_CS, then its resend).
     for (auto& e : events) {
@@ -62,50 +75,19 @@ void ArduinoSession::drain() {
       perform(a);
     for (auto& e : events)
       dispatch(e);
-  }
-  draining_ = false;
-  reschedule();
+  });
+  binding_.schedule(core_.next_wakeup());
 }
 
 void ArduinoSession::perform(Action& action) {
-  if (std::holds_alternative<SendFrame>(action)) {
-    auto& send = std::get<SendFrame>(action);
-    log_->tx(wall_clock_(), std::string(send.bytes.begin(), send.bytes.end()), send.seq);
-    if (pipe_) pipe_->write(send.bytes);
-    return;
+  if (auto* send = std::get_if<SendFrame>(&action)) {
+    log_->tx(wall_clock_(), std::string(send->bytes.begin(), send->bytes.end()), send->seq);
+    binding_.write(send->bytes);
+  } else if (std::holds_alternative<ClosePort>(action)) {
+    binding_.close();
+  } else {
+    binding_.open();
   }
-  if (std::holds_alternative<ClosePort>(action)) {
-    drop_pipe();
-    return;
-  }
-  drop_pipe();
-  const std::uint64_t generation = ++generation_;
-  link::connect(context_, endpoint_,
-                [this, alive = alive_, generation](std::error_code ec, link::BytePipePtr pipe) {
-                  if (!*alive || generation != generation_) {
-                    if (pipe) pipe->close();
-                    return;
-                  }
-                  if (ec || !pipe) {
-                    core_.on_connect_failed(now(), ec ? ec.message() : "no connection");
-                    drain();
-                    return;
-                  }
-                  pipe_ = pipe;
-                  pipe->start({[this, alive, generation](protocol::ByteView bytes) {
-                                 if (!*alive || generation != generation_) return;
-                                 core_.on_bytes(now(), bytes);
-                                 drain();
-                               },
-                               [this, alive, generation](std::error_code) {
-                                 if (!*alive || generation != generation_) return;
-                                 pipe_.reset();
-                                 core_.on_closed(now());
-                                 drain();
-                               }});
-                  core_.on_connected(now());
-                  drain();
-                });
 }
 
 void ArduinoSession::dispatch(Event& event) {
@@ -118,30 +100,6 @@ void ArduinoSession::dispatch(Event& event) {
     }
   }
   if (on_event_) on_event_(event);
-}
-
-void ArduinoSession::reschedule() {
-  const auto due = core_.next_wakeup();
-  if (due == timer_due_) return;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  timer_ = 0;
-  timer_due_ = due;
-  if (!due) return;
-  timer_ = context_.executor.call_at(*due, [this, alive = alive_] {
-    if (!*alive) return;
-    timer_ = 0;
-    timer_due_.reset();
-    core_.on_timer(now());
-    drain();
-  });
-}
-
-void ArduinoSession::drop_pipe() {
-  ++generation_;
-  if (pipe_) {
-    auto pipe = std::exchange(pipe_, nullptr);
-    pipe->close();
-  }
 }
 
 }  // namespace hil::client::arduino

@@ -11,6 +11,7 @@
 
 #include "client/arduino/client_core.hpp"
 #include "client/arduino/comm_log.hpp"
+#include "client/common/pipe_binding.hpp"
 #include "link/endpoint.hpp"
 #include "link/transport.hpp"
 
@@ -26,7 +27,6 @@ class ArduinoSession {
   /// `context` must outlive the session. Nothing happens until open().
   ArduinoSession(link::TransportContext& context, link::Endpoint endpoint,
                  ClientConfig config = {});
-  ~ArduinoSession();
   ArduinoSession(const ArduinoSession&) = delete;
   ArduinoSession& operator=(const ArduinoSession&) = delete;
 
@@ -67,26 +67,18 @@ class ArduinoSession {
   std::shared_ptr<CommLog> shared_log() const { return log_; }
 
  private:
-  link::Time now() const { return context_.executor.now(); }
+  link::Time now() const { return binding_.now(); }
   void drain();
   void perform(Action& action);
   void dispatch(Event& event);
-  void reschedule();
-  void drop_pipe();
 
-  link::TransportContext& context_;
-  link::Endpoint endpoint_;
   ArduinoClientCore core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
-  link::BytePipePtr pipe_;
-  std::uint64_t generation_ = 0;  // callbacks from an older pipe are ignored
-  link::Executor::TimerId timer_ = 0;
-  std::optional<link::Time> timer_due_;
   std::map<RequestId, Callback> callbacks_;
   EventHandler on_event_;
   WallClock wall_clock_;
   bool draining_ = false;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  PipeBinding binding_;  // last: its callbacks use the members above
 };
 
 }  // namespace hil::client::arduino

@@ -7,46 +7,38 @@ namespace hil::client::leka {
 
 LekaSession::LekaSession(link::TransportContext& context, link::Endpoint endpoint,
                          ClientConfig config)
-    : context_(context),
-      endpoint_(std::move(endpoint)),
-      core_(config),
-      wall_clock_([] { return link::wall_time_us(); }) {}
-
-LekaSession::~LekaSession() {
-  *alive_ = false;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  drop_pipe();
-}
+    : core_(config),
+      wall_clock_([] { return link::wall_time_us(); }),
+      binding_(context, std::move(endpoint),
+               {.connected =
+                    [this] {
+                      open_error_.clear();
+                      core_.on_connected(now());
+                      drain();
+                    },
+                .connect_failed = [this](std::error_code ec) { open_error_ = ec.message(); },
+                .bytes =
+                    [this](protocol::ByteView bytes) {
+                      core_.on_bytes(now(), bytes);
+                      drain();
+                    },
+                .closed =
+                    [this] {
+                      core_.on_closed(now());
+                      drain();
+                    },
+                .timer =
+                    [this] {
+                      core_.on_timer(now());
+                      drain();
+                    }}) {}
 
 void LekaSession::open() {
-  drop_pipe();
-  const std::uint64_t generation = ++generation_;
-  link::connect(context_, endpoint_,
-                [this, alive = alive_, generation](std::error_code ec, link::BytePipePtr pipe) {
-                  if (!*alive || generation != generation_) {
-                    if (pipe) pipe->close();
-                    return;
-                  }
-                  if (ec || !pipe) return;
-                  pipe_ = pipe;
-                  pipe->start({[this, alive, generation](protocol::ByteView bytes) {
-                                 if (!*alive || generation != generation_) return;
-                                 core_.on_bytes(now(), bytes);
-                                 drain();
-                               },
-                               [this, alive, generation](std::error_code) {
-                                 if (!*alive || generation != generation_) return;
-                                 pipe_.reset();
-                                 core_.on_closed(now());
-                                 drain();
-                               }});
-                  core_.on_connected(now());
-                  drain();
-                });
+  binding_.open();
 }
 
 void LekaSession::close() {
-  drop_pipe();
+  binding_.close();
   core_.on_closed(now());
   drain();
 }
@@ -65,12 +57,7 @@ RequestId LekaSession::info(InfoCallback done) {
 }
 
 void LekaSession::drain() {
-  if (draining_) return;
-  draining_ = true;
-  for (;;) {
-    auto actions = core_.take_actions();
-    auto events = core_.take_events();
-    if (actions.empty() && events.empty()) break;
+  drain_core(core_, draining_, [this](auto& actions, auto& events) {
     for (auto& e : events) {
       if (auto* line = std::get_if<LineReceived>(&e)) {
         log_->add({LogDirection::rx, wall_clock_(),
@@ -83,7 +70,7 @@ void LekaSession::drain() {
           auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item))
         note = proto::describe(frame->message);
       log_->add({LogDirection::tx, wall_clock_(), a.bytes, std::move(note)});
-      if (pipe_) pipe_->write(a.bytes);
+      binding_.write(a.bytes);
     }
     for (auto& e : events) {
       if (auto* done = std::get_if<InfoDone>(&e)) {
@@ -95,30 +82,8 @@ void LekaSession::drain() {
         }
       }
     }
-  }
-  draining_ = false;
-  reschedule();
-}
-
-void LekaSession::reschedule() {
-  const auto due = core_.next_wakeup();
-  if (due == timer_due_) return;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  timer_ = 0;
-  timer_due_ = due;
-  if (!due) return;
-  timer_ = context_.executor.call_at(*due, [this, alive = alive_] {
-    if (!*alive) return;
-    timer_ = 0;
-    timer_due_.reset();
-    core_.on_timer(now());
-    drain();
   });
-}
-
-void LekaSession::drop_pipe() {
-  ++generation_;
-  if (pipe_) std::exchange(pipe_, nullptr)->close();
+  binding_.schedule(core_.next_wakeup());
 }
 
 }  // namespace hil::client::leka

@@ -7,7 +7,9 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 
+#include "client/common/pipe_binding.hpp"
 #include "client/leka/comm_log.hpp"
 #include "client/leka/core.hpp"
 #include "link/endpoint.hpp"
@@ -24,7 +26,6 @@ class LekaSession {
 
   /// `context` must outlive the session. Nothing happens until open().
   LekaSession(link::TransportContext& context, link::Endpoint endpoint, ClientConfig config = {});
-  ~LekaSession();
   LekaSession(const LekaSession&) = delete;
   LekaSession& operator=(const LekaSession&) = delete;
 
@@ -35,28 +36,24 @@ class LekaSession {
   BuildResult send(const GroupBuilder& builder);
   RequestId info(InfoCallback done = {});
 
+  /// Why the last open() failed (the system's message), empty if it did not.
+  const std::string& open_error() const { return open_error_; }
+
   void set_wall_clock(WallClock clock) { wall_clock_ = std::move(clock); }
   const LekaClientCore& core() const { return core_; }
   CommLog& log() { return *log_; }
 
  private:
-  link::Time now() const { return context_.executor.now(); }
+  link::Time now() const { return binding_.now(); }
   void drain();
-  void reschedule();
-  void drop_pipe();
 
-  link::TransportContext& context_;
-  link::Endpoint endpoint_;
   LekaClientCore core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
-  link::BytePipePtr pipe_;
-  std::uint64_t generation_ = 0;  // callbacks from an older pipe are ignored
-  link::Executor::TimerId timer_ = 0;
-  std::optional<link::Time> timer_due_;
   std::map<RequestId, InfoCallback> callbacks_;
   WallClock wall_clock_;
+  std::string open_error_;
   bool draining_ = false;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  PipeBinding binding_;  // last: its callbacks use the members above
 };
 
 }  // namespace hil::client::leka

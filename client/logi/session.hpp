@@ -3,55 +3,39 @@
 // under either driver: performs its actions, feeds it bytes and closes, and
 // keeps one executor timer for its next wakeup.
 
-#include <functional>
 #include <memory>
-#include <optional>
 
+#include "client/common/connecting_session.hpp"
 #include "client/logi/core.hpp"
-#include "link/endpoint.hpp"
-#include "link/transport.hpp"
 
 namespace hil::client::logi {
 
-class LogiSession {
+class LogiSession
+    : public ConnectingSession<LogiClientCore, Event, OpenConnection, SendBytes, CloseConnection> {
  public:
-  using EventSink = std::function<void(Time now, const Event& event)>;
-
   /// `context` must outlive the session. Events go to `sink` on the executor.
   LogiSession(link::TransportContext& context, link::Endpoint endpoint, ClientConfig config = {},
-              EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
-  ~LogiSession();
-  LogiSession(const LogiSession&) = delete;
-  LogiSession& operator=(const LogiSession&) = delete;
+              EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>())
+      : ConnectingSession(context, std::move(endpoint), std::move(sink),
+                          LogiClientCore(std::move(config), std::move(log))) {}
 
-  void connect();
-  void disconnect();
-  SubmitResult submit(const proto::Message& command);
-  SubmitResult press(proto::Direction direction);
-  SubmitResult release();
-  SubmitResult emergency_stop();
-  SubmitResult confirm_resend(RequestId request);
+  SubmitResult submit(const proto::Message& command) {
+    return feed([&](Time t) { return mutable_core().submit(t, command); });
+  }
+  SubmitResult press(proto::Direction direction) {
+    return feed([&](Time t) { return mutable_core().press(t, direction); });
+  }
+  SubmitResult release() {
+    return feed([&](Time t) { return mutable_core().release(t); });
+  }
+  SubmitResult emergency_stop() {
+    return feed([&](Time t) { return mutable_core().emergency_stop(t); });
+  }
+  SubmitResult confirm_resend(RequestId request) {
+    return feed([&](Time t) { return mutable_core().confirm_resend(t, request); });
+  }
 
-  const LogiClientCore& core() const { return core_; }
-  const std::shared_ptr<CommLog>& log() const { return core_.log(); }
-
- private:
-  Time now() const { return context_.executor.now(); }
-  /// Performs the core's actions, hands on its events, re-arms the timer.
-  void flush();
-  void reschedule();
-  void open();
-
-  link::TransportContext& context_;
-  link::Endpoint endpoint_;
-  EventSink sink_;
-  LogiClientCore core_;
-  link::BytePipePtr pipe_;
-  std::uint64_t generation_ = 0;  // tells a current connection's callbacks from a closed one's
-  link::Executor::TimerId timer_ = 0;
-  std::optional<Time> timer_due_;
-  bool flushing_ = false;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  const std::shared_ptr<CommLog>& log() const { return core().log(); }
 };
 
 }  // namespace hil::client::logi

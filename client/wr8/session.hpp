@@ -3,55 +3,41 @@
 // under either driver: performs its actions, feeds it bytes and closes, and
 // keeps one executor timer for its next wakeup.
 
-#include <functional>
+#include <cstdint>
 #include <memory>
-#include <optional>
+#include <vector>
 
+#include "client/common/connecting_session.hpp"
 #include "client/wr8/core.hpp"
-#include "link/endpoint.hpp"
-#include "link/transport.hpp"
 
 namespace hil::client::wr8 {
 
-class Wr8Session {
+class Wr8Session
+    : public ConnectingSession<Wr8ClientCore, Event, OpenConnection, SendBytes, CloseConnection> {
  public:
-  using EventSink = std::function<void(Time now, const Event& event)>;
-
   /// `context` must outlive the session. Events go to `sink` on the executor.
   Wr8Session(link::TransportContext& context, link::Endpoint endpoint, ClientConfig config = {},
-             EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
-  ~Wr8Session();
-  Wr8Session(const Wr8Session&) = delete;
-  Wr8Session& operator=(const Wr8Session&) = delete;
+             EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>())
+      : ConnectingSession(context, std::move(endpoint), std::move(sink),
+                          Wr8ClientCore(std::move(config), std::move(log))) {}
 
-  void connect();
-  void disconnect();
-  SubmitResult task(proto::TaskCode code, std::vector<proto::Word> params = {});
-  SubmitResult drive(std::int32_t distance_cm);
-  SubmitResult turn(std::int32_t angle_deg);
-  SubmitResult get_settings();
-  SubmitResult set_settings(std::vector<proto::Setting> settings);
+  SubmitResult task(proto::TaskCode code, std::vector<proto::Word> params = {}) {
+    return feed([&](Time t) { return mutable_core().task(t, code, std::move(params)); });
+  }
+  SubmitResult drive(std::int32_t distance_cm) {
+    return feed([&](Time t) { return mutable_core().drive(t, distance_cm); });
+  }
+  SubmitResult turn(std::int32_t angle_deg) {
+    return feed([&](Time t) { return mutable_core().turn(t, angle_deg); });
+  }
+  SubmitResult get_settings() {
+    return feed([&](Time t) { return mutable_core().get_settings(t); });
+  }
+  SubmitResult set_settings(std::vector<proto::Setting> settings) {
+    return feed([&](Time t) { return mutable_core().set_settings(t, std::move(settings)); });
+  }
 
-  const Wr8ClientCore& core() const { return core_; }
-  const std::shared_ptr<CommLog>& log() const { return core_.log(); }
-
- private:
-  Time now() const { return context_.executor.now(); }
-  /// Performs the core's actions, hands on its events, re-arms the timer.
-  void flush();
-  void reschedule();
-  void open();
-
-  link::TransportContext& context_;
-  link::Endpoint endpoint_;
-  EventSink sink_;
-  Wr8ClientCore core_;
-  link::BytePipePtr pipe_;
-  std::uint64_t generation_ = 0;  // tells a current connection's callbacks from a closed one's
-  link::Executor::TimerId timer_ = 0;
-  std::optional<Time> timer_due_;
-  bool flushing_ = false;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  const std::shared_ptr<CommLog>& log() const { return core().log(); }
 };
 
 }  // namespace hil::client::wr8

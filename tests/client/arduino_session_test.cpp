@@ -246,7 +246,9 @@ TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
 
 TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueuedRequestsGoOut) {
   start(quiet());
-  firmware->arm({.name = "", .when = {.at = seconds(1)}, .action = mocks::CloseConnection{}});
+  mocks::When at_1s;
+  at_1s.at = seconds(1);
+  firmware->arm({.name = "", .when = at_1s, .action = mocks::CloseConnection{}});
   executor.run_until(seconds(1));
   ASSERT_EQ(session->state(), LinkState::degraded);
   EXPECT_EQ(changes.back().at, seconds(1));

@@ -31,8 +31,9 @@ struct LekaSessionOnMem : ::testing::Test {
     world.emplace(sim::WorldDef{});
     sim::Vehicle& vehicle = world->add_vehicle(sim::leka_robot());
     firmware = std::make_unique<mocks::LekaFirmware>(*world, vehicle);
-    server = std::make_unique<mocks::MockServer>(
-        context, *firmware, mocks::ServerOptions{.listen = link::MemEndpoint{"leka"}});
+    mocks::ServerOptions options;
+    options.listen = link::MemEndpoint{"leka"};
+    server = std::make_unique<mocks::MockServer>(context, *firmware, options);
     server->start();
     session = std::make_unique<LekaSession>(context, link::MemEndpoint{"leka"}, config);
     session->set_wall_clock([this] { return executor.now().count() / 1000; });

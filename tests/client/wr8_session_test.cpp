@@ -158,9 +158,15 @@ TEST(Wr8Session, SettingsSetThenReadBackGiveTheNewValues) {
   const auto& s = bench.session().core().settings();
   ASSERT_EQ(s.size(), 4u);
   for (const auto& v : s) {
-    if (v.code == proto::SettingCode::p) EXPECT_EQ(v.value.as_f32(), 2.0f);
-    if (v.code == proto::SettingCode::i) EXPECT_EQ(v.value.as_f32(), 0.25f);
-    if (v.code == proto::SettingCode::servo_zero) EXPECT_EQ(v.value.as_i32(), 95);
+    if (v.code == proto::SettingCode::p) {
+      EXPECT_EQ(v.value.as_f32(), 2.0f);
+    }
+    if (v.code == proto::SettingCode::i) {
+      EXPECT_EQ(v.value.as_f32(), 0.25f);
+    }
+    if (v.code == proto::SettingCode::servo_zero) {
+      EXPECT_EQ(v.value.as_i32(), 95);
+    }
   }
 }
 

@@ -1,10 +1,10 @@
-#include "client/logi/comm_log.hpp"
+#include "client/common/comm_log.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-namespace hil::client::logi {
+namespace hil::client {
 
 std::string_view to_string(LogKind kind) {
   switch (kind) {
@@ -128,4 +128,4 @@ std::string CommLog::export_ndjson() const {
   return out;
 }
 
-}  // namespace hil::client::logi
+}  // namespace hil::client

@@ -1,0 +1,84 @@
+#pragma once
+// The I/O half of every client session: opens an endpoint, owns the byte
+// pipe, drops what an abandoned pipe still reports, and keeps one executor
+// timer, so each session only moves bytes and times between its core and it.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <system_error>
+
+#include "link/byte_pipe.hpp"
+#include "link/endpoint.hpp"
+#include "link/executor.hpp"
+#include "link/time.hpp"
+#include "link/transport.hpp"
+#include "protocol/common/bytes.hpp"
+
+namespace hil::client {
+
+class PipeBinding {
+ public:
+  /// What the binding reports; each runs on the executor, never after the
+  /// binding is gone, and never for a pipe that open() or close() replaced.
+  struct Handlers {
+    std::function<void()> connected;
+    std::function<void(std::error_code)> connect_failed;
+    std::function<void(protocol::ByteView)> bytes;
+    std::function<void()> closed;  ///< the peer or the transport ended the pipe
+    std::function<void()> timer;   ///< the time given to schedule() came
+  };
+
+  /// `context` must outlive the binding.
+  PipeBinding(link::TransportContext& context, link::Endpoint endpoint, Handlers handlers);
+  ~PipeBinding();
+  PipeBinding(const PipeBinding&) = delete;
+  PipeBinding& operator=(const PipeBinding&) = delete;
+
+  /// Starts connecting; a pipe still open is closed first.
+  void open();
+  /// Closes the pipe (if any); nothing more is reported about it.
+  void close();
+  /// Writes to the open pipe; false (and nothing written) when there is none.
+  bool write(protocol::ByteView bytes);
+  bool has_pipe() const { return pipe_ != nullptr; }
+
+  /// Keeps one timer due at `due` (none when nullopt); cheap to call after
+  /// every input, as it only re-arms when the time changed.
+  void schedule(std::optional<link::Time> due);
+
+  link::Time now() const { return context_.executor.now(); }
+  const link::Endpoint& endpoint() const { return endpoint_; }
+
+ private:
+  link::TransportContext& context_;
+  link::Endpoint endpoint_;
+  Handlers handlers_;
+  link::BytePipePtr pipe_;
+  std::uint64_t generation_ = 0;  // callbacks from an older pipe are ignored
+  link::Executor::TimerId timer_ = 0;
+  std::optional<link::Time> timer_due_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+/// Hands `step` the core's pending actions and events until it has none
+/// left (a step may cause more). A call made from inside a step returns at
+/// once, so a driver that completes an action synchronously cannot re-enter.
+template <class Core, class Step>
+void drain_core(Core& core, bool& draining, Step&& step) {
+  if (draining) return;
+  struct Reset {
+    bool& flag;
+    ~Reset() { flag = false; }
+  } reset{draining};
+  draining = true;
+  for (;;) {
+    auto actions = core.take_actions();
+    auto events = core.take_events();
+    if (actions.empty() && events.empty()) break;
+    step(actions, events);
+  }
+}
+
+}  // namespace hil::client
