@@ -192,9 +192,11 @@ TEST_F(ArduinoSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
 
 TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   start(quiet());
-  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1}});
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1, .duration = {}}});
+  mocks::When at_100ms;
+  at_100ms.at = milliseconds(100);
   firmware->arm({.name = "",
-                 .when = {.at = milliseconds(100)},
+                 .when = at_100ms,
                  .action = mocks::SendBytes{proto::encode({0x7F, proto::Ack{"999"}})}});
   const Time t0 = executor.now();
   auto r = run([](auto& s, auto cb) { return s.sonar(cb); });
@@ -209,7 +211,7 @@ TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
 TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
   start();  // health check after 5 s of quiet
   // The robot hears nothing for 10 s, then recovers.
-  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.duration = seconds(10)}});
+  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "", .count = {}, .duration = seconds(10)}});
   executor.run_until(seconds(20));
   ASSERT_EQ(changes.size(), 5u);
   const std::vector<std::pair<LinkState, Time>> expected = {
