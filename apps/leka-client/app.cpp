@@ -1,7 +1,5 @@
 #include "apps/leka-client/app.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
 #include <CLI/CLI.hpp>
 
 #include <asio/io_context.hpp>
@@ -239,6 +237,10 @@ class Run {
   void wait_for_open(link::Duration waited) {
     if (finishing_) return;
     if (session_.is_open()) return start();
+    if (!session_.open_error().empty()) {
+      warn("leka-client: cannot open " + options_.port + ": " + session_.open_error());
+      return finish(1);
+    }
     if (waited >= link::seconds(5)) {
       warn("leka-client: cannot open " + options_.port + " (not open after 5 s)");
       return finish(1);
@@ -326,16 +328,6 @@ int run(const AppOptions& options) {
   } catch (const link::EndpointError& e) {
     warn(std::string("leka-client: --port: ") + e.what());
     return 2;
-  }
-  // The session says nothing when a device cannot be opened; try it first
-  // so the user learns why.
-  if (const auto* pty = std::get_if<link::PtyEndpoint>(&endpoint)) {
-    const int fd = ::open(pty->path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) {
-      warn("leka-client: cannot open " + pty->path + ": " + std::strerror(errno));
-      return 1;
-    }
-    ::close(fd);
   }
   Run run_state(options, std::move(script), std::move(endpoint));
   return run_state.go();
