@@ -1,0 +1,23 @@
+#include "harness/outcome.hpp"
+
+namespace hil::harness {
+
+bool ScenarioOutcome::passed() const {
+  if (!error.empty()) return false;
+  for (const auto& s : steps)
+    if (!s.ok) return false;
+  for (const auto& e : expectations)
+    if (!e.passed) return false;
+  return true;
+}
+
+std::string ScenarioOutcome::first_failure() const {
+  if (!error.empty()) return error;
+  for (const auto& s : steps)
+    if (!s.ok) return "step line " + std::to_string(s.line) + " (" + s.text + "): " + s.reason;
+  for (const auto& e : expectations)
+    if (!e.passed) return "expect line " + std::to_string(e.line) + ": " + e.message;
+  return {};
+}
+
+}  // namespace hil::harness

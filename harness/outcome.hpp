@@ -1,0 +1,69 @@
+#pragma once
+// What one run of one scenario came to: each step and each expectation with
+// its verdict and evidence, the timeline, and the command that repeats it.
+// The console table, JUnit XML and the report folder are written from this.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "harness/scenario.hpp"
+#include "harness/timeline.hpp"
+#include "sim/arena.hpp"
+#include "sim/trajectory.hpp"
+
+namespace hil::harness {
+
+struct StepOutcome {
+  int line = 0;
+  std::string text;
+  std::string phase;  ///< "setup", "steps", "teardown" or "schedule"
+  bool ok = true;
+  std::string reason;  ///< why it failed, for a person
+  Time started{0};
+  Time ended{0};
+};
+
+struct ExpectationOutcome {
+  int line = 0;
+  std::string label;
+  bool passed = false;
+  /// For a person: what was looked for, where, and what was found instead
+  /// ("no 'car received MV:STOP' between 5.000 s and 5.300 s; the nearest
+  /// at 5.812 s").
+  std::string message;
+  std::optional<Time> window_from;
+  std::optional<Time> window_to;
+  /// Records around the verdict (the matches, or what came closest and
+  /// the frames near the window), in time order.
+  std::vector<Record> evidence;
+};
+
+struct ScenarioOutcome {
+  std::string file;
+  std::string name;
+  std::vector<std::string> tags;
+  std::uint64_t seed = 0;
+  /// Could not load or could not start (a bad file, a client that would not
+  /// start): the whole scenario failed for this reason before any verdict.
+  std::string error;
+  std::vector<StepOutcome> steps;
+  std::vector<ExpectationOutcome> expectations;
+  Timeline timeline;
+  sim::Arena arena;  ///< for the trajectory picture
+  std::vector<sim::Trajectory> trajectories;
+  Duration run_time{0};     ///< simulated (or real) time the run covered
+  double wall_seconds = 0;  ///< what it cost
+  bool real_time = false;
+  /// The command line that repeats this run exactly (seed included).
+  std::string repro_command;
+
+  /// Passed: no error, every step ok, every expectation met.
+  bool passed() const;
+  /// The first thing that failed, for the table: "step 4 (press FWD): ..."
+  /// or "expect line 31: ...", or the error; empty when passed.
+  std::string first_failure() const;
+};
+
+}  // namespace hil::harness

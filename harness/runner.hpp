@@ -1,0 +1,31 @@
+#pragma once
+// Runs one scenario: builds the car and its world, puts the faults on the
+// link, starts the client (the reference client in virtual time, or an
+// external program in real time), plays the steps and the schedule,
+// records the timeline, and checks the expectations.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "harness/outcome.hpp"
+#include "harness/scenario.hpp"
+
+namespace hil::harness {
+
+struct RunOptions {
+  /// Overrides the scenario's seed (and a random choice when it has none).
+  std::optional<std::uint64_t> seed;
+  /// Runs every scenario against this external program instead of its own
+  /// client (placeholders as in ExecClient::command).
+  std::optional<std::string> client_exec;
+  /// Where reports may put files of this run (wire log); empty: nowhere.
+  std::string work_dir;
+  /// Period of the simulation samples in the timeline.
+  Duration sample_period{std::chrono::milliseconds(100)};
+};
+
+/// Never throws for a scenario's own failures; they are in the outcome.
+ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options = {});
+
+}  // namespace hil::harness
