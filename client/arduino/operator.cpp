@@ -1,12 +1,10 @@
 #include "client/arduino/operator.hpp"
 
-#include <cctype>
-#include <charconv>
-#include <cmath>
 #include <fstream>
-#include <limits>
 #include <sstream>
 #include <utility>
+
+#include "client/common/operator_text.hpp"
 
 namespace hil::client::arduino {
 
@@ -14,74 +12,9 @@ namespace proto = protocol::arduino;
 
 namespace {
 
-struct Token {
-  std::string_view text;
-  std::size_t column = 1;  // 1-based
-};
-
-std::vector<Token> split_words(std::string_view line) {
-  std::vector<Token> out;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i])))
-      ++i;
-    if (i >= line.size()) break;
-    const std::size_t start = i;
-    while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i])))
-      ++i;
-    out.push_back({line.substr(start, i - start), start + 1});
-  }
-  return out;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (auto& c : out)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
-std::optional<long long> parse_integer(std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  long long value = 0;
-  const auto* end = text.data() + text.size();
-  auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (text.empty() || ec != std::errc{} || ptr != end) return std::nullopt;
-  return value;
-}
-
-std::optional<Duration> parse_duration(std::string_view text) {
-  std::string_view number = text;
-  double scale_ns = 0;
-  if (text.ends_with("ms")) {
-    number.remove_suffix(2);
-    scale_ns = 1e6;
-  } else if (text.ends_with("s")) {
-    number.remove_suffix(1);
-    scale_ns = 1e9;
-  } else {
-    return std::nullopt;
-  }
-  if (number.empty() || !std::isdigit(static_cast<unsigned char>(number.front()))) {
-    return std::nullopt;
-  }
-  double value = 0;
-  const auto* end = number.data() + number.size();
-  auto [ptr, ec] = std::from_chars(number.data(), end, value);
-  // A day is far beyond any robot script; the bound keeps the nanoseconds in range.
-  if (ec != std::errc{} || ptr != end || !(value >= 0) || value * scale_ns > 86400e9) {
-    return std::nullopt;
-  }
-  return Duration(static_cast<Duration::rep>(std::llround(value * scale_ns)));
-}
-
-std::string format_duration(Duration d) {
-  const auto ns = d.count();
-  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
-  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
-  std::ostringstream out;
-  out << static_cast<double>(ns) / 1e6 << "ms";
-  return out.str();
+// A day is far beyond any robot script.
+std::optional<Duration> parse_wait(std::string_view text) {
+  return parse_duration(text, link::seconds(86400));
 }
 
 const char* kExpected =
@@ -115,7 +48,7 @@ std::string to_text(const OperatorCommand& command) {
             return word + " " + std::to_string(r->angle_deg);
           return word;
         } else if constexpr (std::is_same_v<T, WaitCommand>) {
-          return "wait " + format_duration(c.duration);
+          return "wait " + duration_text(c.duration);
         } else if constexpr (std::is_same_v<T, HistoryCommand>) {
           return "history";
         } else if constexpr (std::is_same_v<T, SaveLogCommand>) {
@@ -133,21 +66,21 @@ OperatorLine parse_operator_line(std::string_view line) {
   if (const auto hash = line.find('#'); hash != std::string_view::npos) {
     line = line.substr(0, hash);
   }
-  auto words = split_words(line);
+  auto words = split_words(line).words;
   if (words.empty()) return {};
 
   // "V:160" is the seed CLI's raw form of "V 160".
-  Token head = words.front();
-  std::optional<Token> glued;
+  Word head = words.front();
+  std::optional<Word> glued;
   if (const auto colon = head.text.find(':'); colon != std::string_view::npos) {
-    glued = Token{head.text.substr(colon + 1), head.column + colon + 1};
+    glued = Word{head.text.substr(colon + 1), head.column + colon + 1};
     head.text = head.text.substr(0, colon);
   }
-  std::vector<Token> args;
+  std::vector<Word> args;
   if (glued) args.push_back(*glued);
   args.insert(args.end(), words.begin() + 1, words.end());
   const std::size_t line_end = line.find_last_not_of(" \t\r\n") + 2;
-  const std::string word = lower(head.text);
+  const std::string word = to_lower(head.text);
 
   auto no_args = [&](std::string_view name, OperatorCommand command) -> OperatorLine {
     // "PING:" is the raw form with its empty payload.
@@ -165,15 +98,16 @@ OperatorLine parse_operator_line(std::string_view line) {
     if (args.empty() || args.front().text.empty()) {
       return error_at(args.empty() ? line_end : args.front().column, need);
     }
-    const auto value = parse_integer(args.front().text);
-    if (!value || *value < lo || *value > hi) {
+    const auto value = parse_integer(args.front().text, lo, hi);
+    if (!value) {
       return error_at(args.front().column, need + ", not '" + std::string(args.front().text) + "'");
     }
     if (args.size() > 1) {
       return error_at(args[1].column, "unexpected '" + std::string(args[1].text) + "' after " +
-                                          std::string(1, letter) + " " + std::to_string(*value));
+                                          std::string(1, letter) + " " +
+                                          std::to_string(value.value));
     }
-    return command_line(RobotRequest{make(static_cast<int>(*value))});
+    return command_line(RobotRequest{make(static_cast<int>(value.value))});
   };
 
   if (word == "ping") return no_args("PING", RobotRequest{proto::Ping{}});
@@ -210,7 +144,7 @@ OperatorLine parse_operator_line(std::string_view line) {
   if (word == "wait") {
     const std::string need = "wait needs a duration such as 500ms or 1s";
     if (args.empty()) return error_at(line_end, need);
-    const auto d = parse_duration(args.front().text);
+    const auto d = parse_wait(args.front().text);
     if (!d) {
       return error_at(args.front().column, need + ", not '" + std::string(args.front().text) + "'");
     }
@@ -225,7 +159,7 @@ OperatorLine parse_operator_line(std::string_view line) {
 
 std::string ScriptError::to_string() const {
   if (line == 0) return file + ": " + message;
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+  return format_location(file, line, column, message);
 }
 
 std::vector<OperatorCommand> Script::commands() const {
@@ -239,11 +173,8 @@ std::vector<OperatorCommand> Script::commands() const {
 Script parse_script(std::string_view text, const std::string& file) {
   Script script;
   std::size_t number = 0;
-  while (!text.empty()) {
+  for (std::string_view line : split_lines(text)) {
     ++number;
-    const auto nl = text.find('\n');
-    std::string_view line = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     auto parsed = parse_operator_line(line);
     if (parsed.error) {

@@ -1,9 +1,11 @@
 #include "client/leka/operator.hpp"
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
+#include <chrono>
+#include <cstdint>
 #include <utility>
+
+#include "client/common/operator_text.hpp"
 
 namespace hil::client::leka {
 
@@ -43,85 +45,53 @@ std::string range_text(const ArgSpec& a) {
 }
 
 std::optional<int> parse_int(std::string_view text) {
-  int base = 10;
-  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
-    base = 16;
-    text.remove_prefix(2);
-  }
-  if (text.empty() || text.size() > 9) return std::nullopt;
-  int value = 0;
-  auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value, base);
-  if (ec != std::errc{} || p != text.data() + text.size()) return std::nullopt;
-  return value;
+  const auto v = parse_integer(text, INT32_MIN, INT32_MAX,
+                               {.plus = false, .minus = true, .hex = true, .max_digits = 9});
+  if (!v) return std::nullopt;
+  return static_cast<int>(v.value);
 }
 
-std::optional<Duration> parse_duration(std::string_view text) {
-  double scale_us = 0;
-  if (text.ends_with("ms")) {
-    scale_us = 1e3;
-    text.remove_suffix(2);
-  } else if (text.ends_with("s")) {
-    scale_us = 1e6;
-    text.remove_suffix(1);
-  } else {
-    return std::nullopt;
-  }
-  if (text.empty() || text.size() > 12) return std::nullopt;
-  for (char c : text)
-    if (!(c >= '0' && c <= '9') && c != '.') return std::nullopt;
-  double value = 0;
-  auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc{} || p != text.data() + text.size()) return std::nullopt;
-  const double us = value * scale_us;
-  if (us > 3600e6) return std::nullopt;
-  return std::chrono::duration_cast<Duration>(
-      std::chrono::microseconds(static_cast<std::int64_t>(std::llround(us))));
+// At most an hour, to the microsecond the robot's pacing can keep.
+std::optional<Duration> parse_wait(std::string_view text) {
+  const auto d = parse_duration(text, link::seconds(3600));
+  if (!d) return std::nullopt;
+  return std::chrono::round<std::chrono::microseconds>(*d);
 }
 
 // Splits a line into commands at ';', words at blanks, stopping at '#'.
 // Dotted names ("led.belt.single") become separate words at the same column.
 std::vector<CommandWords> split_commands(std::string_view text) {
-  std::vector<CommandWords> commands(1);
-  commands.back().column = 1;
-  std::size_t i = 0;
-  auto push_word = [&](std::size_t start, std::size_t end) {
-    const std::string_view word = text.substr(start, end - start);
-    const bool dotted =
-        word.find('.') != std::string_view::npos && !(word[0] >= '0' && word[0] <= '9');
-    if (!dotted) {
-      commands.back().words.push_back({std::string(word), start + 1});
-    } else {
-      std::size_t from = 0;
-      while (from <= word.size()) {
-        const std::size_t dot = std::min(word.find('.', from), word.size());
-        commands.back().words.push_back({std::string(word.substr(from, dot - from)), start + 1});
+  text = text.substr(0, text.find('#'));
+  std::vector<CommandWords> commands;
+  std::size_t start = 0;  // where the command's text begins
+  for (;;) {
+    const std::size_t semicolon = std::min(text.find(';', start), text.size());
+    const auto split = split_words(text.substr(start, semicolon - start), " \t\r\n");
+    CommandWords& c = commands.emplace_back();
+    for (const Word& w : split.words) {
+      const std::size_t column = start + w.column;
+      const bool dotted =
+          w.text.find('.') != std::string_view::npos && !(w.text[0] >= '0' && w.text[0] <= '9');
+      if (!dotted) {
+        c.words.push_back({std::string(w.text), column});
+        continue;
+      }
+      for (std::size_t from = 0; from <= w.text.size();) {
+        const std::size_t dot = std::min(w.text.find('.', from), w.text.size());
+        c.words.push_back({std::string(w.text.substr(from, dot - from)), column});
         from = dot + 1;
       }
     }
-    commands.back().end_column = end + 1;
-  };
-  while (i < text.size()) {
-    const char c = text[i];
-    if (c == '#') break;
-    if (c == ';') {
-      if (commands.back().words.empty()) commands.back().end_column = i + 1;
-      commands.push_back({});
-      commands.back().column = i + 2;
-      commands.back().end_column = i + 2;
-      ++i;
-      continue;
+    if (!c.words.empty()) {
+      c.column = c.words.front().column;
+      c.end_column = start + split.end_column;
+    } else {
+      // An empty command is pointed at by its ';', or just past the last one.
+      c.column = start + 1;
+      c.end_column = semicolon < text.size() ? semicolon + 1 : start + 1;
     }
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
-      ++i;
-      continue;
-    }
-    std::size_t end = i;
-    while (end < text.size() && text[end] != ' ' && text[end] != '\t' && text[end] != ';' &&
-           text[end] != '#' && text[end] != '\r' && text[end] != '\n')
-      ++end;
-    if (commands.back().words.empty()) commands.back().column = i + 1;
-    push_word(i, end);
-    i = end;
+    if (semicolon >= text.size()) break;
+    start = semicolon + 1;
   }
   return commands;
 }
@@ -308,9 +278,7 @@ std::variant<Script, ScriptError> parse_each(const std::vector<std::string_view>
     auto& line = std::get<OperatorLine>(parsed);
     if (line.kind == OperatorLine::Kind::empty) continue;
     // The line as shown in results: without its comment or trailing blanks.
-    std::string text(texts[i].substr(0, texts[i].find('#')));
-    while (!text.empty() && (text.back() == '\r' || text.back() == ' ' || text.back() == '\t'))
-      text.pop_back();
+    std::string text(trim_end(texts[i].substr(0, texts[i].find('#')), " \t\r"));
     script.lines.push_back({i + 1, std::move(text), std::move(line)});
   }
   return script;
@@ -333,7 +301,7 @@ std::variant<OperatorLine, OperatorError> parse_operator_line(std::string_view t
     if (words.size() > 2)
       return OperatorError{words[2].column, "wait: unexpected '" + words[2].text +
                                                 "'; it takes one duration such as 500ms or 1s"};
-    const auto d = parse_duration(words[1].text);
+    const auto d = parse_wait(words[1].text);
     if (!d)
       return OperatorError{words[1].column,
                            "wait: expected a duration such as 500ms or 1s "
@@ -368,19 +336,12 @@ std::variant<OperatorLine, OperatorError> parse_operator_line(std::string_view t
 }
 
 std::string ScriptError::to_string() const {
-  return source + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+  return format_location(source, line, column, message);
 }
 
 std::variant<Script, ScriptError> parse_script(std::string_view text, const std::string& source,
                                                const proto::ValueLimits& limits) {
-  std::vector<std::string_view> lines;
-  while (!text.empty()) {
-    const std::size_t nl = text.find('\n');
-    lines.push_back(text.substr(0, nl));
-    if (nl == std::string_view::npos) break;
-    text.remove_prefix(nl + 1);
-  }
-  return parse_each(lines, source,
+  return parse_each(split_lines(text), source,
                     [&](std::string_view line) { return parse_operator_line(line, limits); });
 }
 

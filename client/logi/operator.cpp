@@ -1,75 +1,23 @@
 #include "client/logi/operator.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdint>
-#include <numeric>
 #include <utility>
+
+#include "client/common/operator_text.hpp"
 
 namespace hil::client::logi {
 
 namespace {
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
+/// Blanks between words; a line break is not one (an action is one line).
+constexpr std::string_view kLineBlanks = " \t\r\v\f";
 
-std::string upper(std::string_view s) {
-  std::string out(s);
-  for (auto& c : out)
-    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return out;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (auto& c : out)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
-bool is_blank(char c) {
-  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
-
-struct Token {
-  std::string_view text;
-  int column = 0;  // 1-based
-};
-
-/// Whitespace-separated words up to a `#`, and the column just past the last one.
-std::vector<Token> tokenize(std::string_view line, int& end_column) {
-  std::vector<Token> tokens;
-  std::size_t i = 0;
-  std::size_t end = 0;
-  while (i < line.size()) {
-    if (is_blank(line[i])) {
-      ++i;
-      continue;
-    }
-    if (line[i] == '#') break;
-    const std::size_t start = i;
-    while (i < line.size() && !is_blank(line[i]) && line[i] != '#')
-      ++i;
-    tokens.push_back({line.substr(start, i - start), static_cast<int>(start) + 1});
-    end = i;
-  }
-  end_column = static_cast<int>(end) + 1;
-  return tokens;
-}
-
-/// Digits only, at most `max_digits` of them.
-std::optional<int> parse_whole(std::string_view s, std::size_t max_digits) {
-  if (s.empty() || s.size() > max_digits) return std::nullopt;
-  int value = 0;
-  for (char c : s) {
-    if (c < '0' || c > '9') return std::nullopt;
-    value = value * 10 + (c - '0');
-  }
-  return value;
+/// Digits only, at most three of them (stations are written 001 as well).
+std::optional<int> parse_whole(std::string_view s, std::int64_t max) {
+  const auto v = parse_integer(s, 0, max, {.plus = false, .minus = false, .max_digits = 3});
+  if (!v) return std::nullopt;
+  return static_cast<int>(v.value);
 }
 
 constexpr std::string_view kVerbs =
@@ -118,50 +66,7 @@ std::string format_duration(link::Duration d) {
 }
 
 std::optional<link::Duration> parse_duration(std::string_view text) {
-  std::size_t i = 0;
-  std::int64_t whole = 0;
-  std::int64_t fraction = 0;
-  std::int64_t scale = 1;  // 10^(digits after the point)
-  bool digits = false;
-  bool point = false;
-  for (; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c >= '0' && c <= '9') {
-      digits = true;
-      if (point) {
-        if (scale >= 1'000'000'000) return std::nullopt;  // finer than a nanosecond
-        fraction = fraction * 10 + (c - '0');
-        scale *= 10;
-      } else {
-        if (whole > 100'000'000) return std::nullopt;  // far beyond the 24 h limit
-        whole = whole * 10 + (c - '0');
-      }
-    } else if (c == '.' && !point) {
-      point = true;
-    } else {
-      break;
-    }
-  }
-  if (!digits || (point && scale == 1)) return std::nullopt;
-  const std::string unit = lower(text.substr(i));
-  std::int64_t unit_ns = 0;
-  if (unit == "ms") {
-    unit_ns = 1'000'000;
-  } else if (unit == "s") {
-    unit_ns = 1'000'000'000;
-  } else if (unit == "m" || unit == "min") {
-    unit_ns = 60'000'000'000;
-  } else {
-    return std::nullopt;
-  }
-  constexpr std::int64_t kLimitNs = 24LL * 3600 * 1'000'000'000;
-  if (whole > kLimitNs / unit_ns) return std::nullopt;
-  // fraction / scale units in whole nanoseconds, without overflow.
-  const std::int64_t g = std::gcd(unit_ns, scale);
-  if (fraction % (scale / g) != 0) return std::nullopt;
-  const std::int64_t ns = whole * unit_ns + fraction / (scale / g) * (unit_ns / g);
-  if (ns > kLimitNs) return std::nullopt;
-  return link::Duration(ns);
+  return client::parse_duration(text, link::seconds(24 * 3600));
 }
 
 std::string to_string(const OperatorAction& action) {
@@ -184,11 +89,12 @@ std::string to_string(const OperatorAction& action) {
 }
 
 OperatorParseResult parse_operator_action(std::string_view line) {
-  int end_column = 1;
-  const auto tokens = tokenize(line, end_column);
+  const auto split = split_words(line, kLineBlanks);
+  const auto& tokens = split.words;
+  const int end_column = static_cast<int>(split.end_column);
   if (tokens.empty()) return {};
-  const Token& verb_token = tokens[0];
-  const std::string verb = lower(verb_token.text);
+  const Word& verb_token = tokens[0];
+  const std::string verb = to_lower(verb_token.text);
 
   // Verbs without an argument.
   std::optional<OperatorAction> bare;
@@ -203,8 +109,9 @@ OperatorParseResult parse_operator_action(std::string_view line) {
   std::string expected;  // what the argument must be, for the messages
   if (bare) {
     if (tokens.size() > 1) {
-      return fail(tokens[1].column, "unexpected '" + std::string(tokens[1].text) + "' after '" +
-                                        verb + "' (it takes no argument)");
+      return fail(static_cast<int>(tokens[1].column), "unexpected '" + std::string(tokens[1].text) +
+                                                          "' after '" + verb +
+                                                          "' (it takes no argument)");
     }
     OperatorParseResult r;
     r.action = *bare;
@@ -221,33 +128,36 @@ OperatorParseResult parse_operator_action(std::string_view line) {
   } else if (verb == "wait") {
     expected = "a duration with a unit (500ms, 1s, 1.5s, 2m)";
   } else {
-    return fail(verb_token.column, "unknown action '" + std::string(verb_token.text) +
-                                       "' (expected one of " + std::string(kVerbs) + ")");
+    return fail(static_cast<int>(verb_token.column),
+                "unknown action '" + std::string(verb_token.text) + "' (expected one of " +
+                    std::string(kVerbs) + ")");
   }
   if (tokens.size() < 2) return fail(end_column, "expected " + expected + " after '" + verb + "'");
   if (tokens.size() > 2) {
-    return fail(tokens[2].column, "unexpected '" + std::string(tokens[2].text) + "' after '" +
-                                      verb + " " + std::string(tokens[1].text) + "'");
+    return fail(static_cast<int>(tokens[2].column), "unexpected '" + std::string(tokens[2].text) +
+                                                        "' after '" + verb + " " +
+                                                        std::string(tokens[1].text) + "'");
   }
-  const Token& arg = tokens[1];
+  const Word& arg = tokens[1];
   const auto bad = [&] {
-    return fail(arg.column, "expected " + expected + ", got '" + std::string(arg.text) + "'");
+    return fail(static_cast<int>(arg.column),
+                "expected " + expected + ", got '" + std::string(arg.text) + "'");
   };
   OperatorParseResult r;
   if (verb == "speed") {
-    const auto v = parse_whole(arg.text, 3);
-    if (!v || *v > 100) return bad();
+    const auto v = parse_whole(arg.text, 100);
+    if (!v) return bad();
     r.action = op::Speed{*v};
   } else if (verb == "mode") {
-    const auto m = proto::parse_mode(upper(arg.text));
+    const auto m = proto::parse_mode(to_upper(arg.text));
     if (!m) return bad();
     r.action = op::SetMode{*m};
   } else if (verb == "press") {
-    const auto d = proto::parse_direction(upper(arg.text));
+    const auto d = proto::parse_direction(to_upper(arg.text));
     if (!d) return bad();
     r.action = op::Press{*d};
   } else if (verb == "station") {
-    const auto v = parse_whole(arg.text, 3);
+    const auto v = parse_whole(arg.text, 999);
     if (!v || *v < 1) return bad();
     r.action = op::Station{*v};
   } else {  // wait
@@ -259,17 +169,14 @@ OperatorParseResult parse_operator_action(std::string_view line) {
 }
 
 std::string OperatorScriptError::to_string() const {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+  return format_location(file, static_cast<std::size_t>(line), static_cast<std::size_t>(column),
+                         message);
 }
 
 OperatorScript parse_operator_script(std::string_view text, std::string_view file_name) {
   OperatorScript script;
   int line_number = 0;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    std::size_t nl = text.find('\n', pos);
-    if (nl == std::string_view::npos) nl = text.size();
-    const std::string_view line = text.substr(pos, nl - pos);
+  for (const std::string_view line : split_lines(text)) {
     ++line_number;
     auto parsed = parse_operator_action(line);
     if (parsed.error) {
@@ -278,15 +185,9 @@ OperatorScript parse_operator_script(std::string_view text, std::string_view fil
       return script;
     }
     if (parsed.action) {
-      std::string_view body = line.substr(0, std::min(line.find('#'), line.size()));
-      while (!body.empty() && is_blank(body.front()))
-        body.remove_prefix(1);
-      while (!body.empty() && is_blank(body.back()))
-        body.remove_suffix(1);
+      const std::string_view body = trim(line.substr(0, line.find('#')), kLineBlanks);
       script.steps.push_back(OperatorStep{line_number, std::string(body), *parsed.action});
     }
-    if (nl == text.size()) break;
-    pos = nl + 1;
   }
   return script;
 }

@@ -1,86 +1,29 @@
 #include "client/wr8/operator.hpp"
 
-#include <cctype>
-#include <charconv>
-#include <cmath>
-#include <cstdio>
+#include <cstdint>
 #include <stdexcept>
 #include <utility>
+
+#include "client/common/operator_text.hpp"
 
 namespace hil::client::wr8 {
 
 namespace {
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
-
-struct Token {
-  std::string_view text;
-  std::size_t column = 1;  // 1-based
-};
-
-// Words separated by blanks; a `#` outside a word starts a comment.
-std::vector<Token> tokenize(std::string_view line) {
-  std::vector<Token> out;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    const char c = line[i];
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
-      ++i;
-      continue;
-    }
-    if (c == '#') break;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' &&
-           line[i] != '\n')
-      ++i;
-    out.push_back({line.substr(start, i - start), start + 1});
-  }
-  return out;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out)
-    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
+// Blanks between words; a `#` starts a comment only where a word would.
+SplitLine words_of(std::string_view line) {
+  return split_words(line, " \t\r\n", CommentStart::word_start);
 }
 
 std::optional<std::int32_t> parse_i32(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  std::int32_t v = 0;
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc{} || p != s.data() + s.size() || s.empty()) return std::nullopt;
-  return v;
+  const auto v = parse_integer(s, INT32_MIN, INT32_MAX);
+  if (!v) return std::nullopt;
+  return static_cast<std::int32_t>(v.value);
 }
 
 // "500ms", "1s", "1.5s", "2min": a non-negative number and a unit.
 std::optional<Duration> parse_duration(std::string_view s) {
-  std::size_t n = 0;
-  while (n < s.size() && (std::isdigit(static_cast<unsigned char>(s[n])) || s[n] == '.'))
-    ++n;
-  if (n == 0) return std::nullopt;
-  double value = 0;
-  const auto [p, ec] = std::from_chars(s.data(), s.data() + n, value);
-  if (ec != std::errc{} || p != s.data() + n || !std::isfinite(value)) return std::nullopt;
-  const std::string unit = lower(s.substr(n));
-  double ns_per_unit = 0;
-  if (unit == "ms") {
-    ns_per_unit = 1e6;
-  } else if (unit == "s") {
-    ns_per_unit = 1e9;
-  } else if (unit == "min") {
-    ns_per_unit = 60e9;
-  } else {
-    return std::nullopt;
-  }
-  const double ns = value * ns_per_unit;
-  if (ns > 1e18) return std::nullopt;
-  return Duration(static_cast<Duration::rep>(std::llround(ns)));
+  return client::parse_duration(s, Duration(1'000'000'000'000'000'000));
 }
 
 ParsedLine fail(std::size_t column, std::string message) {
@@ -125,14 +68,15 @@ std::string setting_name(proto::SettingCode code) {
 }  // namespace
 
 std::string first_word(std::string_view line) {
-  const auto tokens = tokenize(line);
-  return tokens.empty() ? std::string() : lower(tokens.front().text);
+  const auto split = words_of(line);
+  return split.words.empty() ? std::string() : to_lower(split.words.front().text);
 }
 
 ParsedLine parse_operator_line(std::string_view line, const proto::Profile& profile) {
-  const auto tokens = tokenize(line);
+  const auto split = words_of(line);
+  const auto& tokens = split.words;
   if (tokens.empty()) return {};
-  const std::string verb = lower(tokens[0].text);
+  const std::string verb = to_lower(tokens[0].text);
   const std::size_t end_column = line.size() + 1;
   auto no_more = [&](std::size_t from, std::string_view what) -> std::optional<LineError> {
     if (tokens.size() > from)
@@ -227,36 +171,27 @@ ParsedLine parse_operator_line(std::string_view line, const proto::Profile& prof
 }
 
 std::string ScriptError::to_string() const {
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + message;
+  return format_location(file, static_cast<std::size_t>(line), column, message);
 }
 
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile) {
   Script script;
   int number = 0;
-  while (!text.empty() || number == 0) {
+  for (const std::string_view line : split_lines(text)) {
     ++number;
-    const auto nl = text.find('\n');
-    const std::string_view line = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
     auto parsed = parse_operator_line(line, profile);
     if (parsed.error) {
       script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
     } else if (parsed.action) {
       script.steps.push_back({number, std::move(*parsed.action)});
     }
-    if (nl == std::string_view::npos) break;
   }
   return script;
 }
 
 std::string format_duration(Duration d) {
-  const auto ns = d.count();
-  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
-  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6gms", link::to_ms(d));
-  return buf;
+  return duration_text(d);
 }
 
 std::string format_settings(const std::vector<proto::Setting>& settings,

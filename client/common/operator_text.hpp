@@ -1,0 +1,92 @@
+#pragma once
+// The text handling every operator language shares: words with their
+// columns, letter case, whole numbers and durations, script lines, and the
+// "file:line:col: message" form of an error.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "link/time.hpp"
+
+namespace hil::client {
+
+/// Lambdas as one visitor for std::visit.
+template <class... F>
+struct Overloaded : F... {
+  using F::operator()...;
+};
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;
+
+std::string to_lower(std::string_view text);
+std::string to_upper(std::string_view text);
+
+/// What std::isspace calls blank in the C locale.
+inline constexpr std::string_view kBlanks = " \t\n\v\f\r";
+
+/// `text` without the `blanks` at either end (or only at its end).
+std::string_view trim(std::string_view text, std::string_view blanks = kBlanks);
+std::string_view trim_end(std::string_view text, std::string_view blanks = kBlanks);
+
+/// A word of a line and the 1-based column where it starts.
+struct Word {
+  std::string_view text;
+  std::size_t column = 1;
+};
+
+/// Where a `#` starts a comment.
+enum class CommentStart : std::uint8_t {
+  anywhere,    ///< a `#` ends the word it is in and the line
+  word_start,  ///< only a word that begins with `#`; inside a word it is a letter
+};
+
+struct SplitLine {
+  std::vector<Word> words;
+  std::size_t end_column = 1;  ///< one past the last word (1 for none)
+};
+
+/// The words of `line` between `blanks`, up to a comment.
+SplitLine split_words(std::string_view line, std::string_view blanks = kBlanks,
+                      CommentStart comment = CommentStart::anywhere);
+
+/// What a whole number may look like besides its decimal digits.
+struct IntegerSyntax {
+  bool plus = true;             ///< a leading '+'
+  bool minus = true;            ///< a leading '-'
+  bool hex = false;             ///< 0x or 0X and hex digits
+  std::size_t max_digits = 18;  ///< longer is not a number
+};
+
+/// A whole number, or why the text is not one within the range.
+struct ParsedInteger {
+  enum class Error : std::uint8_t { none, not_a_number, out_of_range };
+  std::int64_t value = 0;
+  Error error = Error::none;
+  explicit operator bool() const { return error == Error::none; }
+};
+
+/// `text` as a whole number in [lo, hi].
+ParsedInteger parse_integer(std::string_view text, std::int64_t lo, std::int64_t hi,
+                            IntegerSyntax syntax = {});
+
+/// A duration with a unit, "500ms", "1s", "1.5s", "2m" or "2min" (units in
+/// any letter case), exact to the nanosecond and at most `max`; nullopt
+/// otherwise. A point needs a digit after it ("1.s" is refused).
+std::optional<link::Duration> parse_duration(std::string_view text, link::Duration max);
+
+/// "2s", "250ms", "1.5ms": whole seconds, else milliseconds.
+std::string duration_text(link::Duration d);
+
+/// The lines of a script, without their '\n'; no last empty line after a
+/// final newline.
+std::vector<std::string_view> split_lines(std::string_view text);
+
+/// "file:line:col: message".
+std::string format_location(std::string_view file, std::size_t line, std::size_t column,
+                            std::string_view message);
+
+}  // namespace hil::client
