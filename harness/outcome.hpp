@@ -21,6 +21,9 @@ struct StepOutcome {
   std::string phase;  ///< "setup", "steps", "teardown" or "schedule"
   bool ok = true;
   std::string reason;  ///< why it failed, for a person
+  /// False when the step never started (an earlier step failed, the run
+  /// timed out, or a scheduled step's moment never came); `reason` says which.
+  bool ran = true;
   Time started{0};
   Time ended{0};
 };

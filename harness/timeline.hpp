@@ -44,6 +44,29 @@ std::string_view to_string(Source source);  ///< "wire", "fault", ...
 ///   "station" {"station"}, "collision" {"with"}, "at_rest", "moving".
 /// - step: kind "start" / "end" {"index", "line", "text", "ok", "reason"}.
 /// - car: kind "behaviour" {"name"}, "fault_state" {"on"}.
+/// What the reference runner writes on top of the fields above:
+/// - wire "frame": also "bytes" (count), "message" (a valid frame decoded, for a person);
+///   for an invalid one "error" is the decoder's error kind ("bad_checksum", "garbage",
+///   "bad_format", "truncated", ...) and "detail" its whole message. "open" {"client", "car"};
+///   "close" also "mode" ("graceful" | "reset"). A refused connection has no open/close, only
+///   its fault record.
+/// - fault: also "frame_number" (1-based in its direction) when the rule acted on a frame.
+/// - client "connection": also "attempt" (reconnect attempt, 0 for the operator's connect),
+///   "detail" (the client library's own name of the state), Arduino "reason"; the Arduino
+///   link also reaches "degraded" and "down". "command": also "request" (the client's id),
+///   LOGI "text" (the frame) and "attempt"; WR8 "command" is the task ("drive", "turn",
+///   "settings"); Arduino has no "command" but "detail" ("ACK OK", "NACK BAD_V") and states
+///   "ok", "nack", "timeout", "link_down", "invalid_request".
+/// - client kinds "fresh" (the stale warning cleared), "login" {"ok", "reason"} (WR8),
+///   "parse_error" {"text"} (a frame the client could not decode), "movement" {"enabled",
+///   "reason"} (LOGI: whether movement controls are enabled).
+/// - sim "station": also "tag" (the tag's id, "002"; "station" is the tag's id when it is not
+///   a number). "moving" when the chassis reaches 5 mm/s or 0.02 rad/s, "at_rest" when both
+///   fall below half of that; a run starts with an "at_rest" at 0. Stations, collisions and
+///   rest are looked at every 10 ms, samples at RunOptions::sample_period from 0.
+/// - step "start" / "end": also "phase" ("setup", "steps", "teardown", "schedule"); "index"
+///   is the step's place in ScenarioOutcome::steps; only "end" has "ok" and "reason".
+/// - car "behaviour" when a car step arms it: {"name", "action"} ("reject", "close", ...).
 struct Record {
   Time at{0};
   Source source = Source::step;

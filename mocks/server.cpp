@@ -28,7 +28,13 @@ MockServer::MockServer(link::TransportContext& context, Firmware& firmware, Serv
   if (!options_.protocol) options_.protocol = firmware_.adapter();
   gate_ = std::make_unique<link::FaultInjector>(
       link::Direction::to_car, options_.protocol,
-      link::for_direction(options_.faults, link::Direction::to_car), options_.seed);
+      link::for_direction(options_.faults, link::Direction::to_car), options_.seed,
+      // A refused connection never gets a link: its fault goes to the
+      // observers from here.
+      [this](const link::FaultEvent& e) {
+        for (const auto& o : options_.observers)
+          o->on_fault(e);
+      });
 }
 
 MockServer::~MockServer() {
@@ -59,6 +65,15 @@ void MockServer::start() {
 
 std::string MockServer::address() const {
   return listener_ ? listener_->address() : link::to_uri(options_.listen);
+}
+
+void MockServer::set_faults(link::FaultProfile faults) {
+  options_.faults = std::move(faults);
+  gate_->set_profile(link::for_direction(options_.faults, link::Direction::to_car));
+  if (link_ && link_->is_open()) {
+    for (const auto d : {link::Direction::to_car, link::Direction::to_client})
+      link_->set_profile(d, link::for_direction(options_.faults, d));
+  }
 }
 
 bool MockServer::client_connected() const {

@@ -47,6 +47,10 @@ class MockServer {
   void start();
   /// Stops listening, closes the client's connection, stops the clock.
   void close();
+  /// Replaces the fault rules: on the current client's link at once (each
+  /// direction keeps its random stream and frame counts) and on every later
+  /// one; an empty profile turns faults off.
+  void set_faults(link::FaultProfile faults);
   /// Where a client connects (the listener's URI, real port or pty path).
   std::string address() const;
 

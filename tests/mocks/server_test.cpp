@@ -221,6 +221,61 @@ TEST(MockServer, LinkFaultsApplyToTheCarsTraffic) {
   EXPECT_EQ(car.server().faults_injected(), 1u);
 }
 
+TEST(MockServer, SetFaultsActsOnTheLinkAtOnceAndOnLaterLinksAndAnEmptyProfileEndsThem) {
+  auto car = make_car();
+  auto client = car.connect();
+  client->write("a");
+  car.run_for(milliseconds(1));
+  EXPECT_EQ(client->take_text(), "Ea");
+
+  link::FaultProfile drop_answers;
+  link::FaultRule drop;
+  drop.direction = link::DirectionFilter::to_client;
+  drop.action = link::Drop{};  // raw frames: every write the car makes
+  drop_answers.rules.push_back(drop);
+  car.server().set_faults(drop_answers);
+  client->write("b");
+  car.run_for(milliseconds(1));
+  EXPECT_EQ(client->take_text(), "") << "the running link drops the answer";
+  EXPECT_EQ(car.server().faults_injected(), 1u);
+
+  client->pipe->close();
+  car.run_for(milliseconds(1));
+  auto second = car.connect();
+  second->write("c");
+  car.run_for(milliseconds(1));
+  EXPECT_EQ(second->take_text(), "") << "the next link starts with the new rules";
+
+  car.server().set_faults({});
+  second->write("d");
+  car.run_for(milliseconds(1));
+  EXPECT_EQ(second->take_text(), "Ed");
+  EXPECT_EQ(car.server().faults_injected(), 2u);
+}
+
+TEST(MockServer, ARefusedConnectionIsAFaultTheObserversSee) {
+  struct Faults final : link::LinkObserver {
+    std::vector<link::FaultEvent> seen;
+    void on_fault(const link::FaultEvent& e) override { seen.push_back(e); }
+  };
+  auto faults = std::make_shared<Faults>();
+  ServerOptions options;
+  options.observers.push_back(faults);
+  link::FaultRule refuse;
+  refuse.name = "closed";
+  refuse.action = link::Refuse{milliseconds(500)};
+  refuse.trigger.at = Time(0);
+  options.faults.rules.push_back(refuse);
+  auto car = make_car(options);
+  auto client = car.connect();
+  car.run_for(milliseconds(1));
+  EXPECT_TRUE(client->closed.has_value());
+  ASSERT_EQ(faults->seen.size(), 1u);
+  EXPECT_EQ(faults->seen[0].kind, "refuse");
+  EXPECT_EQ(faults->seen[0].rule, "closed");
+  EXPECT_EQ(car.server().turned_away(), 1u);
+}
+
 TEST(KindMatches, MatchesWholeParts) {
   EXPECT_TRUE(kind_matches("", "MV:FWD"));
   EXPECT_TRUE(kind_matches("MV", "MV:FWD"));

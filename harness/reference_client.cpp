@@ -1,0 +1,452 @@
+#include "harness/reference_client.hpp"
+
+#include <map>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "client/arduino/operator.hpp"
+#include "client/leka/operator.hpp"
+#include "client/logi/operator.hpp"
+#include "client/wr8/operator.hpp"
+#include "protocol/common/overloaded.hpp"
+
+namespace hil::harness {
+namespace {
+
+// Connection states under one vocabulary for every car, so one matcher
+// ({client: connected}) works whatever the car; "detail" keeps the
+// client's own name of the state.
+nlohmann::json connection(std::string state, std::string_view detail, int attempt) {
+  return {{"state", std::move(state)}, {"detail", std::string(detail)}, {"attempt", attempt}};
+}
+
+std::string decode_error_text(const protocol::DecodeError& e) {
+  std::string text(protocol::to_string(e.kind));
+  if (!e.detail.empty()) text += ": " + e.detail;
+  return text;
+}
+
+std::string column_message(std::size_t column, const std::string& message) {
+  return "column " + std::to_string(column) + ": " + message;
+}
+
+// Runs the action's completion on a later turn, so a runner never sees its
+// owner react (and perhaps start the next action) inside its own callback.
+void later(link::Executor& executor, std::shared_ptr<bool> alive, std::function<void()> f) {
+  executor.post([alive = std::move(alive), f = std::move(f)] {
+    if (*alive) f();
+  });
+}
+
+// ------------------------------------------------------------------ LOGI
+
+class LogiReference final : public ReferenceSession {
+ public:
+  LogiReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline)
+      : executor_(context.executor),
+        timeline_(timeline),
+        session_(context, std::move(endpoint), {},
+                 [this](Time now, const client::logi::Event& e) { on_event(now, e); }) {}
+  ~LogiReference() override { *alive_ = false; }
+
+  void execute(const std::string& text, Done done) override {
+    const auto parsed = client::logi::parse_operator_action(text);
+    if (!parsed.ok() || !parsed.action) {
+      const std::string why = parsed.error
+                                  ? column_message(static_cast<std::size_t>(parsed.error->column),
+                                                   parsed.error->message)
+                                  : "no action";
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    retired_.clear();
+    const std::uint64_t generation = ++generation_;
+    std::vector<client::logi::OperatorStep> steps{{1, text, *parsed.action}};
+    auto result = std::make_shared<client::logi::ActionResult>();
+    current_ = std::make_unique<client::logi::OperatorRunner>(
+        session_, executor_, std::move(steps), client::logi::OperatorRunnerOptions{},
+        [result](const client::logi::ActionResult& r) { *result = r; },
+        [this, generation, result, done](const client::logi::RunSummary&) {
+          if (generation != generation_) return;
+          later(executor_, alive_, [result, done] { done(result->ok, result->reason); });
+        });
+    current_->start();
+  }
+
+  void cancel() override {
+    ++generation_;
+    if (current_) {
+      current_->cancel();
+      retired_.push_back(std::move(current_));
+    }
+  }
+
+  void stop() override {
+    cancel();
+    session_.disconnect();
+  }
+
+ private:
+  void on_event(Time now, const client::logi::Event& event) {
+    namespace cl = client::logi;
+    std::visit(
+        protocol::Overloaded{
+            [&](const cl::ConnectionEvent& e) {
+              static constexpr const char* kStates[] = {"disconnected", "connecting", "connected",
+                                                        "reconnecting"};
+              timeline_.add(Source::client, "connection",
+                            connection(kStates[static_cast<int>(e.state)], cl::to_string(e.state),
+                                       e.attempt));
+            },
+            [&](const cl::CommandEvent& e) {
+              timeline_.add(Source::client, "command",
+                            {{"command", protocol::logi::kind_of(e.command)},
+                             {"text", protocol::logi::encode_text(e.command)},
+                             {"state", std::string(cl::to_string(e.state))},
+                             {"request", e.request},
+                             {"attempt", e.attempt}});
+            },
+            [&](const cl::StaleEvent& e) {
+              timeline_.add(Source::client, e.stale ? "stale" : "fresh");
+            },
+            [&](const cl::NoticeEvent& e) {
+              timeline_.add(Source::client, "notice", {{"text", e.text}});
+            },
+            [&](const cl::ParseErrorEvent& e) {
+              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
+            },
+            [&](const cl::MovementEvent& e) {
+              timeline_.add(Source::client, "movement",
+                            {{"enabled", e.enabled}, {"reason", e.reason}});
+            },
+            [](const cl::StatusEvent&) {},    // the STAT frames are on the wire
+            [](const cl::FeedbackEvent&) {},  // so are the FB frames
+        },
+        event);
+    if (current_) current_->on_event(now, event);
+  }
+
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  client::logi::LogiSession session_;
+  std::unique_ptr<client::logi::OperatorRunner> current_;
+  std::vector<std::unique_ptr<client::logi::OperatorRunner>> retired_;
+  std::uint64_t generation_ = 0;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+// ------------------------------------------------------------------- WR8
+
+class Wr8Reference final : public ReferenceSession {
+ public:
+  Wr8Reference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline)
+      : executor_(context.executor),
+        timeline_(timeline),
+        session_(context, std::move(endpoint), {},
+                 [this](Time now, const client::wr8::Event& e) { on_event(now, e); }),
+        runner_(std::make_unique<client::wr8::OperatorRunner>(executor_, session_)) {}
+  ~Wr8Reference() override { *alive_ = false; }
+
+  void execute(const std::string& text, Done done) override {
+    auto parsed = client::wr8::parse_operator_line(text);
+    if (parsed.error || !parsed.action) {
+      const std::string why =
+          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    retired_.clear();
+    const std::uint64_t generation = ++generation_;
+    runner_->execute(std::move(*parsed.action),
+                     [this, generation, done](const client::wr8::ActionResult& r) {
+                       if (generation != generation_) return;
+                       const bool ok = r.ok;
+                       const std::string reason = r.ok ? std::string() : r.detail;
+                       later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
+                     });
+  }
+
+  void cancel() override {
+    ++generation_;
+    if (runner_->busy()) {
+      // The runner has no cancel; a fresh one takes over and the old one's
+      // answer is ignored.
+      retired_.push_back(std::move(runner_));
+      runner_ = std::make_unique<client::wr8::OperatorRunner>(executor_, session_);
+    }
+  }
+
+  void stop() override {
+    cancel();
+    session_.disconnect();
+  }
+
+ private:
+  void on_event(Time now, const client::wr8::Event& event) {
+    namespace cw = client::wr8;
+    std::visit(
+        protocol::Overloaded{
+            [&](const cw::ConnectionEvent& e) {
+              static constexpr const char* kStates[] = {
+                  "disconnected", "connecting", "authenticating", "connected", "reconnecting"};
+              timeline_.add(Source::client, "connection",
+                            connection(kStates[static_cast<int>(e.state)], cw::to_string(e.state),
+                                       e.attempt));
+            },
+            [&](const cw::LoginEvent&) {
+              timeline_.add(Source::client, "login", {{"ok", true}});
+            },
+            [&](const cw::LoginFailedEvent& e) {
+              timeline_.add(Source::client, "login", {{"ok", false}, {"reason", e.reason}});
+            },
+            [&](const cw::StaleEvent& e) {
+              timeline_.add(Source::client, e.stale ? "stale" : "fresh");
+            },
+            [&](const cw::RequestEvent& e) {
+              const std::string command = e.kind == cw::RequestKind::settings
+                                              ? std::string("settings")
+                                              : std::string(protocol::wr8::to_string(e.task));
+              timeline_.add(Source::client, "command",
+                            {{"command", command},
+                             {"state", std::string(cw::to_string(e.state))},
+                             {"request", e.coi}});
+            },
+            [&](const cw::ParseErrorEvent& e) {
+              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
+            },
+            [](const cw::TelemetryEvent&) {},  // DATA frames are on the wire
+            [](const cw::SettingsEvent&) {},
+            [](const cw::IgnoredEvent&) {},
+        },
+        event);
+    if (runner_) runner_->on_event(now, event);
+  }
+
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  client::wr8::Wr8Session session_;
+  std::unique_ptr<client::wr8::OperatorRunner> runner_;
+  std::vector<std::unique_ptr<client::wr8::OperatorRunner>> retired_;
+  std::uint64_t generation_ = 0;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+// --------------------------------------------------------------- Arduino
+
+class ArduinoReference final : public ReferenceSession {
+ public:
+  ArduinoReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline)
+      : executor_(context.executor), timeline_(timeline), session_(context, std::move(endpoint)) {
+    session_.set_wall_clock([this] { return executor_.now().count() / 1000; });
+    make_runner();
+  }
+  ~ArduinoReference() override {
+    *alive_ = false;
+    runner_.reset();
+  }
+
+  void start() override { session_.open(); }
+
+  void execute(const std::string& text, Done done) override {
+    auto parsed = client::arduino::parse_operator_line(text);
+    if (!parsed.ok() || !parsed.command) {
+      const std::string why =
+          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    // Quitting means nothing in a scenario: the run decides when it ends.
+    if (std::holds_alternative<client::arduino::QuitCommand>(*parsed.command)) {
+      later(executor_, alive_, [done] { done(true, ""); });
+      return;
+    }
+    pending_[next_index_++] = std::move(done);
+    runner_->add(std::move(*parsed.command));
+  }
+
+  void cancel() override {
+    pending_.clear();
+    if (!runner_->idle()) make_runner();
+  }
+
+  void stop() override {
+    cancel();
+    session_.close();
+  }
+
+ private:
+  void make_runner() {
+    runner_.reset();  // its destructor clears the session's handler
+    runner_ = std::make_unique<client::arduino::OperatorRunner>(
+        session_, executor_, client::arduino::OperatorRunner::Options{true});
+    next_index_ = 0;
+    runner_->set_event_handler([this](const client::arduino::Event& e) { on_event(e); });
+    runner_->set_outcome_handler([this](const client::arduino::CommandOutcome& o) {
+      const auto it = pending_.find(o.index);
+      if (it == pending_.end()) return;
+      Done done = std::move(it->second);
+      pending_.erase(it);
+      const bool ok = o.ok;
+      const std::string reason = o.ok ? std::string() : client::arduino::describe_outcome(o);
+      later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
+    });
+  }
+
+  void on_event(const client::arduino::Event& event) {
+    namespace ca = client::arduino;
+    std::visit(
+        protocol::Overloaded{
+            [&](const ca::LinkChanged& e) {
+              static constexpr const char* kStates[] = {"disconnected", "connecting",   "connected",
+                                                        "degraded",     "reconnecting", "down"};
+              auto data = connection(kStates[static_cast<int>(e.to)], ca::to_string(e.to), 0);
+              data["reason"] = e.reason;
+              timeline_.add(Source::client, "connection", std::move(data));
+            },
+            [&](const ca::RequestDone& e) {
+              timeline_.add(Source::client, "command",
+                            {{"request", e.id},
+                             {"state", std::string(ca::to_string(e.result.code))},
+                             {"detail", ca::describe_result(e.result)}});
+            },
+            [](const ca::FrameReceived&) {},  // on the wire already
+        },
+        event);
+  }
+
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  client::arduino::ArduinoSession session_;
+  std::unique_ptr<client::arduino::OperatorRunner> runner_;
+  std::map<std::size_t, Done> pending_;
+  std::size_t next_index_ = 0;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+// ------------------------------------------------------------------ Leka
+
+class LekaReference final : public ReferenceSession {
+ public:
+  LekaReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline)
+      : executor_(context.executor),
+        timeline_(timeline),
+        session_(context, std::move(endpoint)),
+        runner_(executor_, session_) {
+    session_.set_wall_clock([this] { return executor_.now().count() / 1000; });
+  }
+  ~LekaReference() override { *alive_ = false; }
+
+  void start() override { session_.open(); }
+
+  void execute(const std::string& text, Done done) override {
+    auto parsed = client::leka::parse_script(text, "scenario");
+    if (const auto* e = std::get_if<client::leka::ScriptError>(&parsed)) {
+      const std::string why = column_message(e->column, e->message);
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    if (!session_.is_open()) {
+      const std::string why =
+          "the port is not open" +
+          (session_.open_error().empty() ? std::string() : ": " + session_.open_error());
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    const std::uint64_t generation = ++generation_;
+    auto failure = std::make_shared<std::string>();
+    runner_.run(
+        std::get<client::leka::Script>(std::move(parsed)),
+        [failure](const client::leka::LineResult& r) {
+          if (!r.ok) *failure = r.error;
+        },
+        [this, generation, failure, done](bool ok) {
+          if (generation != generation_) return;
+          later(executor_, alive_, [done, ok, failure] { done(ok, *failure); });
+        });
+  }
+
+  void cancel() override {
+    ++generation_;
+    runner_.cancel();
+  }
+
+  void stop() override {
+    cancel();
+    session_.close();
+    poll();
+  }
+
+  void poll() override {
+    const bool open = session_.is_open();
+    if (open == open_) return;
+    open_ = open;
+    timeline_.add(Source::client, "connection",
+                  connection(open ? "connected" : "disconnected", open ? "open" : "closed", 0));
+  }
+
+ private:
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  client::leka::LekaSession session_;
+  client::leka::ScriptRunner runner_;
+  bool open_ = false;
+  std::uint64_t generation_ = 0;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace
+
+std::unique_ptr<ReferenceSession> make_reference_session(mocks::CarKind car,
+                                                         link::TransportContext& context,
+                                                         link::Endpoint endpoint,
+                                                         RunTimeline& timeline) {
+  switch (car) {
+    case mocks::CarKind::logi:
+      return std::make_unique<LogiReference>(context, std::move(endpoint), timeline);
+    case mocks::CarKind::wr8:
+      return std::make_unique<Wr8Reference>(context, std::move(endpoint), timeline);
+    case mocks::CarKind::arduino:
+      return std::make_unique<ArduinoReference>(context, std::move(endpoint), timeline);
+    case mocks::CarKind::leka:
+      return std::make_unique<LekaReference>(context, std::move(endpoint), timeline);
+  }
+  return nullptr;
+}
+
+std::optional<std::string> action_problem(mocks::CarKind car, std::string_view text) {
+  switch (car) {
+    case mocks::CarKind::logi: {
+      const auto parsed = client::logi::parse_operator_action(text);
+      if (parsed.error)
+        return column_message(static_cast<std::size_t>(parsed.error->column),
+                              parsed.error->message);
+      if (!parsed.action) return "no action";
+      return std::nullopt;
+    }
+    case mocks::CarKind::wr8: {
+      const auto parsed = client::wr8::parse_operator_line(text);
+      if (parsed.error) return column_message(parsed.error->column, parsed.error->message);
+      if (!parsed.action) return "no action";
+      return std::nullopt;
+    }
+    case mocks::CarKind::arduino: {
+      const auto parsed = client::arduino::parse_operator_line(text);
+      if (parsed.error) return column_message(parsed.error->column, parsed.error->message);
+      if (!parsed.command) return "no action";
+      return std::nullopt;
+    }
+    case mocks::CarKind::leka: {
+      const auto parsed = client::leka::parse_operator_line(text);
+      if (const auto* e = std::get_if<client::leka::OperatorError>(&parsed))
+        return column_message(e->column, e->message);
+      if (std::get<client::leka::OperatorLine>(parsed).kind ==
+          client::leka::OperatorLine::Kind::empty)
+        return "no action";
+      return std::nullopt;
+    }
+  }
+  return "unknown car";
+}
+
+}  // namespace hil::harness

@@ -1,0 +1,138 @@
+#include "harness/timeline_recorder.hpp"
+
+#include <utility>
+#include <vector>
+
+#include "link/capture/wire_log.hpp"
+
+namespace hil::harness {
+
+// ------------------------------------------------------------ RunTimeline
+
+void RunTimeline::add(Source source, std::string kind, nlohmann::json data) {
+  add_at(clock_.now(), source, std::move(kind), std::move(data));
+}
+
+void RunTimeline::add_at(Time at, Source source, std::string kind, nlohmann::json data) {
+  if (closed_) return;
+  timeline_.add(at, source, std::move(kind), std::move(data));
+  if (listeners_.empty()) return;
+  // A copy of the record and of the listener list: listeners may come and go
+  // while they run, and the timeline may grow.
+  const Record record = timeline_.records().back();
+  std::vector<std::pair<ListenerId, std::shared_ptr<Listener>>> now(listeners_.begin(),
+                                                                    listeners_.end());
+  for (const auto& [id, listener] : now) {
+    if (listeners_.count(id) != 0) (*listener)(record);
+  }
+}
+
+RunTimeline::ListenerId RunTimeline::listen(Listener listener) {
+  const ListenerId id = next_id_++;
+  listeners_.emplace(id, std::make_shared<Listener>(std::move(listener)));
+  return id;
+}
+
+void RunTimeline::unlisten(ListenerId id) {
+  listeners_.erase(id);
+}
+
+// ------------------------------------------------------------ WireRecorder
+
+namespace {
+
+constexpr std::size_t kSent = 0;
+constexpr std::size_t kDelivered = 1;
+constexpr const char* kStageNames[2] = {"sent", "delivered"};
+
+std::size_t index_of(link::Direction d) {
+  return static_cast<std::size_t>(d);
+}
+
+// "bad_checksum: expected 3F, got 40" -> "bad_checksum".
+std::string error_kind(const std::string& text) {
+  const auto colon = text.find(':');
+  return colon == std::string::npos ? text : text.substr(0, colon);
+}
+
+}  // namespace
+
+WireRecorder::WireRecorder(RunTimeline& timeline,
+                           std::shared_ptr<const link::ProtocolAdapter> protocol)
+    : timeline_(timeline), protocol_(std::move(protocol)) {
+  reset_splitters();
+}
+
+void WireRecorder::reset_splitters() {
+  for (std::size_t stage : {kSent, kDelivered}) {
+    for (const auto d : {link::Direction::to_car, link::Direction::to_client}) {
+      splitters_[stage][index_of(d)] =
+          protocol_ ? protocol_->splitter_for(d) : link::protocol_adapter("raw")->splitter();
+    }
+  }
+}
+
+void WireRecorder::on_open(Time at, const std::string& client, const std::string& car) {
+  reset_splitters();
+  timeline_.add_at(at, Source::wire, "open", {{"client", client}, {"car", car}});
+}
+
+void WireRecorder::on_sent(Time at, link::Direction d, protocol::ByteView bytes) {
+  on_bytes(kSent, at, d, bytes);
+}
+
+void WireRecorder::on_delivered(Time at, link::Direction d, protocol::ByteView bytes) {
+  on_bytes(kDelivered, at, d, bytes);
+}
+
+void WireRecorder::on_bytes(std::size_t stage, Time at, link::Direction d,
+                            protocol::ByteView bytes) {
+  std::vector<link::WireFrame> frames;
+  splitters_[stage][index_of(d)]->feed(bytes, frames);
+  write_frames(stage, at, d, frames);
+}
+
+void WireRecorder::write_frames(std::size_t stage, Time at, link::Direction d,
+                                std::vector<link::WireFrame>& frames) {
+  for (auto& f : frames) {
+    nlohmann::json data;
+    data["dir"] = std::string(link::to_string(d));
+    data["stage"] = kStageNames[stage];
+    data["frame"] = f.kind;
+    link::put_bytes(data, f.raw);
+    data["valid"] = f.valid;
+    if (f.valid) {
+      if (!f.text.empty()) data["message"] = f.text;
+    } else {
+      data["error"] = error_kind(f.text);
+      data["detail"] = f.text;
+    }
+    timeline_.add_at(at, Source::wire, "frame", std::move(data));
+  }
+}
+
+void WireRecorder::on_fault(const link::FaultEvent& event) {
+  nlohmann::json data{{"dir", std::string(link::to_string(event.direction))},
+                      {"rule", event.rule},
+                      {"detail", event.detail}};
+  if (event.frame != 0) data["frame_number"] = event.frame;
+  timeline_.add_at(event.at, Source::fault, event.kind, std::move(data));
+}
+
+void WireRecorder::on_close(Time at, const link::LinkClose& close) {
+  // What a stream held when it ended is a frame too (truncated).
+  for (std::size_t stage : {kSent, kDelivered}) {
+    for (const auto d : {link::Direction::to_car, link::Direction::to_client}) {
+      std::vector<link::WireFrame> frames;
+      splitters_[stage][index_of(d)]->finish(frames);
+      write_frames(stage, at, d, frames);
+    }
+  }
+  timeline_.add_at(at, Source::wire, "close",
+                   {{"by", std::string(link::to_string(close.by))},
+                    {"reason", close.reason},
+                    {"mode", close.mode == link::CloseMode::reset ? "reset" : "graceful"}});
+  reset_splitters();
+}
+
+}  // namespace hil::harness
