@@ -87,6 +87,13 @@ std::string describe_wire(const Record& r) {
     }
     return out;
   }
+  if (r.kind == "open") {
+    std::string out = "open";
+    if (d.is_object())
+      for (const auto& [key, value] : d.items())
+        out += " " + key + "=" + field(d, key.c_str());
+    return out;
+  }
   if (r.kind == "close") {
     std::string out = "close";
     if (const auto by = field(d, "by"); !by.empty()) out += " by " + by;
@@ -377,7 +384,18 @@ std::string failure_text(const ScenarioOutcome& o) {
       out += "    window: " + (e.window_from ? format_seconds(*e.window_from) : "start") + " .. " +
              (e.window_to ? format_seconds(*e.window_to) : "end") + "\n";
     }
-    append_evidence(out, e.evidence);
+    if (!e.evidence.empty() || !e.window_from) {
+      append_evidence(out, e.evidence);
+    } else {
+      // The checker found nothing to show: what happened in the window, then.
+      const Time to = e.window_to.value_or(Time::max());
+      std::vector<Record> seen;
+      for (const auto& r : o.timeline.records())
+        if (r.at >= *e.window_from && r.at <= to &&
+            !(r.source == Source::sim && r.kind == "sample"))
+          seen.push_back(r);
+      append_evidence(out, seen);
+    }
   }
   if (!o.repro_command.empty()) out += "  repeat: " + o.repro_command + "\n";
   return out;
