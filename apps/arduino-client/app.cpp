@@ -1,22 +1,18 @@
 #include "apps/arduino-client/app.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
 #include <asio/io_context.hpp>
-#include <asio/posix/stream_descriptor.hpp>
-#include <asio/read_until.hpp>
-#include <asio/signal_set.hpp>
-#include <asio/streambuf.hpp>
 #include <cmath>
-#include <csignal>
 #include <functional>
 #include <iostream>
 #include <string_view>
 #include <utility>
 
+#include "apps/common/log_file.hpp"
+#include "apps/common/stdin_lines.hpp"
 #include "client/arduino/session.hpp"
 #include "link/asio_executor.hpp"
 #include "link/transport.hpp"
@@ -42,37 +38,21 @@ class Repl {
  public:
   Repl(asio::io_context& io, arduino::OperatorRunner& runner, bool interactive,
        std::function<void(int)> exit)
-      : stdin_flags_(::fcntl(STDIN_FILENO, F_GETFL)),
-        input_(io),
+      : input_(io, {.line = [this](std::string line) { handle(std::move(line)); },
+                    .end = [this](std::string rest) { ended(std::move(rest)); },
+                    .more = [this] { return !runner_.halted(); }}),
         runner_(runner),
         interactive_(interactive),
         exit_(std::move(exit)) {}
-  ~Repl() { stop(); }
   Repl(const Repl&) = delete;
   Repl& operator=(const Repl&) = delete;
 
   void start() {
-    const int fd = ::dup(STDIN_FILENO);
-    std::error_code ec;
-    if (fd >= 0) input_.assign(fd, ec);
-    if (fd < 0 || ec) {
-      if (fd >= 0) ::close(fd);
-      input_done_ = true;
-      on_idle();
-      return;
-    }
     prompt();
-    read();
+    input_.start();
   }
 
-  void stop() {
-    if (!input_.is_open()) return;
-    std::error_code ec;
-    input_.close(ec);
-    // Asio made the shared file description non-blocking; the shell that
-    // gets the terminal back expects it as it was.
-    if (stdin_flags_ != -1) ::fcntl(STDIN_FILENO, F_SETFL, stdin_flags_);
-  }
+  void stop() { input_.stop(); }
 
   /// The runner has nothing left to do.
   void on_idle() {
@@ -90,24 +70,12 @@ class Repl {
     std::cout << "arduino> " << std::flush;
   }
 
-  void read() {
-    asio::async_read_until(input_, buffer_, '\n', [this](std::error_code ec, std::size_t n) {
-      if (ec) {
-        // End of input (Ctrl-D, the pipe closed) or stdin cannot be read:
-        // a last line without a newline still counts.
-        std::string rest(asio::buffers_begin(buffer_.data()), asio::buffers_end(buffer_.data()));
-        buffer_.consume(buffer_.size());
-        input_done_ = true;
-        if (!rest.empty()) handle(rest);
-        if (runner_.idle()) on_idle();
-        return;
-      }
-      std::string line(asio::buffers_begin(buffer_.data()),
-                       asio::buffers_begin(buffer_.data()) + static_cast<std::ptrdiff_t>(n));
-      buffer_.consume(n);
-      handle(line);
-      if (!runner_.halted()) read();
-    });
+  // End of input (Ctrl-D, the pipe closed) or stdin cannot be read: a last
+  // line without a newline still counts.
+  void ended(std::string rest) {
+    input_done_ = true;
+    if (!rest.empty()) handle(std::move(rest));
+    if (runner_.idle()) on_idle();
   }
 
   void handle(std::string line) {
@@ -124,9 +92,7 @@ class Repl {
     if (runner_.idle() && !input_done_) prompt();
   }
 
-  int stdin_flags_;
-  asio::posix::stream_descriptor input_;
-  asio::streambuf buffer_;
+  StdinLines input_;
   arduino::OperatorRunner& runner_;
   bool interactive_;
   std::function<void(int)> exit_;
@@ -150,21 +116,20 @@ std::string link_change_text(const arduino::LinkChanged& change, const std::stri
 ParsedArguments parse_arguments(int argc, const char* const* argv) {
   AppOptions o;
   CLI::App app{"arduino-client: steer the Arduino serial robot (raw tokens, a script, or a REPL)"};
-  app.add_option("-p,--port", o.port,
-                 "Serial device (/dev/ttyUSB0, /tmp/hil-arduino0) or a hil endpoint (pty://..., "
-                 "tcp://HOST:PORT)")
+  add_serial_options(app, o.port, o.baud,
+                     "Serial device (/dev/ttyUSB0, /tmp/hil-arduino0) or a hil endpoint "
+                     "(pty://..., tcp://HOST:PORT)",
+                     "Line rate of the serial port (default 9600)")
       ->required();
-  app.add_option("--baud", o.baud, "Line rate of the serial port (default 9600)")
-      ->check(CLI::Range(0u, 4000000u));
   app.add_option("--timeout", o.timeout_s,
                  "Seconds the first attempt waits for an answer; each retry doubles it "
                  "(default 0.6)")
       ->check(CLI::Range(0.001, 60.0));
   app.add_option("--retries", o.retries, "Retries after the first attempt (default 3)")
       ->check(CLI::Range(0, 10));
-  app.add_option("--log", o.log_path,
-                 "Write the frame log here at exit: .txt, .csv, .json or .ndjson");
-  app.add_option("--script", o.script, "Run the commands of this file, one per line");
+  add_log_and_script_options(app, o.log_path,
+                             "Write the frame log here at exit: .txt, .csv, .json or .ndjson",
+                             o.script, "Run the commands of this file, one per line");
   app.add_flag("--keep-going", o.keep_going,
                "Tokens and scripts: run every command even after one failed (exit 1 at the end)");
   app.add_option("tokens", o.tokens,
@@ -180,30 +145,12 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
       "  arduino-client --port /dev/ttyUSB0\n"
       "  arduino-client --port /tmp/hil-arduino0 PING \"V 160\" \"M 20\" STATUS\n"
       "  arduino-client --port /tmp/hil-arduino0 --script square.txt --log run.csv\n");
-  ParsedArguments out;
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    out.exit_code = app.exit(e) == 0 ? 0 : 2;
-    return out;
-  }
-  if (!o.script.empty() && !o.tokens.empty()) {
-    warn("arduino-client: give either --script or command tokens, not both");
-    out.exit_code = 2;
-    return out;
-  }
-  out.options = std::move(o);
-  return out;
-}
-
-link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
-  if (port.find("://") != std::string::npos) {
-    link::Endpoint e = link::parse_endpoint(port);
-    if (auto* pty = std::get_if<link::PtyEndpoint>(&e); pty && pty->baud == 0) pty->baud = baud;
-    return e;
-  }
-  if (port.empty()) throw link::EndpointError("--port needs a device path");
-  return link::PtyEndpoint{port, baud, link::Duration{0}};
+  return parse_options<AppOptions>(app, argc, argv, o, [](const AppOptions& given) {
+    return !given.script.empty() && !given.tokens.empty()
+               ? std::optional<std::string>(
+                     "arduino-client: give either --script or command tokens, not both")
+               : std::nullopt;
+  });
 }
 
 TokenCommands commands_from_tokens(const std::vector<std::string>& tokens) {
@@ -276,10 +223,8 @@ int run(const AppOptions& options) {
   runner.set_outcome_handler(
       [](const arduino::CommandOutcome& outcome) { say(arduino::describe_outcome(outcome)); });
 
-  asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](std::error_code ec, int) {
-    if (!ec) finish(130);
-  });
+  StopSignals signals(io);
+  signals.on_next([&](int) { finish(kExitInterrupted); });
 
   std::unique_ptr<Repl> repl;
   session.open();
@@ -299,8 +244,7 @@ int run(const AppOptions& options) {
   runner.set_outcome_handler({});
   session.close();
   if (!options.log_path.empty()) {
-    const auto format = arduino::CommLog::format_for(options.log_path);
-    if (!session.log().save(options.log_path, format)) {
+    if (!save_log(session.log(), options.log_path)) {
       warn("arduino-client: cannot write the log to " + options.log_path);
       if (exit_code == 0) exit_code = 1;
     }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "client/arduino/operator.hpp"
 #include "link/endpoint.hpp"
 
@@ -24,15 +25,10 @@ struct AppOptions {
 
 /// What the command line asks for, or the exit code when it asks for nothing
 /// to run (--help: 0, bad usage: 2; the message is already printed).
-struct ParsedArguments {
-  std::optional<AppOptions> options;
-  int exit_code = 0;
-};
+using ParsedArguments = apps::ParsedArguments<AppOptions>;
 ParsedArguments parse_arguments(int argc, const char* const* argv);
 
-/// The endpoint for --port: a URI is taken as it is (a pty:// without a baud
-/// gets `baud`), anything else is a serial device path.
-link::Endpoint endpoint_for_port(const std::string& port, unsigned baud);
+using apps::endpoint_for_port;
 
 /// The commands of the token arguments, one line each; an error names the
 /// argument and the column.

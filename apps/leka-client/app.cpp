@@ -3,16 +3,13 @@
 #include <CLI/CLI.hpp>
 
 #include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
 #include <cerrno>
-#include <csignal>
 #include <cstring>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
-#include <sstream>
 
+#include "apps/common/log_file.hpp"
 #include "client/leka/session.hpp"
 #include "link/asio_executor.hpp"
 #include "link/transport.hpp"
@@ -62,15 +59,14 @@ std::string plural(std::size_t n, const char* one, const char* many) {
 ParsedArguments parse_arguments(int argc, const char* const* argv) {
   AppOptions o;
   CLI::App app{"leka-client: send command groups to the Leka robot, one line per group"};
-  app.add_option("-p,--port", o.port,
-                 "Serial device of the robot (/dev/ttyUSB0, /tmp/hil-leka0) or a hil endpoint "
-                 "(pty://PATH, tcp://HOST:PORT); not needed with --dry-run");
-  app.add_option("--baud", o.baud, "Line rate of the serial port (default 115200; 0 leaves it)")
-      ->check(CLI::Range(0u, 4000000u));
-  app.add_option("--log", o.log_path,
-                 "Write every frame sent and line received to FILE at exit (.txt, .csv or "
-                 ".ndjson)");
-  app.add_option("--script", o.script, "Run the groups of this file, one per line ('-' = stdin)");
+  add_serial_options(app, o.port, o.baud,
+                     "Serial device of the robot (/dev/ttyUSB0, /tmp/hil-leka0) or a hil "
+                     "endpoint (pty://PATH, tcp://HOST:PORT); not needed with --dry-run",
+                     "Line rate of the serial port (default 115200; 0 leaves it)");
+  add_log_and_script_options(
+      app, o.log_path,
+      "Write every frame sent and line received to FILE at exit (.txt, .csv or .ndjson)", o.script,
+      "Run the groups of this file, one per line ('-' = stdin)");
   app.add_flag("--dry-run", o.dry_run,
                "Print each group's frames in hex and exit, without opening a port");
   app.add_option("--info-timeout-ms", o.info_timeout_ms,
@@ -96,35 +92,19 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
       "  leka-client --port /tmp/hil-leka0 \"ear all 255 0 0; motor all 0 120\" info\n"
       "  leka-client --port /tmp/hil-leka0 --script show.leka --log run.csv\n"
       "  leka-client --dry-run \"belt single 0 255 0 0\"\n");
-  ParsedArguments out;
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    out.exit_code = app.exit(e) == 0 ? 0 : 2;
-    return out;
-  }
-  if (!o.script.empty() && !o.groups.empty()) {
-    warn("leka-client: give either --script or groups, not both");
-    out.exit_code = 2;
-    return out;
-  }
-  if (o.script.empty() && o.groups.empty()) {
-    warn("leka-client: nothing to send: give groups or --script FILE (see --help)");
-    out.exit_code = 2;
-    return out;
-  }
-  if (o.port.empty() && !o.dry_run) {
-    warn("leka-client: --port is required (or --dry-run)");
-    out.exit_code = 2;
-    return out;
-  }
-  if (!o.log_path.empty() && !log_format_for(o.log_path)) {
-    warn("leka-client: --log " + o.log_path + ": the name must end in .txt, .csv or .ndjson");
-    out.exit_code = 2;
-    return out;
-  }
-  out.options = std::move(o);
-  return out;
+  return parse_options<AppOptions>(
+      app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
+        if (!given.script.empty() && !given.groups.empty())
+          return "leka-client: give either --script or groups, not both";
+        if (given.script.empty() && given.groups.empty())
+          return "leka-client: nothing to send: give groups or --script FILE (see --help)";
+        if (given.port.empty() && !given.dry_run)
+          return "leka-client: --port is required (or --dry-run)";
+        if (!given.log_path.empty() && !log_format_for(given.log_path))
+          return "leka-client: --log " + given.log_path +
+                 ": the name must end in .txt, .csv or .ndjson";
+        return std::nullopt;
+      });
 }
 
 leka::ClientConfig config_for(const AppOptions& options) {
@@ -135,37 +115,27 @@ leka::ClientConfig config_for(const AppOptions& options) {
   return config;
 }
 
-link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
-  if (port.find("://") != std::string::npos) {
-    link::Endpoint e = link::parse_endpoint(port);
-    if (auto* pty = std::get_if<link::PtyEndpoint>(&e); pty && pty->baud == 0) pty->baud = baud;
-    return e;
-  }
-  if (port.empty()) throw link::EndpointError("--port needs a device path");
-  return link::PtyEndpoint{port, baud, link::Duration{0}};
-}
-
 std::optional<leka::LogFormat> log_format_for(const std::string& path) {
-  if (path.ends_with(".txt")) return leka::LogFormat::txt;
-  if (path.ends_with(".csv")) return leka::LogFormat::csv;
-  if (path.ends_with(".ndjson")) return leka::LogFormat::ndjson;
-  return std::nullopt;
+  if (!has_log_extension(path)) return std::nullopt;
+  switch (log_format_of(path)) {
+    case LogFileFormat::csv:
+      return leka::LogFormat::csv;
+    case LogFileFormat::ndjson:
+      return leka::LogFormat::ndjson;
+    case LogFileFormat::text:
+      break;
+  }
+  return leka::LogFormat::txt;
 }
 
 std::variant<leka::Script, leka::ScriptError> load_script(const AppOptions& options,
                                                           std::istream& in) {
   if (options.script.empty()) return leka::parse_lines(options.groups, "arg");
-  std::stringstream text;
-  if (options.script == "-") {
-    text << in.rdbuf();
-  } else {
-    std::ifstream file(options.script, std::ios::binary);
-    if (!file)
-      return leka::ScriptError{options.script, 0, 0,
-                               std::string("cannot read the script: ") + std::strerror(errno)};
-    text << file.rdbuf();
-  }
-  return leka::parse_script(text.str(), options.script == "-" ? "stdin" : options.script);
+  const auto text = read_script_text(options.script, in);
+  if (!text)
+    return leka::ScriptError{options.script, 0, 0,
+                             std::string("cannot read the script: ") + std::strerror(errno)};
+  return leka::parse_script(*text, options.script == "-" ? "stdin" : options.script);
 }
 
 std::string format_result(const std::string& source, const leka::LineResult& result,
@@ -210,14 +180,14 @@ class Run {
         context_{executor_, &io_},
         session_(context_, std::move(endpoint), config_for(options)),
         runner_(executor_, session_),
-        signals_(io_, SIGINT, SIGTERM) {
+        signals_(io_) {
     for (const auto& line : script_.lines)
       lines_[line.number] = &line.line;
   }
 
   int go() {
-    signals_.async_wait([this](const std::error_code& ec, int) {
-      if (ec || finishing_) return;
+    signals_.on_next([this](int) {
+      if (finishing_) return;
       runner_.cancel();
       if (session_.is_open()) {
         session_.send(leka::GroupBuilder{}.stop_robot());
@@ -225,7 +195,7 @@ class Run {
       } else {
         warn("leka-client: interrupted");
       }
-      finish(130);
+      finish(kExitInterrupted);
     });
     session_.open();
     wait_for_open(link::Time(0));
@@ -285,7 +255,7 @@ class Run {
     session_.close();
     signals_.cancel();
     if (!options_.log_path.empty()) {
-      if (!session_.log().save(options_.log_path, *log_format_for(options_.log_path))) {
+      if (!save_log(session_.log(), options_.log_path)) {
         warn("leka-client: cannot write the log " + options_.log_path);
         if (exit_code_ == 0) exit_code_ = 1;
       }
@@ -301,7 +271,7 @@ class Run {
   link::TransportContext context_;
   leka::LekaSession session_;
   leka::ScriptRunner runner_;
-  asio::signal_set signals_;
+  StopSignals signals_;
   bool finishing_ = false;
   int exit_code_ = 0;
 };

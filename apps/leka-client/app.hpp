@@ -8,6 +8,7 @@
 #include <variant>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "client/leka/comm_log.hpp"
 #include "client/leka/core.hpp"
 #include "client/leka/operator.hpp"
@@ -28,18 +29,13 @@ struct AppOptions {
 
 /// What the command line asks for, or the exit code when it asks for nothing
 /// to run (--help: 0, bad usage: 2; the message is already printed).
-struct ParsedArguments {
-  std::optional<AppOptions> options;
-  int exit_code = 0;
-};
+using ParsedArguments = apps::ParsedArguments<AppOptions>;
 ParsedArguments parse_arguments(int argc, const char* const* argv);
 
 /// The client settings the options ask for.
 client::leka::ClientConfig config_for(const AppOptions& options);
 
-/// The endpoint for --port: a URI is taken as it is (a pty:// without a baud
-/// gets `baud`), anything else is a serial device path.
-link::Endpoint endpoint_for_port(const std::string& port, unsigned baud);
+using apps::endpoint_for_port;
 
 /// The log format for a file name: .txt, .csv or .ndjson; nullopt otherwise.
 std::optional<client::leka::LogFormat> log_format_for(const std::string& path);

@@ -1,18 +1,16 @@
 #include "apps/logi-client/batch.hpp"
 
 #include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
 
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
-#include <iterator>
 #include <memory>
-#include <sstream>
+#include <string_view>
 
+#include "apps/common/log_file.hpp"
+#include "client/common/operator_text.hpp"
 #include "client/logi/session.hpp"
 #include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
@@ -27,20 +25,12 @@ using logi::ConnectionState;
 
 LoadedScript load_script_file(const std::string& path) {
   LoadedScript loaded;
-  std::string text;
-  std::string name = path;
-  if (path == "-") {
-    name = "<stdin>";
-    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-  } else {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      loaded.error = path + ": cannot read the script";
-      return loaded;
-    }
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  const auto text = read_script_text(path, std::cin);
+  if (!text) {
+    loaded.error = path + ": cannot read the script";
+    return loaded;
   }
-  auto script = logi::parse_operator_script(text, name);
+  auto script = logi::parse_operator_script(*text, path == "-" ? "<stdin>" : path);
   if (!script.ok()) {
     loaded.error = script.error->to_string();
     return loaded;
@@ -66,9 +56,8 @@ LoadedScript load_script_arguments(const std::vector<std::string>& actions) {
       return loaded;
     }
     if (!parsed.action) continue;  // an empty or comment-only argument
-    std::string text = actions[i].substr(0, actions[i].find('#'));
-    text.erase(0, text.find_first_not_of(" \t\r"));
-    text.erase(text.find_last_not_of(" \t\r") + 1);
+    const std::string text(
+        client::trim(std::string_view(actions[i]).substr(0, actions[i].find('#')), " \t\r"));
     loaded.steps.push_back(logi::OperatorStep{number, text, *parsed.action});
   }
   return loaded;
@@ -76,42 +65,21 @@ LoadedScript load_script_arguments(const std::vector<std::string>& actions) {
 
 // ---- log ----
 
-namespace {
-std::string extension_of(const std::string& path) {
-  return std::filesystem::path(path).extension().string();
-}
-}  // namespace
-
 std::optional<std::string> check_log_path(const std::string& path) {
-  const auto ext = extension_of(path);
-  if (ext == ".txt" || ext == ".csv" || ext == ".ndjson") return std::nullopt;
+  if (has_log_extension(path)) return std::nullopt;
   return "--log " + path + ": the format comes from the extension: .txt, .csv or .ndjson";
 }
 
 bool write_log(const logi::CommLog& log, const std::string& path, std::string& error) {
-  const auto ext = extension_of(path);
-  std::string text;
-  if (ext == ".csv") {
-    text = log.export_csv();
-  } else if (ext == ".ndjson") {
-    text = log.export_ndjson();
-  } else {
-    text = log.export_text();
-  }
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out || !out.write(text.data(), static_cast<std::streamsize>(text.size())) || !out.flush()) {
-    error = "cannot write the log to " + path;
-    return false;
-  }
-  return true;
+  if (save_log(log, path)) return true;
+  error = "cannot write the log to " + path;
+  return false;
 }
 
 // ---- reporting ----
 
 std::string stamp(logi::Time at) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "[%7.3f s]", std::chrono::duration<double>(at).count());
-  return buf;
+  return "[" + seconds_stamp(at, 7) + "]";
 }
 
 std::string BatchReporter::result_line(const logi::ActionResult& result) {
@@ -209,7 +177,7 @@ class BatchRun {
  public:
   BatchRun(const BatchOptions& options, std::vector<logi::OperatorStep> steps, std::ostream& out,
            std::ostream& err)
-      : options_(options), out_(out), err_(err), signals_(io_, SIGINT, SIGTERM) {
+      : options_(options), out_(out), err_(err), signals_(io_) {
     logi::ClientConfig config;
     config.keepalive = options.keepalive;
     session_ = std::make_unique<logi::LogiSession>(
@@ -231,7 +199,7 @@ class BatchRun {
   }
 
   int run() {
-    signals_.async_wait([this](const std::error_code& ec, int signal) { on_signal(ec, signal); });
+    signals_.on_next([this](int signal) { on_signal(signal); });
     runner_->start();
     io_.run();
     if (!options_.log_path.empty()) {
@@ -252,8 +220,7 @@ class BatchRun {
     if (runner_) runner_->on_event(now, e);
   }
 
-  void on_signal(const std::error_code& ec, int signal) {
-    if (ec) return;
+  void on_signal(int signal) {
     if (stopping_) {
       // A second Ctrl-C: out now, without waiting for the car.
       print(stamp(executor_.now()) + " interrupted again: leaving at once");
@@ -263,7 +230,7 @@ class BatchRun {
     }
     print(stamp(executor_.now()) + " interrupted (" + (signal == SIGTERM ? "SIGTERM" : "SIGINT") +
           "): stopping");
-    signals_.async_wait([this](const std::error_code& e, int s) { on_signal(e, s); });
+    signals_.on_next([this](int s) { on_signal(s); });
     runner_->cancel();
     shut_down(kExitInterrupted, true);
   }
@@ -318,7 +285,7 @@ class BatchRun {
   asio::io_context io_;
   link::AsioExecutor executor_{io_};
   link::TransportContext context_{executor_, &io_};
-  asio::signal_set signals_;
+  StopSignals signals_;
   std::unique_ptr<logi::LogiSession> session_;
   std::unique_ptr<logi::OperatorRunner> runner_;
   BatchReporter reporter_;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "client/logi/core.hpp"
 #include "client/logi/operator.hpp"
 
@@ -24,11 +25,11 @@ struct BatchOptions {
   logi::OperatorRunnerOptions runner;
 };
 
-/// Exit statuses of logi-client.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitActionFailed = 1;
-inline constexpr int kExitUsage = 2;
-inline constexpr int kExitInterrupted = 130;
+/// Exit statuses of logi-client (a failed action is kExitActionFailed).
+using apps::kExitInterrupted;
+using apps::kExitOk;
+using apps::kExitUsage;
+inline constexpr int kExitActionFailed = kExitFailed;
 
 /// The actions of a script file ("-": standard input) or of command-line
 /// arguments (one action each; errors name them "<command line>:N:col").

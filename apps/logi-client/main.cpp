@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "apps/logi-client/batch.hpp"
 #include "apps/logi-client/tui.hpp"
 #include "client/logi/operator.hpp"
@@ -26,10 +27,11 @@ int main(int argc, char** argv) {
   app.add_option("--port", options.port, "The car's TCP port (default 9000)");
   app.add_flag("--keepalive", options.keepalive,
                "Repeat the held direction's MV every 300 ms while it is held");
-  app.add_option("--log", options.log_path,
-                 "Write the communication log at exit (batch mode); format by extension: .txt, "
-                 ".csv, .ndjson");
-  app.add_option("--script", script, "Run the actions of this file, one per line ('-': stdin)");
+  hil::apps::add_log_and_script_options(
+      app, options.log_path,
+      "Write the communication log at exit (batch mode); format by extension: .txt, .csv, "
+      ".ndjson",
+      script, "Run the actions of this file, one per line ('-': stdin)");
   app.add_flag("--continue-on-error", continue_on_error,
                "Run every action even after one failed (the exit status is still 1)");
   app.add_option("--connect-timeout", connect_timeout,
@@ -46,11 +48,7 @@ int main(int argc, char** argv) {
       "  logi-client --port 9000 connect \"speed 50\" \"mode MAN\" \"press FWD\" \"wait 1s\" "
       "release\n"
       "  logi-client --script scenarios/clients/logi-client/manual-drive.txt --log run.csv");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? lc::kExitOk : lc::kExitUsage;
-  }
+  if (const auto exit_code = hil::apps::parse_command_line(app, argc, argv)) return *exit_code;
 
   const auto timeout = hil::client::logi::parse_duration(connect_timeout);
   if (!timeout) {

@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 
+#include "apps/common/log_file.hpp"
 #include "apps/logi-client/tui_model.hpp"
 #include "apps/logi-client/tui_view.hpp"
 #include "client/logi/session.hpp"
@@ -94,13 +95,8 @@ class LiveSession final : public SessionControl {
                       : format == LogFormat::csv ? "csv"
                                                  : "ndjson";
     const std::string path = log_dir_ + "/logi-client-log-" + stamp + "." + ext;
-    std::ofstream out(path, std::ios::binary);
-    if (out) {
-      out << (format == LogFormat::text  ? log_->export_text()
-              : format == LogFormat::csv ? log_->export_csv()
-                                         : log_->export_ndjson());
-    }
-    if (!out) return "could not write " + path + ": " + std::strerror(errno);
+    if (!write_text_file(path, export_log(*log_, log_format_of(path))))
+      return "could not write " + path + ": " + std::strerror(errno);
     return "log saved to " + path + " (" + std::to_string(log_->total()) + " entries)";
   }
 

@@ -1,21 +1,13 @@
 #include "apps/wr8-client/app.hpp"
 
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <array>
 #include <asio/io_context.hpp>
-#include <asio/posix/stream_descriptor.hpp>
 #include <asio/post.hpp>
-#include <asio/signal_set.hpp>
-#include <cerrno>
-#include <csignal>
-#include <fstream>
 #include <iostream>
-#include <memory>
-#include <sstream>
 
+#include "apps/common/stdin_lines.hpp"
 #include "apps/wr8-client/console.hpp"
 #include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
@@ -31,9 +23,9 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
   app.add_option("--host", o.host, "The vehicle's address (default 127.0.0.1)");
   app.add_option("--port", o.port, "The vehicle's TCP port (default 9100)");
   app.add_option("--auth", o.auth, "The 10-character authentication string (default HIL-WR8-01)");
-  app.add_option("--log", o.log_path,
-                 "Write the communication log here at exit: .txt, .csv or .ndjson");
-  app.add_option("--script", o.script, "Run the actions of this file, one per line");
+  add_log_and_script_options(app, o.log_path,
+                             "Write the communication log here at exit: .txt, .csv or .ndjson",
+                             o.script, "Run the actions of this file, one per line");
   app.add_flag("--data", o.data,
                "Batch: print DATA as it arrives (on a change of state, else once a second)");
   app.add_flag("--keep-going", o.keep_going,
@@ -54,26 +46,16 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
       "  wr8-client connect \"drive 30\" \"turn 10\" get-settings\n"
       "  wr8-client --port 9101 --script scenarios/clients/wr8-client/drive-and-turn.wr8\n"
       "  wr8-client --log session.csv          # interactive\n");
-  ParsedArguments out;
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    out.exit_code = app.exit(e) == 0 ? kExitOk : kExitUsage;
-    return out;
-  }
-  if (!o.script.empty() && !o.actions.empty()) {
-    std::cerr << "wr8-client: give either --script or actions, not both\n";
-    out.exit_code = kExitUsage;
-    return out;
-  }
-  if (!o.auth.empty() && o.auth.size() != wr8::proto::kAuthTextBytes) {
-    std::cerr << "wr8-client: --auth must be exactly " << wr8::proto::kAuthTextBytes
-              << " characters, got " << o.auth.size() << " (\"" << o.auth << "\")\n";
-    out.exit_code = kExitUsage;
-    return out;
-  }
-  out.options = std::move(o);
-  return out;
+  return parse_options<AppOptions>(
+      app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
+        if (!given.script.empty() && !given.actions.empty())
+          return "wr8-client: give either --script or actions, not both";
+        if (!given.auth.empty() && given.auth.size() != wr8::proto::kAuthTextBytes)
+          return "wr8-client: --auth must be exactly " +
+                 std::to_string(wr8::proto::kAuthTextBytes) + " characters, got " +
+                 std::to_string(given.auth.size()) + " (\"" + given.auth + "\")";
+        return std::nullopt;
+      });
 }
 
 wr8::ClientConfig client_config(const AppOptions& options) {
@@ -88,14 +70,12 @@ std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& 
                                                               std::ostream& errors) {
   std::vector<wr8::OperatorAction> actions;
   if (!options.script.empty()) {
-    std::ifstream file(options.script, std::ios::binary);
-    if (!file) {
+    const auto text = read_script_text(options.script, std::cin);
+    if (!text) {
       errors << options.script << ": cannot open the script\n";
       return std::nullopt;
     }
-    std::stringstream text;
-    text << file.rdbuf();
-    const auto script = wr8::parse_operator_script(text.str(), options.script, profile);
+    const auto script = wr8::parse_operator_script(*text, options.script, profile);
     for (const auto& e : script.errors)
       errors << e.to_string() << '\n';
     if (!script.errors.empty()) return std::nullopt;
@@ -117,73 +97,6 @@ std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& 
   if (!ok) return std::nullopt;
   return actions;
 }
-
-namespace {
-
-/// Reads stdin line by line without blocking the io_context: through the
-/// reactor for a pipe, socket or terminal, at once for a file.
-class StdinReader {
- public:
-  StdinReader(asio::io_context& io, Wr8Console& console) : io_(io), console_(console) {}
-
-  void start() {
-    struct stat st {};
-    const bool pollable = ::fstat(STDIN_FILENO, &st) == 0 &&
-                          (S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode) || ::isatty(STDIN_FILENO));
-    if (!pollable) {
-      // A regular file or /dev/null cannot be waited on; it never blocks.
-      asio::post(io_, [this] { read_all(); });
-      return;
-    }
-    input_ = std::make_unique<asio::posix::stream_descriptor>(io_, ::dup(STDIN_FILENO));
-    read_some();
-  }
-
- private:
-  void read_all() {
-    std::array<char, 4096> buf{};
-    for (;;) {
-      const ssize_t n = ::read(STDIN_FILENO, buf.data(), buf.size());
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      take(std::string_view(buf.data(), static_cast<std::size_t>(n)));
-    }
-    ended();
-  }
-
-  void read_some() {
-    input_->async_read_some(asio::buffer(buf_), [this](std::error_code ec, std::size_t n) {
-      if (n > 0) take(std::string_view(buf_.data(), n));
-      if (ec) {
-        ended();
-        return;
-      }
-      if (!console_.exited()) read_some();
-    });
-  }
-
-  void take(std::string_view bytes) {
-    partial_.append(bytes);
-    for (std::size_t nl = partial_.find('\n'); nl != std::string::npos; nl = partial_.find('\n')) {
-      std::string line = partial_.substr(0, nl);
-      partial_.erase(0, nl + 1);
-      console_.line(std::move(line));
-    }
-  }
-
-  void ended() {
-    if (!partial_.empty()) console_.line(std::exchange(partial_, {}));
-    console_.end_of_input();
-  }
-
-  asio::io_context& io_;
-  Wr8Console& console_;
-  std::unique_ptr<asio::posix::stream_descriptor> input_;
-  std::array<char, 4096> buf_{};
-  std::string partial_;
-};
-
-}  // namespace
 
 int run(const AppOptions& options) {
   const wr8::ClientConfig config = client_config(options);
@@ -232,12 +145,16 @@ int run(const AppOptions& options) {
   });
   console_ptr = &console;
 
-  asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](std::error_code ec, int) {
-    if (!ec) console.interrupt();
-  });
+  StopSignals signals(io);
+  signals.on_next([&](int) { console.interrupt(); });
 
-  StdinReader reader(io, console);
+  StdinLines reader(io, {.line = [&](std::string line) { console.line(std::move(line)); },
+                         .end =
+                             [&](std::string rest) {
+                               if (!rest.empty()) console.line(std::move(rest));
+                               console.end_of_input();
+                             },
+                         .more = [&] { return !console.exited(); }});
   if (interactive) {
     std::cout << "wr8-client: vehicle at " << options.host << ":" << options.port
               << "; type 'help' for the commands, 'connect' to log in\n"

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "client/wr8/operator.hpp"
 
 namespace hil::apps::wr8_client {
@@ -23,10 +24,8 @@ struct AppOptions {
   std::vector<std::string> actions;  ///< one action per argument
 };
 
-struct ParsedArguments {
-  std::optional<AppOptions> options;  ///< nullopt: exit with `exit_code`
-  int exit_code = 0;
-};
+/// The options, or nullopt: exit with `exit_code`.
+using ParsedArguments = apps::ParsedArguments<AppOptions>;
 
 /// Reads the command line; prints help or usage errors itself.
 ParsedArguments parse_arguments(int argc, const char* const* argv);

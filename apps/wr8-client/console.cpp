@@ -1,26 +1,16 @@
 #include "apps/wr8-client/console.hpp"
 
-#include <cctype>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <utility>
+
+#include "apps/common/log_file.hpp"
+#include "client/common/operator_text.hpp"
 
 namespace hil::apps::wr8_client {
 
 namespace {
 
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
-
-bool ends_with(const std::string& s, std::string_view suffix) {
-  return s.size() >= suffix.size() &&
-         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
+using client::Overloaded;
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -40,14 +30,8 @@ std::string spaced(std::string_view s) {
   return out;
 }
 
-std::string trim(const std::string& s) {
-  std::size_t b = 0;
-  std::size_t e = s.size();
-  while (b < e && std::isspace(static_cast<unsigned char>(s[b])))
-    ++b;
-  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1])))
-    --e;
-  return s.substr(b, e - b);
+std::string trim(std::string_view s) {
+  return std::string(client::trim(s));
 }
 
 constexpr std::string_view kHelp =
@@ -70,27 +54,6 @@ constexpr std::string_view kHelp =
     "  quit                    disconnect and leave (end of input does the same)\n";
 
 }  // namespace
-
-std::string export_log(const wr8::CommLog& log, const std::string& path) {
-  if (ends_with(path, ".csv")) return log.export_csv();
-  if (ends_with(path, ".ndjson") || ends_with(path, ".jsonl")) return log.export_ndjson();
-  return log.export_text();
-}
-
-bool save_log(const wr8::CommLog& log, const std::string& path, std::string& error) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) {
-    error = "cannot write " + path;
-    return false;
-  }
-  file << export_log(log, path);
-  file.close();
-  if (!file) {
-    error = "cannot write " + path;
-    return false;
-  }
-  return true;
-}
 
 std::string format_live(const wr8::LiveState& live) {
   return std::string(wr8::proto::to_string(live.state)) + "  odometry " +
@@ -126,9 +89,7 @@ Wr8Console::Wr8Console(link::Executor& executor, wr8::Wr8Session& session,
       exit_(std::move(exit)) {}
 
 std::string Wr8Console::stamp(link::Time t) const {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%8.3f s", link::to_ms(t) / 1000.0);
-  return buf;
+  return seconds_stamp(t, 8);
 }
 
 void Wr8Console::print(const std::string& text) {
@@ -296,11 +257,10 @@ bool Wr8Console::builtin(const std::string& raw) {
       print("error: save-log needs a path (.txt, .csv or .ndjson)");
       return true;
     }
-    std::string error;
-    if (save_log(*core.log(), rest, error))
+    if (save_log(*core.log(), rest))
       print("saved " + std::to_string(core.log()->snapshot().size()) + " log entries to " + rest);
     else
-      print("error: " + error);
+      print("error: cannot write " + rest);
   } else if (word == "help" || word == "?") {
     std::string s(kHelp);
     s.pop_back();
@@ -317,10 +277,8 @@ void Wr8Console::exit(int code) {
   if (exited_) return;
   exited_ = true;
   if (session_.core().state() != wr8::ConnectionState::disconnected) session_.disconnect();
-  if (!options_.log_path.empty()) {
-    std::string error;
-    if (!save_log(*session_.core().log(), options_.log_path, error)) print("error: " + error);
-  }
+  if (!options_.log_path.empty() && !save_log(*session_.core().log(), options_.log_path))
+    print("error: cannot write " + options_.log_path);
   if (exit_) exit_(code);
 }
 

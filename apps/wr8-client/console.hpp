@@ -11,16 +11,17 @@
 #include <string>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "client/wr8/operator.hpp"
 
 namespace hil::apps::wr8_client {
 
 namespace wr8 = client::wr8;
 
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailed = 1;
-inline constexpr int kExitUsage = 2;
-inline constexpr int kExitInterrupted = 130;
+using apps::kExitFailed;
+using apps::kExitInterrupted;
+using apps::kExitOk;
+using apps::kExitUsage;
 
 struct ConsoleOptions {
   bool interactive = false;
@@ -28,11 +29,6 @@ struct ConsoleOptions {
   bool print_data = false;  ///< batch: print DATA (on change, else once a second)
   std::string log_path;     ///< written at exit when not empty
 };
-
-/// The log written as `path`'s extension asks: .csv, .ndjson (or .jsonl), else text.
-std::string export_log(const wr8::CommLog& log, const std::string& path);
-/// Writes the log to `path`; false with `error` set when it cannot.
-bool save_log(const wr8::CommLog& log, const std::string& path, std::string& error);
 
 /// The live state as the `state` command prints it (several lines).
 std::string format_state(const wr8::Wr8ClientCore& core, link::Time now);

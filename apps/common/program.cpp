@@ -1,0 +1,72 @@
+#include "apps/common/program.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <istream>
+#include <iterator>
+
+namespace hil::apps {
+
+std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return std::nullopt;
+}
+
+CLI::Option* add_serial_options(CLI::App& app, std::string& port, unsigned& baud,
+                                const std::string& port_help, const std::string& baud_help) {
+  CLI::Option* port_option = app.add_option("-p,--port", port, port_help);
+  app.add_option("--baud", baud, baud_help)->check(CLI::Range(0u, 4000000u));
+  return port_option;
+}
+
+void add_log_and_script_options(CLI::App& app, std::string& log_path, const std::string& log_help,
+                                std::string& script, const std::string& script_help) {
+  app.add_option("--log", log_path, log_help);
+  app.add_option("--script", script, script_help);
+}
+
+link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
+  if (port.find("://") != std::string::npos) {
+    link::Endpoint e = link::parse_endpoint(port);
+    if (auto* pty = std::get_if<link::PtyEndpoint>(&e); pty && pty->baud == 0) pty->baud = baud;
+    return e;
+  }
+  if (port.empty()) throw link::EndpointError("--port needs a device path");
+  return link::PtyEndpoint{port, baud, link::Duration{0}};
+}
+
+std::optional<std::string> read_script_text(const std::string& path, std::istream& standard_input) {
+  if (path == "-") {
+    return std::string(std::istreambuf_iterator<char>(standard_input),
+                       std::istreambuf_iterator<char>());
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string seconds_stamp(link::Time at, int width) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%*.3f s", width, std::chrono::duration<double>(at).count());
+  return buf;
+}
+
+void StopSignals::on_next(std::function<void(int)> handler) {
+  signals_.async_wait([handler = std::move(handler)](const std::error_code& ec, int signal) {
+    if (!ec) handler(signal);
+  });
+}
+
+void StopSignals::cancel() {
+  std::error_code ignored;
+  signals_.cancel(ignored);
+}
+
+}  // namespace hil::apps
