@@ -15,68 +15,41 @@
 #include <vector>
 
 #include "apps/arduino-client/app.hpp"
-#include "tests/apps/hil_cli_support.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace hil::test {
 namespace {
 
 using namespace std::chrono_literals;
 
-std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 /// A temp dir with the mock robot on a pty in it.
 struct ArduinoClientCli : ::testing::Test {
-  void SetUp() override {
-    dir = std::filesystem::temp_directory_path() /
-          ("hil-arduino-client-" + std::to_string(::getpid()) + "-" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir);
-    port = (dir / "robot0").string();
-  }
   void TearDown() override {
     if (mock) {
-      EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+      EXPECT_EQ(mock->stop(), 0) << mock->output();
     }
-    std::filesystem::remove_all(dir);
   }
 
   void start_mock(std::vector<std::string> extra = {}) {
-    std::vector<std::string> args{"mock", "arduino", "--pty", port};
-    args.insert(args.end(), extra.begin(), extra.end());
-    mock.emplace(args);
-    ASSERT_TRUE(mock->wait_for_line("as a serial port at 9600 baud")) << mock->output();
+    mock.emplace(mock_on_pty_args("arduino", port, std::move(extra)),
+                 "as a serial port at 9600 baud");
+    ASSERT_TRUE(mock->ready()) << mock->output();
   }
 
   std::filesystem::path write(const std::string& name, const std::string& text) {
-    const auto path = dir / name;
-    std::ofstream(path) << text;
-    return path;
+    return temp.write(name, text);
   }
 
   /// Runs arduino-client with `args` (after --port) to its exit.
   CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 30s) {
     args.insert(args.begin(), {"--port", port});
-    HilProcess process(ARDUINO_CLIENT_BINARY, args);
-    process.close_stdin();
-    CommandResult result;
-    const auto code = process.wait_exit(limit);
-    result.exit_code = code.value_or(-1);
-    result.output = process.output();
-    return result;
+    return run_to_exit(ARDUINO_CLIENT_BINARY, args, limit);
   }
 
-  std::filesystem::path dir;
-  std::string port;
-  std::optional<HilProcess> mock;
+  TempDir temp{"hil-arduino-client"};
+  std::filesystem::path dir = temp.path();
+  std::string port = temp.file("robot0");
+  std::optional<MockCar> mock;
 };
 
 TEST_F(ArduinoClientCli, RawTokensRunOnceEachAndTheStatusShowsTheSpeedSet) {
@@ -182,7 +155,7 @@ TEST_F(ArduinoClientCli, ANackedCommandExits1WithItsCodeAndStopsTheRun) {
   EXPECT_TRUE(contains(r.output, "V 160 -> NACK BUSY\n")) << r.output;
   EXPECT_FALSE(contains(r.output, "STATUS ->")) << "the run stops at the failure: " << r.output;
   // --keep-going runs the rest and still exits 1.
-  EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+  EXPECT_EQ(mock->stop(), 0) << mock->output();
   mock.reset();
   start_mock({"--behaviours", behaviours.string()});
   const auto all = client({"--keep-going", "V 160", "STATUS"});

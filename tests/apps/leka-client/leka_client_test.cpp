@@ -11,44 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "tests/apps/hil_cli_support.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace {
 
-using hil::test::HilProcess;
+using namespace hil::test;
 
-struct TempDir {
-  TempDir() {
-    static int counter = 0;
-    path = std::filesystem::temp_directory_path() /
-           ("hil-leka-client-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-  std::filesystem::path path;
-};
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// The "delivered to the car" records of the mock's wire log.
-std::vector<std::string> delivered_to_car(const std::string& wire_log) {
-  std::vector<std::string> out;
-  std::istringstream in(read_file(wire_log));
-  std::string line;
-  while (std::getline(in, line))
-    if (line.find("\"event\":\"delivered\"") != std::string::npos &&
-        line.find("\"dir\":\"to_car\"") != std::string::npos)
-      out.push_back(line);
-  return out;
+// The "delivered to the car" records of the mock's wire log file.
+std::vector<std::string> delivered_to_car_of(const std::string& wire_log) {
+  return delivered_to_car(read_file(wire_log));
 }
 
 bool any_contains(const std::vector<std::string>& lines, const std::string& text) {
@@ -60,22 +31,27 @@ bool any_contains(const std::vector<std::string>& lines, const std::string& text
 // `hil mock leka` on a pty in `dir`, its wire log beside it.
 struct MockLeka {
   explicit MockLeka(const TempDir& dir, std::vector<std::string> extra = {})
-      : device(dir.file("leka0")), wire_log(dir.file("wire.ndjson")) {
-    std::vector<std::string> args{"mock", "leka", "--pty", device, "--log", wire_log};
-    args.insert(args.end(), extra.begin(), extra.end());
-    process = std::make_unique<HilProcess>(args);
-    ready = process->wait_for_line("as a serial port at 115200 baud").has_value();
+      : device(dir.file("leka0")),
+        wire_log(dir.file("wire.ndjson")),
+        car(mock_on_pty_args("leka", device, with_log(wire_log, std::move(extra))),
+            "as a serial port at 115200 baud"),
+        process(&car.process()),
+        ready(car.ready()) {}
+  static std::vector<std::string> with_log(const std::string& log, std::vector<std::string> extra) {
+    extra.insert(extra.begin(), {"--log", log});
+    return extra;
   }
   std::string device;
   std::string wire_log;
-  std::unique_ptr<HilProcess> process;
+  MockCar car;
+  HilProcess* process;
   bool ready = false;
 };
 
 const std::string kInfoTimeout = "--info-timeout-ms=5000";  // a loaded machine cannot miss it
 
 TEST(LekaClientBatch, GroupsSetLedsAndMotorsAndTheInfoIsPrinted) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   MockLeka mock(dir);
   ASSERT_TRUE(mock.ready) << mock.process->output();
   HilProcess client(LEKA_CLIENT_BINARY,
@@ -92,7 +68,7 @@ TEST(LekaClientBatch, GroupsSetLedsAndMotorsAndTheInfoIsPrinted) {
             std::string::npos)
       << client.output();
   // What the robot received: the group whole, then the info.
-  const auto received = delivered_to_car(mock.wire_log);
+  const auto received = delivered_to_car_of(mock.wire_log);
   EXPECT_TRUE(any_contains(received,
                            "2A 2B 2C 2D 0F 11 FF 00 00 14 00 09 00 00 FF 22 01 C8 00 "
                            "C8 40"))
@@ -103,11 +79,11 @@ TEST(LekaClientBatch, GroupsSetLedsAndMotorsAndTheInfoIsPrinted) {
   const std::string log = read_file(dir.file("run.csv"));
   EXPECT_EQ(log.rfind("utc_us,direction,note,hex\n", 0), 0u) << log;
   EXPECT_NE(log.find(",RX,LEKA name=leka"), std::string::npos) << log;
-  EXPECT_EQ(mock.process->interrupt(), 0);
+  EXPECT_EQ(mock.car.stop(), 0);
 }
 
 TEST(LekaClientBatch, TheExampleShowScriptRunsAgainstTheMock) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   MockLeka mock(dir);
   ASSERT_TRUE(mock.ready) << mock.process->output();
   HilProcess client(LEKA_CLIENT_BINARY, {"--port", "pty://" + mock.device, kInfoTimeout, "--script",
@@ -119,14 +95,14 @@ TEST(LekaClientBatch, TheExampleShowScriptRunsAgainstTheMock) {
             std::string::npos)
       << out;
   EXPECT_NE(out.find("show.leka:12: ok"), std::string::npos) << out;
-  const auto received = delivered_to_car(mock.wire_log);
+  const auto received = delivered_to_car_of(mock.wire_log);
   EXPECT_TRUE(any_contains(received, "stop.robot + led.belt.single led=0 rgb=(255,255,255)"))
       << read_file(mock.wire_log);
-  EXPECT_EQ(mock.process->interrupt(), 0);
+  EXPECT_EQ(mock.car.stop(), 0);
 }
 
 TEST(LekaClientBatch, TheInfoReportsTheRobotsFaultState) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   MockLeka mock(dir, {"--commands"});
   ASSERT_TRUE(mock.ready) << mock.process->output();
   ASSERT_TRUE(mock.process->wait_for_line("type 'help' for desk commands"));
@@ -135,11 +111,11 @@ TEST(LekaClientBatch, TheInfoReportsTheRobotsFaultState) {
   HilProcess client(LEKA_CLIENT_BINARY, {"--port", mock.device, kInfoTimeout, "info"});
   ASSERT_EQ(client.wait_exit(std::chrono::seconds(20)), 0) << client.output();
   EXPECT_NE(client.output().find("state=fault"), std::string::npos) << client.output();
-  EXPECT_EQ(mock.process->interrupt(), 0);
+  EXPECT_EQ(mock.car.stop(), 0);
 }
 
 TEST(LekaClientBatch, ScriptFromStdinAndAnInterruptSendsStopRobot) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   MockLeka mock(dir);
   ASSERT_TRUE(mock.ready) << mock.process->output();
   HilProcess client(LEKA_CLIENT_BINARY, {"--port", mock.device, kInfoTimeout, "--script", "-"});
@@ -152,12 +128,12 @@ TEST(LekaClientBatch, ScriptFromStdinAndAnInterruptSendsStopRobot) {
   // The robot got the stop (it is written before the port closes).
   bool stopped = false;
   for (int i = 0; i < 100 && !stopped; ++i) {
-    stopped = any_contains(delivered_to_car(mock.wire_log), "2A 2B 2C 2D 01 FF FF");
+    stopped = any_contains(delivered_to_car_of(mock.wire_log), "2A 2B 2C 2D 01 FF FF");
     if (!stopped) ::usleep(100'000);
   }
   EXPECT_TRUE(stopped) << read_file(mock.wire_log);
-  EXPECT_FALSE(any_contains(delivered_to_car(mock.wire_log), "2A 2B 2C 2D 03 21 00 0A"));
-  EXPECT_EQ(mock.process->interrupt(), 0);
+  EXPECT_FALSE(any_contains(delivered_to_car_of(mock.wire_log), "2A 2B 2C 2D 03 21 00 0A"));
+  EXPECT_EQ(mock.car.stop(), 0);
 }
 
 TEST(LekaClientBatch, DryRunPrintsTheSeedsExampleFramesByteForByte) {
@@ -186,7 +162,7 @@ TEST(LekaClientBatch, DryRunWithDefaultFramesSplitsTheBigGroup) {
 }
 
 TEST(LekaClientBatch, ARangeErrorInAScriptIsExit2WithFileLineColumn) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   const std::string script = dir.file("bad.leka");
   std::ofstream(script) << "# lights\near all 255 0 0\nbelt single 20 0 0 255\n";
   // Nothing is opened: the script is checked first.
@@ -198,7 +174,7 @@ TEST(LekaClientBatch, ARangeErrorInAScriptIsExit2WithFileLineColumn) {
 }
 
 TEST(LekaClientBatch, AMissingDeviceIsAClearErrorAndExit1) {
-  TempDir dir;
+  TempDir dir("hil-leka-client");
   HilProcess client(LEKA_CLIENT_BINARY, {"--port", dir.file("no-robot"), "info"});
   ASSERT_EQ(client.wait_exit(), 1) << client.output();
   EXPECT_NE(

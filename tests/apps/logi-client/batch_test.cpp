@@ -2,11 +2,6 @@
 // real TCP, reading its output, its exit status and the communication log
 // it writes. Every wait is bounded.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -18,7 +13,7 @@
 #include <vector>
 
 #include "apps/logi-client/batch.hpp"
-#include "tests/apps/hil_cli_support.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace hil::test {
 namespace {
@@ -26,49 +21,21 @@ namespace {
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-/// `hil mock logi` on a free port.
-class MockCar {
- public:
-  explicit MockCar(std::vector<std::string> extra = {}) : process_(args(std::move(extra))) {
-    const auto line = process_.wait_for_line("connect to tcp://", 15s);
-    if (!line) return;
-    std::smatch m;
-    if (std::regex_search(*line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) port_ = m[1];
+/// `hil mock logi` on a free port (the same car every run).
+struct MockLogi : MockCar {
+  explicit MockLogi(std::vector<std::string> extra = {})
+      : MockCar(mock_on_tcp_args("logi", with_seed(std::move(extra))), kTcpReady) {}
+  static std::vector<std::string> with_seed(std::vector<std::string> extra) {
+    extra.insert(extra.begin(), {"--seed", "1"});
+    return extra;
   }
-  ~MockCar() { process_.interrupt(); }
-  const std::string& port() const { return port_; }
-  HilProcess& process() { return process_; }
-
- private:
-  static std::vector<std::string> args(std::vector<std::string> extra) {
-    std::vector<std::string> a{"mock", "logi", "--port", "0", "--seed", "1"};
-    a.insert(a.end(), extra.begin(), extra.end());
-    return a;
-  }
-  HilProcess process_;
-  std::string port_;
 };
 
-/// A fresh directory for one test's files.
-fs::path temp_dir(const std::string& name) {
-  const auto dir =
-      fs::temp_directory_path() / ("logi-client-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 TEST(LogiClientBatch, TheManualDriveScriptDrivesTheMockCarAndExits0) {
-  MockCar car;
+  MockLogi car;
   ASSERT_FALSE(car.port().empty()) << car.process().output();
-  const auto dir = temp_dir("manual");
+  const TempDir temp("logi-client-manual");
+  const auto& dir = temp.path();
   const auto log = dir / "run.txt";
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--log", log.string(), "--script",
                                          "scenarios/clients/logi-client/manual-drive.txt"});
@@ -90,11 +57,10 @@ TEST(LogiClientBatch, TheManualDriveScriptDrivesTheMockCarAndExits0) {
   EXPECT_NE(text.find("RX   LOGI:FB:MV:1:"), std::string::npos) << text;
   EXPECT_TRUE(std::regex_search(text, std::regex("RX   LOGI:STAT:[^ ]*MAN:FWD"))) << text;
   EXPECT_TRUE(std::regex_search(text, std::regex("RX   LOGI:STAT:[^ ]*MAN:CW"))) << text;
-  fs::remove_all(dir);
 }
 
 TEST(LogiClientBatch, AMoveTheCarRefusesExits1WithTheReasonAndRunsNothingAfterIt) {
-  MockCar car({"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml"});
+  MockLogi car({"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml"});
   ASSERT_FALSE(car.port().empty()) << car.process().output();
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "connect", "speed 50", "mode MAN",
                                          "press FWD", "wait 1s", "release"});
@@ -109,7 +75,7 @@ TEST(LogiClientBatch, AMoveTheCarRefusesExits1WithTheReasonAndRunsNothingAfterIt
 }
 
 TEST(LogiClientBatch, ContinueOnErrorRunsEveryActionAndStillExits1) {
-  MockCar car;
+  MockLogi car;
   ASSERT_FALSE(car.port().empty()) << car.process().output();
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--continue-on-error", "connect",
                                          "station 7", "speed 30", "disconnect"});
@@ -124,7 +90,8 @@ TEST(LogiClientBatch, ContinueOnErrorRunsEveryActionAndStillExits1) {
 }
 
 TEST(LogiClientBatch, AScriptWithATypoExits2NamingFileLineAndColumn) {
-  const auto dir = temp_dir("typo");
+  const TempDir temp("logi-client-typo");
+  const auto& dir = temp.path();
   const auto script = dir / "drive.txt";
   std::ofstream(script) << "# drive\nconnect\nspeed 50\nmode MAN\npress  FORWARD\n";
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", "1", "--script", script.string()});
@@ -151,26 +118,11 @@ TEST(LogiClientBatch, AScriptWithATypoExits2NamingFileLineAndColumn) {
   HilProcess bad_log(LOGI_CLIENT_BINARY, {"--log", "run.xml", "connect"});
   EXPECT_EQ(bad_log.wait_exit(10s), 2) << bad_log.output();
   EXPECT_NE(bad_log.output().find(".txt, .csv or .ndjson"), std::string::npos) << bad_log.output();
-  fs::remove_all(dir);
-}
-
-/// A TCP port nothing listens on (bound, then released).
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  addr.sin_port = 0;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  ::close(fd);
-  return ntohs(addr.sin_port);
 }
 
 TEST(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", std::to_string(free_port()), "--connect-timeout",
-                                         "2s", "connect", "speed 50"});
+  HilProcess client(LOGI_CLIENT_BINARY,
+                    {"--port", free_tcp_port(), "--connect-timeout", "2s", "connect", "speed 50"});
   const auto status = client.wait_exit(20s);
   ASSERT_TRUE(status) << client.output();
   EXPECT_EQ(*status, 1) << client.output();
@@ -182,9 +134,10 @@ TEST(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
 }
 
 TEST(LogiClientBatch, CtrlCDuringAWaitStopsTheCarAndExits130) {
-  MockCar car;
+  MockLogi car;
   ASSERT_FALSE(car.port().empty()) << car.process().output();
-  const auto dir = temp_dir("sigint");
+  const TempDir temp("logi-client-sigint");
+  const auto& dir = temp.path();
   const auto log = dir / "run.ndjson";
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--log", log.string(), "connect",
                                          "speed 50", "mode MAN", "press FWD", "wait 30s"});
@@ -201,11 +154,10 @@ TEST(LogiClientBatch, CtrlCDuringAWaitStopsTheCarAndExits130) {
   const auto stop = text.find(R"("kind":"TX","raw":"LOGI:MV:STOP:88#")");
   ASSERT_NE(stop, std::string::npos) << text;
   EXPECT_NE(text.find(R"("kind":"RX","raw":"LOGI:FB:MV:1:)", stop), std::string::npos) << text;
-  fs::remove_all(dir);
 }
 
 TEST(LogiClientBatch, ActionsCanComeFromStandardInput) {
-  MockCar car;
+  MockLogi car;
   ASSERT_FALSE(car.port().empty()) << car.process().output();
   HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--script", "-"});
   client.write_stdin("connect\nspeed 60\nmode AUTO\nstation 001\nstop\nwait 1200ms\ndisconnect\n");

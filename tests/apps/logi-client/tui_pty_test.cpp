@@ -24,19 +24,14 @@
 #include <string>
 #include <vector>
 
-#include "tests/apps/hil_cli_support.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace {
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using hil::test::read_file;
 
 /// logi-client on the slave side of a pty; the test holds the master.
 class PtyProgram {
@@ -127,23 +122,12 @@ class PtyProgram {
   std::optional<int> exit_code_;
 };
 
-int port_in(const std::string& line) {
-  std::smatch m;
-  if (!std::regex_search(line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) return -1;
-  return std::stoi(m[1]);
-}
-
 /// The client-to-car frames of the mock's NDJSON wire log, in order of arrival.
 std::vector<std::string> frames_received(const std::string& wire_log) {
   std::vector<std::string> frames;
   const std::regex frame(R"(LOGI:(SP|MD|MV|GS|ST):[A-Z0-9]+:[0-9A-F]{2}#)");
-  std::istringstream lines(wire_log);
-  std::string line;
-  while (std::getline(lines, line)) {
-    // What reached the car (after any faults; there are none here).
-    if (line.find(R"("event":"delivered")") == std::string::npos ||
-        line.find(R"("dir":"to_car")") == std::string::npos)
-      continue;
+  // What reached the car (after any faults; there are none here).
+  for (const auto& line : hil::test::delivered_to_car(wire_log)) {
     for (auto it = std::sregex_iterator(line.begin(), line.end(), frame);
          it != std::sregex_iterator(); ++it)
       frames.push_back(it->str());
@@ -151,23 +135,15 @@ std::vector<std::string> frames_received(const std::string& wire_log) {
   return frames;
 }
 
-fs::path make_temp_dir() {
-  std::string pattern = (fs::temp_directory_path() / "logi-tui-XXXXXX").string();
-  const char* dir = ::mkdtemp(pattern.data());
-  return dir != nullptr ? fs::path(dir) : fs::path();
-}
-
 TEST(LogiClientTui, DrivesTheMockCarFromARealTerminal) {
-  const fs::path dir = make_temp_dir();
-  ASSERT_FALSE(dir.empty());
+  const hil::test::TempDir temp("logi-tui");
+  const fs::path& dir = temp.path();
   const fs::path wire = dir / "wire.ndjson";
-  hil::test::HilProcess mock({"mock", "logi", "--port", "0", "--log", wire.string()});
-  const auto line = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << mock.output();
-  const int port = port_in(*line);
-  ASSERT_GT(port, 0) << *line;
+  hil::test::MockCar mock(hil::test::mock_on_tcp_args("logi", {"--log", wire.string()}),
+                          hil::test::kTcpReady);
+  ASSERT_FALSE(mock.port().empty()) << mock.output();
 
-  PtyProgram tui({"--port", std::to_string(port)}, dir, 32, 100);
+  PtyProgram tui({"--port", mock.port()}, dir, 32, 100);
   ASSERT_TRUE(tui.started());
   ASSERT_TRUE(tui.wait_until([&] {
     return tui.screen_output().find("Connected") != std::string::npos;
@@ -231,8 +207,7 @@ TEST(LogiClientTui, DrivesTheMockCarFromARealTerminal) {
     if (entry.path().extension() == ".txt") saved = read_file(entry.path());
   EXPECT_NE(saved.find("TX   LOGI:MV:FWD:23#"), std::string::npos) << saved;
   EXPECT_NE(saved.find("RX   LOGI:FB:MV:1"), std::string::npos) << saved;
-  EXPECT_EQ(mock.interrupt(), 0);
-  fs::remove_all(dir);
+  EXPECT_EQ(mock.stop(), 0);
 }
 
 TEST(LogiClientTui, RefusesToStartWithoutATerminal) {

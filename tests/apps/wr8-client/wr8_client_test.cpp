@@ -3,10 +3,6 @@
 // pipe, scripts (the shipped examples and a typo), nothing listening, and
 // Ctrl-C. Waits are bounded and generous; no upper bound on durations.
 
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,23 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "tests/apps/hil_cli_support.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace hil::test {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 /// The largest `odometry_cm=N` in a log.
 int max_odometry_cm(const std::string& log) {
@@ -46,61 +31,33 @@ int max_odometry_cm(const std::string& log) {
   return best;
 }
 
-/// A TCP port nobody listens on: bound by the kernel's choice, then released.
-std::string unused_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  addr.sin_port = 0;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  socklen_t len = sizeof addr;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-  ::close(fd);
-  return std::to_string(ntohs(addr.sin_port));
-}
-
 /// The mock vehicle on a free port and a temp dir for files.
 struct Wr8ClientCli : ::testing::Test {
-  void SetUp() override {
-    dir = std::filesystem::temp_directory_path() /
-          ("hil-wr8-client-" + std::to_string(::getpid()) + "-" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir);
-  }
   void TearDown() override {
     if (mock) {
-      EXPECT_EQ(mock->interrupt(), 0) << mock->output();
+      EXPECT_EQ(mock->stop(), 0) << mock->output();
     }
-    std::filesystem::remove_all(dir);
   }
 
   void start_mock() {
-    mock.emplace(std::vector<std::string>{"mock", "wr8", "--port", "0"});
-    const auto line = mock->wait_for_line("connect to tcp://");
-    ASSERT_TRUE(line) << mock->output();
-    port = line->substr(line->rfind(':') + 1);
+    mock.emplace(mock_on_tcp_args("wr8"), kTcpReady);
+    ASSERT_TRUE(mock->ready()) << mock->output();
+    port = mock->port();
   }
 
   /// wr8-client with `--port PORT` and `args`; waits for its exit.
   CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 20s) {
     args.insert(args.begin(), {"--port", port});
-    HilProcess p(WR8_CLIENT_BINARY, args);
-    p.close_stdin();
-    CommandResult r;
-    r.exit_code = p.wait_exit(limit).value_or(-1);
-    r.output = p.output();
-    return r;
+    return run_to_exit(WR8_CLIENT_BINARY, args, limit);
   }
 
   std::filesystem::path write(const std::string& name, const std::string& text) {
-    const auto path = dir / name;
-    std::ofstream(path) << text;
-    return path;
+    return temp.write(name, text);
   }
 
-  std::filesystem::path dir;
-  std::optional<HilProcess> mock;
+  TempDir temp{"hil-wr8-client"};
+  std::filesystem::path dir = temp.path();
+  std::optional<MockCar> mock;
   std::string port = "9100";
 };
 
@@ -122,7 +79,7 @@ TEST_F(Wr8ClientCli, ABatchLogsInDrivesTurnsAndReadsTheSettings) {
   const std::string text = read_file(log);
   EXPECT_TRUE(contains(text, "\"kind\":\"TX\"")) << text;
   EXPECT_GE(max_odometry_cm(text), 29) << text;
-  EXPECT_TRUE(mock->wait_for_line("client")) << mock->output();
+  EXPECT_TRUE(mock->process().wait_for_line("client")) << mock->output();
 }
 
 TEST_F(Wr8ClientCli, AWrongLoginStringFailsConnectWithTheReason) {
@@ -208,7 +165,7 @@ TEST_F(Wr8ClientCli, BadUsageExits2) {
 }
 
 TEST_F(Wr8ClientCli, NothingListeningFailsConnectAndExits1) {
-  port = unused_port();
+  port = free_tcp_port();
   const auto r = client({"--connect-timeout", "5", "connect", "drive 10"});
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +FAIL +connect failed"))) << r.output;
