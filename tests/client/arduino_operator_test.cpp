@@ -22,6 +22,7 @@
 #include "mocks/server.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -235,22 +236,17 @@ TEST(ArduinoOperatorDescribe, ResultsReadAsAPersonWouldSayThem) {
 
 // ---- the runner, against the mock robot in virtual time ----
 
-struct ArduinoOperatorRunner : ::testing::Test {
+struct ArduinoOperatorRunner : ::testing::Test, test::VirtualCar<mocks::ArduinoFirmware> {
   /// The robot on mem://arduino; `bytes_per_second` paces both directions.
   void start(std::optional<std::uint64_t> bytes_per_second = std::nullopt,
              OperatorRunner::Options options = {}) {
-    world.emplace(sim::WorldDef{});
-    sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
-    firmware = std::make_unique<mocks::ArduinoFirmware>(*world, vehicle);
-    mocks::ServerOptions server_options;
-    server_options.listen = link::MemEndpoint{"arduino"};
+    mocks::ServerOptions server_options = test::on_mem("arduino");
     if (bytes_per_second) {
       link::FaultRule rule;
       rule.action = link::Bandwidth{*bytes_per_second};
       server_options.faults.rules.push_back(rule);
     }
-    server = std::make_unique<mocks::MockServer>(context, *firmware, std::move(server_options));
-    server->start();
+    start_car(sim::arduino_robot(), std::move(server_options));
     connect("arduino", options);
   }
 
@@ -269,12 +265,8 @@ struct ArduinoOperatorRunner : ::testing::Test {
 
   /// Runs the executor until the runner is idle (or `limit` of virtual time).
   void run_to_idle(Duration limit = seconds(60)) {
-    const Time end = executor.now() + limit;
-    while (!runner->idle() && executor.now() < end) {
-      auto due = executor.next_due();
-      if (!due || *due > end) break;
-      executor.run_until(*due);
-    }
+    test::run_until_done(
+        executor, [this] { return runner->idle(); }, limit);
   }
 
   void run_script(std::string_view text) {
@@ -292,11 +284,6 @@ struct ArduinoOperatorRunner : ::testing::Test {
     return out;
   }
 
-  link::VirtualExecutor executor;
-  link::TransportContext context{executor};
-  std::optional<sim::World> world;
-  std::unique_ptr<mocks::ArduinoFirmware> firmware;
-  std::unique_ptr<mocks::MockServer> server;
   std::unique_ptr<ArduinoSession> session;
   std::unique_ptr<OperatorRunner> runner;
   std::vector<CommandOutcome> outcomes;

@@ -17,6 +17,7 @@
 #include "protocol/arduino/codec.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -26,14 +27,9 @@ using link::milliseconds;
 using link::seconds;
 
 /// The mock robot behind mem://arduino and a session to it, in virtual time.
-struct ArduinoSessionOnMem : ::testing::Test {
+struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFirmware> {
   void start(ClientConfig config = {}, mocks::ServerOptions options = {}) {
-    world.emplace(sim::WorldDef{});
-    sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
-    firmware = std::make_unique<mocks::ArduinoFirmware>(*world, vehicle);
-    options.listen = link::MemEndpoint{"arduino"};
-    server = std::make_unique<mocks::MockServer>(context, *firmware, std::move(options));
-    server->start();
+    start_car(sim::arduino_robot(), test::on_mem("arduino", std::move(options)));
     session = std::make_unique<ArduinoSession>(context, link::MemEndpoint{"arduino"}, config);
     // Log times are the virtual clock in microseconds, so the log shows
     // exactly when each frame went out.
@@ -55,12 +51,8 @@ struct ArduinoSessionOnMem : ::testing::Test {
       result = r;
       done_at = executor.now();
     });
-    const Time end = executor.now() + limit;
-    while (!result && executor.now() < end) {
-      auto due = executor.next_due();
-      if (!due || *due > end) break;
-      executor.run_until(*due);
-    }
+    test::run_until_done(
+        executor, [&] { return result.has_value(); }, limit);
     return result;
   }
 
@@ -72,11 +64,6 @@ struct ArduinoSessionOnMem : ::testing::Test {
     return out;
   }
 
-  link::VirtualExecutor executor;
-  link::TransportContext context{executor};
-  std::optional<sim::World> world;
-  std::unique_ptr<mocks::ArduinoFirmware> firmware;
-  std::unique_ptr<mocks::MockServer> server;
   std::unique_ptr<ArduinoSession> session;
   std::vector<LinkChanged> changes;
   Time done_at{0};
@@ -192,7 +179,8 @@ TEST_F(ArduinoSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
 
 TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   start(quiet());
-  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1, .duration = {}}});
+  firmware->arm(
+      {.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1, .duration = {}}});
   mocks::When at_100ms;
   at_100ms.at = milliseconds(100);
   firmware->arm({.name = "",
@@ -211,7 +199,9 @@ TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
 TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
   start();  // health check after 5 s of quiet
   // The robot hears nothing for 10 s, then recovers.
-  firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{.match = "", .count = {}, .duration = seconds(10)}});
+  firmware->arm({.name = "",
+                 .when = {},
+                 .action = mocks::Ignore{.match = "", .count = {}, .duration = seconds(10)}});
   executor.run_until(seconds(20));
   ASSERT_EQ(changes.size(), 5u);
   const std::vector<std::pair<LinkState, Time>> expected = {

@@ -19,6 +19,7 @@
 #include "protocol/common/bytes.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::leka {
 namespace {
@@ -286,15 +287,9 @@ TEST(LekaOperatorFrames, AnInfoIsItsOwnFrameInItsPlace) {
 
 // ------------------------------------------------------------ the runner
 
-struct LekaOperatorRunner : ::testing::Test {
+struct LekaOperatorRunner : ::testing::Test, test::VirtualCar<mocks::LekaFirmware> {
   void SetUp() override {
-    world.emplace(sim::WorldDef{});
-    sim::Vehicle& vehicle = world->add_vehicle(sim::leka_robot());
-    firmware = std::make_unique<mocks::LekaFirmware>(*world, vehicle);
-    mocks::ServerOptions options;
-    options.listen = link::MemEndpoint{"leka"};
-    server = std::make_unique<mocks::MockServer>(context, *firmware, options);
-    server->start();
+    start_car(sim::leka_robot(), test::on_mem("leka"));
     session = std::make_unique<LekaSession>(context, link::MemEndpoint{"leka"});
     session->set_wall_clock([this] { return executor.now().count() / 1000; });
     session->open();
@@ -325,11 +320,6 @@ struct LekaOperatorRunner : ::testing::Test {
     return out;
   }
 
-  link::VirtualExecutor executor;
-  link::TransportContext context{executor};
-  std::optional<sim::World> world;
-  std::unique_ptr<mocks::LekaFirmware> firmware;
-  std::unique_ptr<mocks::MockServer> server;
   std::unique_ptr<LekaSession> session;
   std::unique_ptr<ScriptRunner> runner;
   std::vector<LineResult> results;

@@ -16,6 +16,7 @@
 #include "mocks/server.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::leka {
 namespace {
@@ -26,15 +27,9 @@ Time at_ms(int ms) {
   return Time(milliseconds(ms));
 }
 
-struct LekaSessionOnMem : ::testing::Test {
+struct LekaSessionOnMem : ::testing::Test, test::VirtualCar<mocks::LekaFirmware> {
   void start(ClientConfig config = {}) {
-    world.emplace(sim::WorldDef{});
-    sim::Vehicle& vehicle = world->add_vehicle(sim::leka_robot());
-    firmware = std::make_unique<mocks::LekaFirmware>(*world, vehicle);
-    mocks::ServerOptions options;
-    options.listen = link::MemEndpoint{"leka"};
-    server = std::make_unique<mocks::MockServer>(context, *firmware, options);
-    server->start();
+    start_car(sim::leka_robot(), test::on_mem("leka"));
     session = std::make_unique<LekaSession>(context, link::MemEndpoint{"leka"}, config);
     session->set_wall_clock([this] { return executor.now().count() / 1000; });
     session->open();
@@ -58,11 +53,6 @@ struct LekaSessionOnMem : ::testing::Test {
     return b;
   }
 
-  link::VirtualExecutor executor;
-  link::TransportContext context{executor};
-  std::optional<sim::World> world;
-  std::unique_ptr<mocks::LekaFirmware> firmware;
-  std::unique_ptr<mocks::MockServer> server;
   std::unique_ptr<LekaSession> session;
 };
 

@@ -19,6 +19,7 @@
 #include "mocks/server.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::logi {
 namespace {
@@ -109,7 +110,8 @@ TEST(OperatorParser, EveryErrorNamesItsColumnAndWhatWasExpected) {
       {"mode", 5, "expected MAN or AUTO after 'mode'"},
       {"mode HALF", 6, "expected MAN or AUTO, got 'HALF'"},
       {"press", 6, "expected a direction"},
-      {"press UP", 7, "expected a direction (STOP, FWD, BWD, LEFT, RIGHT, LF, RF, LB, RB, CW, CCW)"},
+      {"press UP", 7,
+       "expected a direction (STOP, FWD, BWD, LEFT, RIGHT, LF, RF, LB, RB, CW, CCW)"},
       {"press L", 7, "got 'L'"},
       {"station", 8, "expected a station number"},
       {"station 0", 9, "got '0'"},
@@ -184,22 +186,19 @@ TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsTheFirstErrorAsFileLineColu
 /// The mock car on mem://car, a session and a runner, in virtual time.
 class RunnerBench {
  public:
-  RunnerBench()
-      : vehicle_(world_.add_vehicle(sim::logi_car())), firmware_(world_, vehicle_) {
-    mocks::ServerOptions options;
-    options.listen = link::MemEndpoint{"car"};
+  RunnerBench() {
+    mocks::ServerOptions options = test::on_mem("car");
     options.name = "logi";
-    server_ = std::make_unique<mocks::MockServer>(context_, firmware_, std::move(options));
-    server_->start();
-    session_ = std::make_unique<LogiSession>(context_, link::MemEndpoint{"car"}, ClientConfig{},
+    car_.start_car(sim::logi_car(), std::move(options));
+    session_ = std::make_unique<LogiSession>(car_.context, link::MemEndpoint{"car"}, ClientConfig{},
                                              [this](Time now, const Event& e) {
                                                if (runner_) runner_->on_event(now, e);
                                              });
   }
 
-  mocks::LogiFirmware& firmware() { return firmware_; }
-  mocks::MockServer& server() { return *server_; }
-  link::VirtualExecutor& executor() { return executor_; }
+  mocks::LogiFirmware& firmware() { return *car_.firmware; }
+  mocks::MockServer& server() { return *car_.server; }
+  link::VirtualExecutor& executor() { return car_.executor; }
   LogiSession& session() { return *session_; }
   OperatorRunner& runner() { return *runner_; }
 
@@ -208,16 +207,16 @@ class RunnerBench {
     const auto parsed = parse_operator_script(script, "test");
     ASSERT_TRUE(parsed.ok()) << parsed.error->to_string();
     runner_ = std::make_unique<OperatorRunner>(
-        *session_, executor_, parsed.steps, options,
+        *session_, car_.executor, parsed.steps, options,
         [this](const ActionResult& r) { results_.push_back(r); },
         [this](const RunSummary& s) { summary_ = s; });
     runner_->start();
   }
   /// Runs until the runner is done (at most `limit` of virtual time).
   bool run(link::Duration limit = seconds(120)) {
-    const Time end = executor_.now() + limit;
-    while (!summary_ && executor_.now() < end) {
-      executor_.run_one();
+    const Time end = car_.executor.now() + limit;
+    while (!summary_ && car_.executor.now() < end) {
+      car_.executor.run_one();
     }
     return summary_.has_value();
   }
@@ -241,12 +240,7 @@ class RunnerBench {
   }
 
  private:
-  link::VirtualExecutor executor_;
-  link::TransportContext context_{executor_};
-  sim::World world_{sim::WorldDef{}};
-  sim::Vehicle& vehicle_;
-  mocks::LogiFirmware firmware_;
-  std::unique_ptr<mocks::MockServer> server_;
+  test::VirtualCar<mocks::LogiFirmware> car_;
   std::unique_ptr<LogiSession> session_;
   std::unique_ptr<OperatorRunner> runner_;
   std::vector<ActionResult> results_;

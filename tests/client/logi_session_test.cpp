@@ -17,6 +17,7 @@
 #include "mocks/server.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::logi {
 namespace {
@@ -29,24 +30,22 @@ using proto::Mode;
 /// The mock car on mem://car and a session pointed at it, in virtual time.
 class VirtualBench {
  public:
-  explicit VirtualBench(mocks::ServerOptions options = {}, ClientConfig config = {})
-      : vehicle_(world_.add_vehicle(sim::logi_car())), firmware_(world_, vehicle_) {
-    options.listen = link::MemEndpoint{"car"};
+  explicit VirtualBench(mocks::ServerOptions options = {}, ClientConfig config = {}) {
+    options = test::on_mem("car", std::move(options));
     options.name = "logi";
-    server_ = std::make_unique<mocks::MockServer>(context_, firmware_, std::move(options));
-    server_->start();
+    car_.start_car(sim::logi_car(), std::move(options));
     session_ = std::make_unique<LogiSession>(
-        context_, link::MemEndpoint{"car"}, std::move(config),
+        car_.context, link::MemEndpoint{"car"}, std::move(config),
         [this](Time now, const Event& e) { events_.emplace_back(now, e); });
   }
 
   LogiSession& session() { return *session_; }
-  mocks::LogiFirmware& firmware() { return firmware_; }
-  mocks::MockServer& server() { return *server_; }
-  link::VirtualExecutor& executor() { return executor_; }
-  Time now() const { return executor_.now(); }
-  void run_until(Time t) { executor_.run_until(t); }
-  void run_for(link::Duration d) { executor_.run_for(d); }
+  mocks::LogiFirmware& firmware() { return *car_.firmware; }
+  mocks::MockServer& server() { return *car_.server; }
+  link::VirtualExecutor& executor() { return car_.executor; }
+  Time now() const { return car_.executor.now(); }
+  void run_until(Time t) { car_.executor.run_until(t); }
+  void run_for(link::Duration d) { car_.executor.run_for(d); }
 
   /// Runs until `done()` holds, in 10 ms steps, for at most `limit`.
   template <class Pred>
@@ -54,14 +53,14 @@ class VirtualBench {
     const Time end = now() + limit;
     while (!done()) {
       if (now() >= end) return false;
-      executor_.run_for(milliseconds(10));
+      car_.executor.run_for(milliseconds(10));
     }
     return true;
   }
 
   void connect() {
     session_->connect();
-    executor_.run_for(milliseconds(1));
+    car_.executor.run_for(milliseconds(1));
     ASSERT_EQ(session_->core().state(), ConnectionState::connected);
   }
 
@@ -90,12 +89,7 @@ class VirtualBench {
   }
 
  private:
-  link::VirtualExecutor executor_;
-  link::TransportContext context_{executor_};
-  sim::World world_{sim::WorldDef{}};
-  sim::Vehicle& vehicle_;
-  mocks::LogiFirmware firmware_;
-  std::unique_ptr<mocks::MockServer> server_;
+  test::VirtualCar<mocks::LogiFirmware> car_;
   std::unique_ptr<LogiSession> session_;
   std::vector<std::pair<Time, Event>> events_;
 };

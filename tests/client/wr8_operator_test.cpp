@@ -16,6 +16,7 @@
 #include "mocks/wr8.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::wr8 {
 namespace {
@@ -152,18 +153,15 @@ TEST(Wr8OperatorParse, ShippedExampleScriptsParse) {
 /// The mock vehicle on mem://car, a session and a runner, in virtual time.
 class Bench {
  public:
-  explicit Bench(mocks::Wr8Config car = {}, ClientConfig config = {})
-      : vehicle_(world_.add_vehicle(sim::wr8_vehicle())), firmware_(world_, vehicle_, car) {
-    mocks::ServerOptions options;
-    options.listen = link::MemEndpoint{"car"};
+  explicit Bench(mocks::Wr8Config car = {}, ClientConfig config = {}) {
+    mocks::ServerOptions options = test::on_mem("car");
     options.name = "wr8";
-    server_ = std::make_unique<mocks::MockServer>(context_, firmware_, std::move(options));
-    server_->start();
-    session_ = std::make_unique<Wr8Session>(context_, link::MemEndpoint{"car"}, std::move(config),
-                                            [this](Time now, const Event& e) {
+    car_.start_car(sim::wr8_vehicle(), std::move(options), car);
+    session_ = std::make_unique<Wr8Session>(car_.context, link::MemEndpoint{"car"},
+                                            std::move(config), [this](Time now, const Event& e) {
                                               if (runner_) runner_->on_event(now, e);
                                             });
-    runner_ = std::make_unique<OperatorRunner>(executor_, *session_);
+    runner_ = std::make_unique<OperatorRunner>(car_.executor, *session_);
   }
 
   /// Runs `script` from the current time until it ends (at most 60 s).
@@ -178,25 +176,20 @@ class Bench {
     runner_->run(
         actions, keep_going, [&](const ActionResult& r) { results.push_back(r); },
         [this](bool ok) { finished_ = ok; });
-    const Time limit = executor_.now() + seconds(60);
-    while (!finished_ && executor_.now() < limit)
-      executor_.run_until(executor_.now() + milliseconds(10));
+    const Time limit = car_.executor.now() + seconds(60);
+    while (!finished_ && car_.executor.now() < limit)
+      car_.executor.run_until(car_.executor.now() + milliseconds(10));
     EXPECT_TRUE(finished_.has_value()) << "the script did not end";
     return results;
   }
 
   std::optional<bool> finished() const { return finished_; }
   Wr8Session& session() { return *session_; }
-  mocks::Wr8Firmware& firmware() { return firmware_; }
-  Time now() const { return executor_.now(); }
+  mocks::Wr8Firmware& firmware() { return *car_.firmware; }
+  Time now() const { return car_.executor.now(); }
 
  private:
-  link::VirtualExecutor executor_;
-  link::TransportContext context_{executor_};
-  sim::World world_{sim::WorldDef{}};
-  sim::Vehicle& vehicle_;
-  mocks::Wr8Firmware firmware_;
-  std::unique_ptr<mocks::MockServer> server_;
+  test::VirtualCar<mocks::Wr8Firmware> car_;
   std::unique_ptr<Wr8Session> session_;
   std::unique_ptr<OperatorRunner> runner_;
   std::optional<bool> finished_;

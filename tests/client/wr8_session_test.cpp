@@ -17,6 +17,7 @@
 #include "mocks/wr8.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::wr8 {
 namespace {
@@ -31,22 +32,19 @@ std::pair<Time, RequestState> at(Time t, RequestState s) {
 /// The mock vehicle on mem://car and a session pointed at it, in virtual time.
 class VirtualBench {
  public:
-  explicit VirtualBench(mocks::Wr8Config car = {}, ClientConfig config = {})
-      : vehicle_(world_.add_vehicle(sim::wr8_vehicle())), firmware_(world_, vehicle_, car) {
-    mocks::ServerOptions options;
-    options.listen = link::MemEndpoint{"car"};
+  explicit VirtualBench(mocks::Wr8Config car = {}, ClientConfig config = {}) {
+    mocks::ServerOptions options = test::on_mem("car");
     options.name = "wr8";
-    server_ = std::make_unique<mocks::MockServer>(context_, firmware_, std::move(options));
-    server_->start();
+    car_.start_car(sim::wr8_vehicle(), std::move(options), car);
     session_ = std::make_unique<Wr8Session>(
-        context_, link::MemEndpoint{"car"}, std::move(config),
+        car_.context, link::MemEndpoint{"car"}, std::move(config),
         [this](Time now, const Event& e) { events_.emplace_back(now, e); });
   }
 
   Wr8Session& session() { return *session_; }
-  mocks::Wr8Firmware& firmware() { return firmware_; }
-  Time now() const { return executor_.now(); }
-  void run_until(Time t) { executor_.run_until(t); }
+  mocks::Wr8Firmware& firmware() { return *car_.firmware; }
+  Time now() const { return car_.executor.now(); }
+  void run_until(Time t) { car_.executor.run_until(t); }
 
   template <class E>
   std::vector<std::pair<Time, E>> of() const {
@@ -66,12 +64,7 @@ class VirtualBench {
   }
 
  private:
-  link::VirtualExecutor executor_;
-  link::TransportContext context_{executor_};
-  sim::World world_{sim::WorldDef{}};
-  sim::Vehicle& vehicle_;
-  mocks::Wr8Firmware firmware_;
-  std::unique_ptr<mocks::MockServer> server_;
+  test::VirtualCar<mocks::Wr8Firmware> car_;
   std::unique_ptr<Wr8Session> session_;
   std::vector<std::pair<Time, Event>> events_;
 };
