@@ -11,16 +11,11 @@
 #include <vector>
 
 #include "link/time.hpp"
+#include "protocol/common/overloaded.hpp"
 
 namespace hil::client {
 
-/// Lambdas as one visitor for std::visit.
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
+using protocol::Overloaded;
 
 std::string to_lower(std::string_view text);
 std::string to_upper(std::string_view text);
