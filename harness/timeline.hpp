@@ -44,6 +44,15 @@ std::string_view to_string(Source source);  ///< "wire", "fault", ...
 ///   "station" {"station"}, "collision" {"with"}, "at_rest", "moving".
 /// - step: kind "start" / "end" {"index", "line", "text", "ok", "reason"}.
 /// - car: kind "behaviour" {"name"}, "fault_state" {"on"}.
+/// Values the scenario loader's matchers compare with (so write exactly these):
+/// - client "connection" state: "connecting", "authenticating", "connected",
+///   "disconnected", "reconnecting" (waiting to reconnect); "command" state: the client
+///   library's word ("sent", "accepted", "rejected", "uncertain", "cancelled"; WR8 also
+///   "started", "completed", "error", "timed_out"); "command": the frame kind ("SP", "MV:FWD").
+/// - client "action" text and step "text": Step::text exactly (the loader resolves
+///   `{step: ...}` to it); "ok", wire "valid" and car "on" are JSON booleans.
+/// - client "exit" code and sim "station" are JSON numbers (station 2, not "002");
+///   sim "sample" fields are numbers in metres, degrees and m/s.
 /// What the reference runner writes on top of the fields above:
 /// - wire "frame": also "bytes" (count), "message" (a valid frame decoded, for a person);
 ///   for an invalid one "error" is the decoder's error kind ("bad_checksum", "garbage",
