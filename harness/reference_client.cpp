@@ -334,8 +334,17 @@ class LekaReference final : public ReferenceSession {
         session_(context, std::move(endpoint)),
         runner_(executor_, session_) {
     session_.set_wall_clock([this] { return executor_.now().count() / 1000; });
+    // The port has no events of its own: look again whenever the wire opens
+    // or closes, so the record comes at the moment it happened.
+    listener_ = timeline_.listen([this](const Record& r) {
+      if (r.source == Source::wire && (r.kind == "open" || r.kind == "close"))
+        later(executor_, alive_, [this] { poll(); });
+    });
   }
-  ~LekaReference() override { *alive_ = false; }
+  ~LekaReference() override {
+    *alive_ = false;
+    timeline_.unlisten(listener_);
+  }
 
   void start() override { session_.open(); }
 
@@ -392,6 +401,7 @@ class LekaReference final : public ReferenceSession {
   client::leka::ScriptRunner runner_;
   bool open_ = false;
   std::uint64_t generation_ = 0;
+  RunTimeline::ListenerId listener_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

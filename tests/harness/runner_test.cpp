@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "harness/runner.hpp"
+#include "harness/scenario_yaml.hpp"
 #include "sim/arena.hpp"
 
 namespace hil::harness {
@@ -434,7 +436,9 @@ TEST(RunnerOtherCars, LekaRunsAGroupAndAnswersInfo) {
       run_scenario(scenario(mocks::CarKind::leka, {action("ear all 255 0 0"), action("info")}));
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
   expect_frames_both_ways(o);
-  EXPECT_EQ(of(o, Source::client, "connection").front().data["state"], "connected");
+  const auto connected = of(o, Source::client, "connection").front();
+  EXPECT_EQ(connected.data["state"], "connected");
+  EXPECT_EQ(connected.at, Time(0));
 }
 
 TEST(RunnerOtherCars, AnUnknownActionFailsItsStepWithTheParsersWords) {
@@ -466,6 +470,20 @@ TEST(Runner, WithoutASeedOneIsChosenAndPrintedInTheReproCommand) {
   const auto o = run_scenario(s);
   EXPECT_EQ(o.repro_command, "hil run scenarios/x.yaml --seed " + std::to_string(o.seed));
   EXPECT_EQ(o.run_time, milliseconds(500)) << "no steps: the settle alone";
+}
+
+TEST(Runner, TheExampleScenariosPassWithTheReferenceClient) {
+  const auto folder = std::filesystem::path(HIL_SOURCE_DIR) / "scenarios" / "examples";
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    if (entry.path().extension() == ".yaml") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_FALSE(files.empty());
+  for (const auto& file : files) {
+    const Scenario s = load_scenario(file);
+    const auto o = run_scenario(s);
+    EXPECT_TRUE(o.passed()) << file << ": " << o.first_failure() << "\n" << steps_summary(o);
+  }
 }
 
 }  // namespace
