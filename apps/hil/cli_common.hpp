@@ -103,5 +103,7 @@ void register_proxy(CLI::App& app, std::function<int()>& run);
 void register_world(CLI::App& app, std::function<int()>& run);
 /// `hil mock`: standalone mock cars in real time (apps/hil/mock_command.cpp).
 void register_mock(CLI::App& app, std::function<int()>& run);
+/// `hil run`: scenario files, the table, JUnit and the report folder (apps/hil/run_command.cpp).
+void register_run(CLI::App& app, std::function<int()>& run);
 
 }  // namespace hil::apps

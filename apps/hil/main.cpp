@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
       "  hil decode leka --hex --file capture.hex --summary\n"
       "  hil world check scenarios/worlds/*.yaml\n"
       "  hil world render scenarios/worlds/corridor.yaml -o corridor.svg\n"
+      "  hil run scenarios/ --junit hil.xml --report-dir hil-report\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode =
@@ -43,6 +44,7 @@ int main(int argc, char** argv) {
   hil::apps::register_proxy(app, run);
   hil::apps::register_world(app, run);
   hil::apps::register_mock(app, run);
+  hil::apps::register_run(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&

@@ -1,0 +1,378 @@
+// hil run: runs scenario files (in parallel), prints the table with every
+// failure's evidence and the command that repeats it, and writes JUnit XML
+// and a report folder for CI. Exit 0 all passed, 1 any failed, 2 bad usage.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include "apps/hil/cli_common.hpp"
+#include "harness/report.hpp"
+#include "harness/runner.hpp"
+#include "harness/scenario_yaml.hpp"
+
+namespace hil::apps {
+namespace {
+
+namespace fs = std::filesystem;
+using harness::ReportEntry;
+using harness::Scenario;
+using harness::ScenarioOutcome;
+
+struct RunArgs {
+  std::vector<std::string> paths;
+  std::string junit;
+  std::string report_dir;
+  std::optional<std::uint64_t> seed;
+  int repeat = 1;
+  std::vector<std::string> tags;
+  std::vector<std::string> exclude_tags;
+  std::optional<std::string> client_exec;
+  std::vector<std::string> sets;
+  int jobs = 0;
+  bool list = false;
+  bool verbose = false;
+};
+
+// A scenario file is a YAML map with top-level `car:` and `steps:`. Read as
+// text so a file with a YAML mistake is still found (and its error shown).
+bool looks_like_scenario(const fs::path& path) {
+  std::ifstream in(path);
+  bool car = false;
+  bool steps = false;
+  for (std::string line; std::getline(in, line) && !(car && steps);) {
+    car = car || line.rfind("car:", 0) == 0;
+    steps = steps || line.rfind("steps:", 0) == 0;
+  }
+  return car && steps;
+}
+
+bool is_yaml(const fs::path& path) {
+  const auto ext = path.extension().string();
+  return ext == ".yaml" || ext == ".yml";
+}
+
+// For the repro command: a word the shell passes through unchanged.
+std::string shell_quote(const std::string& word) {
+  const bool plain = !word.empty() && std::all_of(word.begin(), word.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 ||
+           std::string_view("_-./=:,+@%").find(c) != std::string_view::npos;
+  });
+  if (plain) return word;
+  std::string out = "'";
+  for (const char c : word)
+    out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string repro_command(const RunArgs& args, const std::string& file,
+                          std::optional<std::uint64_t> seed) {
+  std::string out = "hil run " + shell_quote(file);
+  if (seed) out += " --seed " + std::to_string(*seed);
+  for (const auto& s : args.sets)
+    out += " --set " + shell_quote(s);
+  if (args.client_exec) out += " --client-exec " + shell_quote(*args.client_exec);
+  return out;
+}
+
+struct Planned {
+  std::string file;
+  std::optional<Scenario> scenario;
+  std::string error;  ///< why it did not load
+};
+
+bool has_any(const std::vector<std::string>& have, const std::vector<std::string>& wanted) {
+  return std::any_of(wanted.begin(), wanted.end(), [&](const std::string& t) {
+    return std::find(have.begin(), have.end(), t) != have.end();
+  });
+}
+
+std::string joined(const std::vector<std::string>& words, const char* separator = ", ") {
+  std::string out;
+  for (const auto& w : words)
+    out += (out.empty() ? "" : separator) + w;
+  return out;
+}
+
+// The scenario files named by the arguments, sorted; nullopt (and a message
+// on stderr) for a path that does not exist.
+std::optional<std::vector<std::string>> find_files(const RunArgs& args) {
+  std::set<std::string> files;
+  for (const auto& arg : args.paths) {
+    const fs::path path(arg);
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+      std::vector<fs::path> found;
+      for (auto it = fs::recursive_directory_iterator(
+               path, fs::directory_options::skip_permission_denied, ec);
+           !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        if (it->is_regular_file(ec) && is_yaml(it->path())) found.push_back(it->path());
+      }
+      if (ec) {
+        std::cerr << "hil run: cannot read folder " << arg << ": " << ec.message() << '\n';
+        return std::nullopt;
+      }
+      for (const auto& f : found) {
+        if (looks_like_scenario(f)) {
+          files.insert(f.lexically_normal().string());
+        } else if (args.verbose) {
+          std::cerr << "hil run: skipped " << f.lexically_normal().string()
+                    << " (no top-level car: and steps:, not a scenario)\n";
+        }
+      }
+    } else if (fs::exists(path, ec)) {
+      // A file named on the command line is a scenario: if it is not one,
+      // loading it says why.
+      files.insert(path.lexically_normal().string());
+    } else {
+      std::cerr << "hil run: " << arg << ": no such file or folder\n";
+      return std::nullopt;
+    }
+  }
+  return std::vector<std::string>(files.begin(), files.end());
+}
+
+ScenarioOutcome load_failure(const Planned& p, const RunArgs& args) {
+  ScenarioOutcome o;
+  o.file = p.file;
+  o.name = fs::path(p.file).stem().string();
+  o.error = p.error;
+  o.repro_command = repro_command(args, p.file, std::nullopt);
+  return o;
+}
+
+int run_scenarios(const RunArgs& args) {
+  std::map<std::string, std::string> overrides;
+  for (const auto& s : args.sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "hil run: --set " << s << ": expected name=value\n";
+      return 2;
+    }
+    overrides[s.substr(0, eq)] = s.substr(eq + 1);
+  }
+  const auto files = find_files(args);
+  if (!files) return 2;
+  if (files->empty()) {
+    std::cerr << "hil run: no scenario files (YAML with top-level car: and steps:) in "
+              << joined(args.paths, " ") << '\n';
+    return 2;
+  }
+
+  std::vector<Planned> plan;
+  for (const auto& file : *files) {
+    Planned p{file, std::nullopt, {}};
+    try {
+      p.scenario = harness::load_scenario(file, overrides);
+    } catch (const harness::ScenarioError& e) {
+      p.error = e.what();
+    } catch (const std::exception& e) {
+      p.error = file + ": " + e.what();
+    }
+    if (p.scenario) {
+      if (!args.tags.empty() && !has_any(p.scenario->tags, args.tags)) continue;
+      if (has_any(p.scenario->tags, args.exclude_tags)) continue;
+    }
+    // A file that does not load stays in, whatever the tags: a gate must not
+    // pass because a broken file was silently left out.
+    plan.push_back(std::move(p));
+  }
+  if (plan.empty()) {
+    std::cerr << "hil run: no scenario has the tags " << joined(args.tags)
+              << (args.exclude_tags.empty() ? "" : " without " + joined(args.exclude_tags)) << '\n';
+    return 2;
+  }
+
+  if (args.list) {
+    bool all_load = true;
+    for (const auto& p : plan) {
+      if (p.scenario) {
+        std::cout << p.file << "  " << p.scenario->name;
+        if (!p.scenario->tags.empty()) std::cout << "  [" << joined(p.scenario->tags) << ']';
+        std::cout << '\n';
+      } else {
+        all_load = false;
+        std::cout << p.file << "  does not load: " << p.error << '\n';
+      }
+    }
+    return all_load ? 0 : 1;
+  }
+
+  // One entry per run, in the table's order (file, then repeat); each knows
+  // its folder before it runs so the runner can put files there.
+  struct Task {
+    std::size_t plan_index;
+    std::optional<std::uint64_t> seed;
+  };
+  std::vector<ReportEntry> entries;
+  std::vector<Task> tasks;
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const auto& p = plan[i];
+    if (!p.scenario) {
+      ReportEntry e;
+      e.outcome = load_failure(p, args);
+      entries.push_back(std::move(e));
+      tasks.push_back(Task{i, std::nullopt});
+      continue;
+    }
+    const std::optional<std::uint64_t> base = args.seed ? args.seed : p.scenario->seed;
+    for (int r = 0; r < args.repeat; ++r) {
+      ReportEntry e;
+      e.outcome.file = p.file;
+      e.outcome.name = p.scenario->name;
+      e.repeat = r;
+      e.repeats = args.repeat;
+      entries.push_back(std::move(e));
+      tasks.push_back(
+          Task{i, base ? std::optional<std::uint64_t>(*base + static_cast<std::uint64_t>(r))
+                       : std::nullopt});
+    }
+  }
+  if (!args.report_dir.empty()) harness::report_folders(entries);
+
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::mutex progress;
+  const auto worker = [&] {
+    for (std::size_t k = next++; k < tasks.size(); k = next++) {
+      const auto& p = plan[tasks[k].plan_index];
+      auto& entry = entries[k];
+      if (p.scenario) {
+        harness::RunOptions options;
+        options.seed = tasks[k].seed;
+        options.client_exec = args.client_exec;
+        if (!args.report_dir.empty()) {
+          const fs::path folder = fs::path(args.report_dir) / entry.folder;
+          std::error_code ec;
+          fs::create_directories(folder, ec);
+          if (!ec) options.work_dir = folder.string();
+        }
+        ScenarioOutcome outcome;
+        try {
+          outcome = harness::run_scenario(*p.scenario, options);
+        } catch (const std::exception& e) {
+          outcome.error = std::string("the run stopped: ") + e.what();
+        }
+        if (outcome.file.empty()) outcome.file = p.file;
+        if (outcome.name.empty()) outcome.name = p.scenario->name;
+        if (outcome.tags.empty()) outcome.tags = p.scenario->tags;
+        outcome.repro_command = repro_command(args, p.file, outcome.seed);
+        entry.outcome = std::move(outcome);
+      }
+      const std::size_t finished = ++done;
+      if (args.verbose) {
+        const std::lock_guard lock(progress);
+        std::cerr << '[' << finished << '/' << tasks.size() << "] "
+                  << (entry.outcome.passed() ? "PASS " : "FAIL ") << entry.outcome.name;
+        if (entry.repeats > 1) std::cerr << " #" << entry.repeat + 1;
+        if (p.scenario) std::cerr << " (seed " << entry.outcome.seed << ')';
+        std::cerr << '\n';
+      }
+    }
+  };
+  const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
+  const std::size_t jobs = std::min<std::size_t>(
+      args.jobs > 0 ? static_cast<std::size_t>(args.jobs) : cores, tasks.size());
+  std::vector<std::thread> threads;
+  for (std::size_t t = 1; t < jobs; ++t)
+    threads.emplace_back(worker);
+  worker();
+  for (auto& t : threads)
+    t.join();
+
+  harness::ConsoleOptions console;
+  console.color = harness::want_color(STDOUT_FILENO);
+  console.width = harness::terminal_width(STDOUT_FILENO, 100);
+  harness::write_console(std::cout, entries, console);
+  std::cout.flush();
+
+  int status = 0;
+  for (const auto& s : harness::summarize(entries))
+    if (s.verdict != harness::Verdict::pass) status = 1;
+  if (!args.junit.empty()) {
+    std::ofstream out(args.junit, std::ios::binary | std::ios::trunc);
+    if (out) out << harness::junit_xml(entries);
+    out.close();
+    if (!out) {
+      std::cerr << "hil run: cannot write " << args.junit << '\n';
+      status = 1;
+    }
+  }
+  if (!args.report_dir.empty()) {
+    try {
+      harness::write_report_dir(args.report_dir, entries);
+      std::cout << "report: " << (fs::path(args.report_dir) / "index.html").string() << '\n';
+    } catch (const std::exception& e) {
+      std::cerr << "hil run: " << e.what() << '\n';
+      status = 1;
+    }
+  }
+  return status;
+}
+
+}  // namespace
+
+void register_run(CLI::App& app, std::function<int()>& run) {
+  auto args = std::make_shared<RunArgs>();
+  auto* cmd = app.add_subcommand(
+      "run", "Run scenario files against the reference clients or an external client");
+  cmd->add_option("paths", args->paths,
+                  "Scenario files, or folders searched for them (*.yaml with top-level car: and "
+                  "steps:)")
+      ->required();
+  cmd->add_option("--junit", args->junit, "Write JUnit XML for CI to FILE")->type_name("FILE");
+  cmd->add_option("--report-dir", args->report_dir,
+                  "Write an HTML report, NDJSON timelines and SVG trajectories to DIR")
+      ->type_name("DIR");
+  cmd->add_option("--seed", args->seed, "Seed every scenario with N (overrides the files' seeds)")
+      ->type_name("N");
+  cmd->add_option(
+         "--repeat", args->repeat,
+         "Run each scenario N times, seeds S, S+1, ... from --seed or the file (else random): "
+         "finds flaky scenarios")
+      ->type_name("N")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--tags", args->tags, "Run only scenarios with any of these tags (a,b)")
+      ->type_name("TAGS")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  cmd->add_option("--exclude-tags", args->exclude_tags, "Leave out scenarios with any of these")
+      ->type_name("TAGS")
+      ->delimiter(',')
+      ->allow_extra_args(false);
+  cmd->add_option("--client-exec", args->client_exec,
+                  "Run every scenario against this program instead of its client "
+                  "({host} {port} {pty} {actions} ... as in docs/client-contract.md)")
+      ->type_name("CMD");
+  cmd->add_option("--set", args->sets, "Set a scenario variable: name=value (repeatable)")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+  cmd->add_option("-j,--jobs", args->jobs, "Runs at a time (default: the number of cores)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_flag("--list", args->list, "Print the scenarios that would run, with their tags");
+  cmd->add_flag("-v,--verbose", args->verbose,
+                "Show each run as it finishes and the YAML files that are not scenarios");
+  cmd->footer(
+      "Examples:\n"
+      "  hil run scenarios/                              # every scenario, a table at the end\n"
+      "  hil run scenarios/ --tags smoke --junit hil.xml --report-dir hil-report\n"
+      "  hil run scenarios/logi/release.yaml --seed 42   # repeat one run exactly\n"
+      "  hil run scenarios/ --repeat 20 -j 4             # hunt flaky scenarios\n"
+      "Every failure prints the command that repeats it.\n"
+      "Exit status: 0 every scenario passed; 1 any failed (or was flaky, or did not load);\n"
+      "2 a malformed command line, a path that does not exist, or no scenario to run.");
+  cmd->callback([&run, args] { run = [args] { return run_scenarios(*args); }; });
+}
+
+}  // namespace hil::apps
