@@ -31,7 +31,9 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   sim::World world(sim::WorldDef{});
   sim::Vehicle& vehicle = world.add_vehicle(sim::arduino_robot());
   mocks::ArduinoFirmware firmware(world, vehicle);
-  mocks::MockServer server(context, firmware, {.listen = link::parse_endpoint(uri)});
+  mocks::ServerOptions options;
+  options.listen = link::parse_endpoint(uri);
+  mocks::MockServer server(context, firmware, options);
   server.start();
 
   ArduinoSession session(context, link::parse_endpoint(uri));
