@@ -85,7 +85,9 @@ void LogiClientCore::disconnect(Time now) {
 
 void LogiClientCore::on_connected(Time now) {
   if (state_ != ConnectionState::connecting) return;
-  reconnect_attempt_ = 0;
+  // The reconnect ladder starts again only once the car has sent a valid
+  // frame (on_frame): a car that accepts and hangs up at once is a failed
+  // attempt, not a reason to hammer it every second.
   decoder_ = proto::Decoder(config_.decoder);
   last_stat_ = now;
   mode_confirmed_ = false;
@@ -371,6 +373,7 @@ void LogiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
 }
 
 void LogiClientCore::on_frame(Time now, const protocol::Frame<proto::Message>& frame) {
+  reconnect_attempt_ = 0;
   log_->add(LogEntry{now, LogKind::rx, std::string(frame.raw.begin(), frame.raw.end()),
                      proto::describe(frame.message)});
   if (const auto* status = std::get_if<proto::Status>(&frame.message)) {

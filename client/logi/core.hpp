@@ -213,7 +213,7 @@ class LogiClientCore {
 
   ConnectionState state_ = ConnectionState::disconnected;
   bool want_connected_ = false;
-  int reconnect_attempt_ = 0;  // attempts since the last successful connect
+  int reconnect_attempt_ = 0;  // attempts since the car last sent a valid frame
   std::optional<Time> reconnect_at_;
 
   RequestId next_id_ = 1;

@@ -163,15 +163,34 @@ TEST(LogiClientCore, ReconnectsAfterADropAt1s2s3sThen3sForever) {
     h.core.on_connect_failed(h.now);
     h.drain();
   }
-  // A successful connect starts the series again at 1 s.
+  // A connection over which the car spoke starts the series again at 1 s.
   h.run_until(seconds(25));
   h.core.on_connected(h.now);
-  h.drain();
+  h.feed(stat_frame());
   h.now = seconds(30);
   h.core.on_closed(h.now);
   h.drain();
   h.run_until(seconds(31));
   EXPECT_EQ(h.open_times.back(), seconds(31));
+}
+
+TEST(LogiClientCore, ACarThatHangsUpBeforeSayingAnythingDoesNotRestartTheSeries) {
+  Harness h;
+  h.connected();
+  h.feed(stat_frame());
+  h.core.on_closed(h.now);
+  h.drain();
+  // Each attempt connects and is closed at once, with no frame from the car:
+  // the delays still grow 1 s, 2 s, 3 s, 3 s.
+  for (Time at : {seconds(1), seconds(3), seconds(6), seconds(9)}) {
+    h.run_until(at);
+    ASSERT_EQ(h.open_times.back(), at);
+    h.core.on_connected(h.now);
+    h.core.on_closed(h.now);
+    h.drain();
+  }
+  h.run_until(seconds(12));
+  EXPECT_EQ(h.open_times.back(), seconds(12));
 }
 
 TEST(LogiClientCore, AFailedFirstConnectIsRetriedAfter1s) {
