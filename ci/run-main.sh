@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Sets up this machine (Debian 12), builds hil, and runs its main job.
-# Today the main job decodes the recorded wire captures in scenarios/captures/
+# The main job decodes the recorded wire captures in scenarios/captures/
 # with the protocol calculator, printing every frame and every error, checks
 # every world file in scenarios/worlds/ and draws each (and the built-in
-# warehouse) to build/worlds/*.svg; it grows into the scenario suite as the
-# harness does.
+# warehouse) to build/worlds/*.svg, and ends by running the scenario suite
+# (scenarios/) against the reference clients: the table on the console,
+# JUnit XML in build/hil-junit.xml and the report in build/hil-report/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -36,4 +37,9 @@ mkdir -p build/worlds
 for world in scenarios/worlds/*.yaml; do
   "$hil" world render "$world" -o "build/worlds/$(basename "$world" .yaml).svg" || status=1
 done
+
+echo "== scenarios"
+if ! "$hil" run scenarios/ --junit build/hil-junit.xml --report-dir build/hil-report; then
+  status=1
+fi
 exit "$status"
