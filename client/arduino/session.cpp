@@ -10,31 +10,8 @@ ArduinoSession::ArduinoSession(link::TransportContext& context, link::Endpoint e
     : core_(config),
       wall_clock_([] { return link::wall_time_us(); }),
       binding_(context, std::move(endpoint),
-               {.connected =
-                    [this] {
-                      core_.on_connected(now());
-                      drain();
-                    },
-                .connect_failed =
-                    [this](std::error_code ec) {
-                      core_.on_connect_failed(now(), ec.message());
-                      drain();
-                    },
-                .bytes =
-                    [this](protocol::ByteView bytes) {
-                      core_.on_bytes(now(), bytes);
-                      drain();
-                    },
-                .closed =
-                    [this] {
-                      core_.on_closed(now());
-                      drain();
-                    },
-                .timer =
-                    [this] {
-                      core_.on_timer(now());
-                      drain();
-                    }}) {}
+               core_handlers(
+                   core_, [this] { return now(); }, [this] { drain(); })) {}
 
 void ArduinoSession::open() {
   core_.open(now());

@@ -34,17 +34,8 @@ class ConnectingSession {
       : sink_(std::move(sink)),
         core_(std::move(core)),
         binding_(context, std::move(endpoint),
-                 {.connected = [this] { feed([&](link::Time t) { core_.on_connected(t); }); },
-                  .connect_failed =
-                      [this](std::error_code) {
-                        feed([&](link::Time t) { core_.on_connect_failed(t); });
-                      },
-                  .bytes =
-                      [this](protocol::ByteView bytes) {
-                        feed([&](link::Time t) { core_.on_bytes(t, bytes); });
-                      },
-                  .closed = [this] { feed([&](link::Time t) { core_.on_closed(t); }); },
-                  .timer = [this] { feed([&](link::Time t) { core_.on_timer(t); }); }}) {}
+                 core_handlers(
+                     core_, [this] { return now(); }, [this] { flush(); })) {}
   ConnectingSession(const ConnectingSession&) = delete;
   ConnectingSession& operator=(const ConnectingSession&) = delete;
 

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <system_error>
 
 #include "link/byte_pipe.hpp"
@@ -61,6 +62,40 @@ class PipeBinding {
   std::optional<link::Time> timer_due_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
+
+/// Handlers that give `core` what the binding reports, stamped with `now()`,
+/// then call `after()` (the session's drain): on_connected, on_bytes,
+/// on_closed, on_timer, and on_connect_failed (with the system's message
+/// when the core takes one; nothing when the core has none).
+template <class Core, class Now, class After>
+PipeBinding::Handlers core_handlers(Core& core, Now now, After after) {
+  PipeBinding::Handlers h;
+  h.connected = [&core, now, after] {
+    core.on_connected(now());
+    after();
+  };
+  h.connect_failed = [&core, now, after](std::error_code ec) {
+    if constexpr (requires { core.on_connect_failed(now(), ec.message()); }) {
+      core.on_connect_failed(now(), ec.message());
+    } else if constexpr (requires { core.on_connect_failed(now()); }) {
+      core.on_connect_failed(now());
+    }
+    after();
+  };
+  h.bytes = [&core, now, after](protocol::ByteView bytes) {
+    core.on_bytes(now(), bytes);
+    after();
+  };
+  h.closed = [&core, now, after] {
+    core.on_closed(now());
+    after();
+  };
+  h.timer = [&core, now, after] {
+    core.on_timer(now());
+    after();
+  };
+  return h;
+}
 
 /// Hands `step` the core's pending actions and events until it has none
 /// left (a step may cause more). A call made from inside a step returns at

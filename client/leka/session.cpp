@@ -9,29 +9,20 @@ LekaSession::LekaSession(link::TransportContext& context, link::Endpoint endpoin
                          ClientConfig config)
     : core_(config),
       wall_clock_([] { return link::wall_time_us(); }),
-      binding_(context, std::move(endpoint),
-               {.connected =
-                    [this] {
-                      open_error_.clear();
-                      core_.on_connected(now());
-                      drain();
-                    },
-                .connect_failed = [this](std::error_code ec) { open_error_ = ec.message(); },
-                .bytes =
-                    [this](protocol::ByteView bytes) {
-                      core_.on_bytes(now(), bytes);
-                      drain();
-                    },
-                .closed =
-                    [this] {
-                      core_.on_closed(now());
-                      drain();
-                    },
-                .timer =
-                    [this] {
-                      core_.on_timer(now());
-                      drain();
-                    }}) {}
+      binding_(context, std::move(endpoint), handlers()) {}
+
+PipeBinding::Handlers LekaSession::handlers() {
+  auto h = core_handlers(
+      core_, [this] { return now(); }, [this] { drain(); });
+  // The core has no notion of a failed open; the session keeps the reason.
+  h.connect_failed = [this](std::error_code ec) { open_error_ = ec.message(); };
+  auto connected = std::move(h.connected);
+  h.connected = [this, connected] {
+    open_error_.clear();
+    connected();
+  };
+  return h;
+}
 
 void LekaSession::open() {
   binding_.open();

@@ -46,6 +46,7 @@ class LekaSession {
  private:
   link::Time now() const { return binding_.now(); }
   void drain();
+  PipeBinding::Handlers handlers();
 
   LekaClientCore core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
