@@ -140,6 +140,11 @@ struct Step {
   int line = 0;      ///< in the scenario file
   std::string text;  ///< as written, for reports and the timeline
   StepAction action;
+  /// The step must fail (a NACK, a timeout, an uncertain command): it
+  /// passes when it fails, and fails when it succeeds.
+  bool expect_failure = false;
+  /// With expect_failure: the failure's reason must contain this ("" any).
+  std::string failure_contains;
   friend bool operator==(const Step&, const Step&) = default;
 };
 
