@@ -38,6 +38,12 @@ class ReferenceSession {
   /// State that only shows by looking (the Leka port being open), checked
   /// on every simulation tick.
   virtual void poll() {}
+  /// After stop(): whether the client is gone for good (an external
+  /// program has exited). The runner waits for this a while.
+  virtual bool finished() const { return true; }
+  /// After stop(), when finished() did not come in time: end it by force
+  /// (`hard`: no more chances).
+  virtual void terminate(bool hard) { (void)hard; }
 };
 
 /// The car's reference client on `endpoint`, writing client records to
