@@ -2,20 +2,32 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <memory>
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <thread>
 #include <utility>
 #include <vector>
 
+#include <stdlib.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <asio/io_context.hpp>
+
+#include "harness/exec_client.hpp"
 #include "harness/expect.hpp"
 #include "harness/reference_client.hpp"
 #include "harness/timeline_recorder.hpp"
+#include "link/asio_executor.hpp"
 #include "link/executor.hpp"
 #include "link/transport.hpp"
 #include "mocks/car.hpp"
@@ -42,6 +54,13 @@ constexpr double kMovingRadps = 0.02;
 constexpr Duration kTeardownGrace = seconds(10);
 // A guard against a run that makes no progress in time.
 constexpr std::uint64_t kMaxTasks = 50'000'000;
+// An external client gets this long to exit after its stdin closed, then
+// this long after SIGTERM before SIGKILL (docs/client-contract.md).
+constexpr Duration kExitGrace = seconds(5);
+constexpr Duration kTermGrace = seconds(2);
+// Under the real-time driver, the longest the loop waits for the next
+// handler before looking at `done` again.
+constexpr auto kRealTimeSlice = std::chrono::milliseconds(20);
 
 std::string seconds_text(Duration d) {
   const double s = std::chrono::duration<double>(d).count();
@@ -69,19 +88,102 @@ std::string world_path(const Scenario& scenario) {
   return p.string();
 }
 
-// One run of one scenario with the reference client in virtual time.
+// What moves time: everything in a run goes through the driver's executor
+// and transport context; only the loop that runs tasks differs.
+class Driver {
+ public:
+  virtual ~Driver() = default;
+  virtual link::Executor& executor() = 0;
+  virtual link::TransportContext& context() = 0;
+  virtual bool real_time() const = 0;
+  /// Runs tasks until `done` or until the clock reaches `deadline` (the
+  /// clock then stands there). Returns an error when the run stopped
+  /// making progress.
+  virtual std::optional<std::string> drive(const std::function<bool()>& done, Time deadline) = 0;
+};
+
+// The virtual-time driver: runs the executor task by task; time jumps to
+// the next task.
+class VirtualDriver final : public Driver {
+ public:
+  link::Executor& executor() override { return executor_; }
+  link::TransportContext& context() override { return context_; }
+  bool real_time() const override { return false; }
+  std::optional<std::string> drive(const std::function<bool()>& done, Time deadline) override {
+    while (!done()) {
+      const auto next = executor_.next_due();
+      if (!next || *next > deadline) {
+        executor_.run_until(deadline);
+        return std::nullopt;
+      }
+      executor_.run_one();
+      // Something that reschedules itself at the same instant forever would
+      // hang the run; no scenario needs this many tasks.
+      if (++tasks_run_ > kMaxTasks)
+        return "the run stopped making progress at " + link::format_ms(executor_.now()) +
+               " (more than " + std::to_string(kMaxTasks) + " tasks)";
+    }
+    return std::nullopt;
+  }
+
+ private:
+  link::VirtualExecutor executor_;
+  link::TransportContext context_{executor_};
+  std::uint64_t tasks_run_ = 0;
+};
+
+// The real-time driver: an io_context with real sockets and ptys; the
+// clock is the steady clock.
+class RealTimeDriver final : public Driver {
+ public:
+  link::Executor& executor() override { return executor_; }
+  link::TransportContext& context() override { return context_; }
+  bool real_time() const override { return true; }
+  std::optional<std::string> drive(const std::function<bool()>& done, Time deadline) override {
+    while (!done()) {
+      const Time now = executor_.now();
+      if (now >= deadline) return std::nullopt;
+      const auto slice = std::min<Duration>(deadline - now, kRealTimeSlice);
+      if (io_.run_one_for(slice) == 0) {
+        // Nothing to wait on at all: the io_context stopped; let the time pass.
+        if (io_.stopped()) io_.restart();
+        if (executor_.pending() == 0) std::this_thread::sleep_for(slice);
+      }
+    }
+    return std::nullopt;
+  }
+
+ private:
+  asio::io_context io_;
+  link::AsioExecutor executor_{io_};
+  link::TransportContext context_{executor_, &io_};
+};
+
+// One run of one scenario, under either driver, with the reference client
+// or an external program.
 class ReferenceRun {
  public:
   ReferenceRun(const Scenario& scenario, const RunOptions& options, std::uint64_t seed,
-               ScenarioOutcome& out)
+               ScenarioOutcome& out, std::unique_ptr<Driver> driver)
       : scenario_(scenario),
         options_(options),
         seed_(seed),
         out_(out),
+        driver_(std::move(driver)),
+        executor_(driver_->executor()),
+        context_(driver_->context()),
         timeline_(executor_),
         recorder_(options.sample_period) {}
 
-  ~ReferenceRun() { *alive_ = false; }
+  ~ReferenceRun() {
+    *alive_ = false;
+    client_.reset();
+    server_.reset();
+    if (!temp_dir_.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove_all(temp_dir_, ignored);
+    }
+  }
 
   void run();
 
@@ -99,12 +201,17 @@ class ReferenceRun {
   };
 
   bool build();
+  std::optional<link::Endpoint> listen_endpoint();
+  bool make_client(const link::Endpoint& endpoint);
+  void stop_external_client();
   void plan();
   void start_schedule();
   void advance(Sequence& seq);
   void skip_rest(Sequence& seq, const std::string& reason);
   void begin_step(std::size_t index, std::function<void(bool ok)> then);
-  void finish_step(std::size_t index, bool ok, std::string reason);
+  /// `cut_short`: the run ended the step (a timeout), so a step expected to
+  /// fail does not pass by it.
+  void finish_step(std::size_t index, bool ok, std::string reason, bool cut_short = false);
   void finish_later(std::size_t index, bool ok, std::string reason);
   void begin_wait_until(std::size_t index, const WaitUntilStep& wait);
   void obstacle(std::size_t index, const ObstacleStep& step);
@@ -120,10 +227,11 @@ class ReferenceRun {
   std::uint64_t seed_;
   ScenarioOutcome& out_;
 
-  // Destroyed last to first: the executor outlives everything that
-  // schedules on it, the timeline everything that writes to it.
-  link::VirtualExecutor executor_;
-  link::TransportContext context_{executor_};
+  // Destroyed last to first: the driver's executor outlives everything
+  // that schedules on it, the timeline everything that writes to it.
+  std::unique_ptr<Driver> driver_;
+  link::Executor& executor_;
+  link::TransportContext& context_;
   RunTimeline timeline_;
   std::unique_ptr<mocks::MockCar> car_;
   std::shared_ptr<WireRecorder> wire_;
@@ -141,7 +249,9 @@ class ReferenceRun {
   std::multimap<std::string, std::size_t> obstacles_;  // name -> arena obstacle index
   bool ended_ = false;
   bool stuck_ = false;
-  std::uint64_t tasks_run_ = 0;
+  bool external_ = false;
+  bool steps_over_ = false;         // no scheduled step starts any more
+  std::filesystem::path temp_dir_;  // real time: the pty and the actions file
 
   link::Executor::TimerId sim_timer_ = 0;
   Time next_sample_{0};
@@ -169,22 +279,94 @@ bool ReferenceRun::build() {
     out_.error = std::string("the world cannot be built: ") + e.what();
     return false;
   }
-  const link::Endpoint endpoint = link::MemEndpoint{"car0"};
+  const auto listen = listen_endpoint();
+  if (!listen) return false;
   mocks::ServerOptions server;
-  server.listen = endpoint;
+  server.listen = *listen;
   server.faults = scenario_.faults;
   server.seed = seed_;
   server.name = "car0";
   wire_ = std::make_shared<WireRecorder>(timeline_, car_->firmware().adapter());
   server.observers.push_back(wire_);
   server_ = std::make_unique<mocks::MockServer>(context_, car_->firmware(), std::move(server));
-  client_ = make_reference_session(scenario_.car, context_, endpoint, timeline_);
   try {
     server_->start();
   } catch (const std::exception& e) {
     out_.error = std::string("the car cannot listen: ") + e.what();
     return false;
   }
+  // Under real time the listener chose the port; the client goes there.
+  return make_client(driver_->real_time() ? link::parse_endpoint(server_->address()) : *listen);
+}
+
+std::optional<link::Endpoint> ReferenceRun::listen_endpoint() {
+  if (!driver_->real_time()) return link::MemEndpoint{"car0"};
+  // A folder of this run's own for the pty and the actions file, so runs
+  // in parallel never meet.
+  std::string pattern = (std::filesystem::temp_directory_path() / "hil-run-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    out_.error = "cannot make a temporary folder for the run: " + std::string(std::strerror(errno));
+    return std::nullopt;
+  }
+  temp_dir_ = pattern;
+  link::Endpoint e = mocks::default_endpoint(scenario_.car, 0);
+  if (auto* tcp = std::get_if<link::TcpEndpoint>(&e)) {
+    tcp->host = "127.0.0.1";
+    tcp->port = 0;  // any free port
+  } else if (auto* pty = std::get_if<link::PtyEndpoint>(&e)) {
+    pty->path = (temp_dir_ / "car0").string();
+  }
+  return e;
+}
+
+bool ReferenceRun::make_client(const link::Endpoint& endpoint) {
+  const auto* exec = std::get_if<ExecClient>(&scenario_.client);
+  const std::string* command = options_.client_exec ? &*options_.client_exec
+                               : exec               ? &exec->command
+                                                    : nullptr;
+  if (command == nullptr) {
+    client_ = make_reference_session(scenario_.car, context_, endpoint, timeline_);
+    return true;
+  }
+  external_ = true;
+  Placeholders values;
+  values["endpoint"] = link::to_uri(endpoint);
+  if (const auto* tcp = std::get_if<link::TcpEndpoint>(&endpoint)) {
+    values["host"] = tcp->host;
+    values["port"] = std::to_string(tcp->port);
+  } else if (const auto* pty = std::get_if<link::PtyEndpoint>(&endpoint)) {
+    values["pty"] = pty->path;
+  }
+  values["scenario"] = scenario_.file.empty()
+                           ? std::string()
+                           : std::filesystem::absolute(scenario_.file).lexically_normal().string();
+  const auto actions = temp_dir_ / "actions.txt";
+  {
+    std::ofstream file(actions);
+    const auto write = [&file](const Step& step) {
+      if (const auto* a = std::get_if<ActionStep>(&step.action)) file << a->text << '\n';
+    };
+    for (const auto* phase : {&scenario_.setup, &scenario_.steps, &scenario_.teardown})
+      for (const auto& step : *phase)
+        write(step);
+    for (const auto& s : scenario_.schedule)
+      write(s.step);
+    if (!file) {
+      out_.error = "cannot write the actions file " + actions.string();
+      return false;
+    }
+  }
+  values["actions"] = actions.string();
+  ExecOptions o;
+  try {
+    o.command = substitute_placeholders(*command, values);
+  } catch (const std::invalid_argument& e) {
+    out_.error = "the client command '" + *command + "': " + e.what();
+    return false;
+  }
+  o.environment = values;
+  if (exec != nullptr) o.startup_timeout = exec->startup_timeout;
+  client_ = make_exec_session(context_, std::move(o), timeline_);
   return true;
 }
 
@@ -217,7 +399,7 @@ void ReferenceRun::start_schedule() {
     const std::size_t index = schedule_base_ + j;
     const Anchor& when = scenario_.schedule[j].when;
     const auto fire = [this, index] {
-      if (!ended_) begin_step(index, [](bool) {});
+      if (!ended_ && !steps_over_) begin_step(index, [](bool) {});
     };
     if (!when.event) {
       executor_.call_at(Time(0) + when.offset, [alive = std::weak_ptr<bool>(alive_), fire] {
@@ -306,9 +488,20 @@ void ReferenceRun::finish_later(std::size_t index, bool ok, std::string reason) 
   post([this, index, ok, reason = std::move(reason)] { finish_step(index, ok, reason); });
 }
 
-void ReferenceRun::finish_step(std::size_t index, bool ok, std::string reason) {
+void ReferenceRun::finish_step(std::size_t index, bool ok, std::string reason, bool cut_short) {
   const auto it = running_.find(index);
   if (it == running_.end()) return;  // already ended (a timeout)
+  if (const Step& step = *plan_[index]; step.expect_failure && !cut_short) {
+    if (ok) {
+      reason = "expected to fail, but it succeeded";
+    } else if (!step.failure_contains.empty() &&
+               reason.find(step.failure_contains) == std::string::npos) {
+      reason = "failed, but not with '" + step.failure_contains + "': " + reason;
+    } else {
+      reason = "failed as expected: " + reason;
+    }
+    ok = !ok && reason.starts_with("failed as expected");
+  }
   Running r = std::move(it->second);
   running_.erase(it);
   if (r.timer != 0) executor_.cancel(r.timer);
@@ -408,7 +601,7 @@ void ReferenceRun::time_out(Sequence& seq, const std::string& reason) {
   for (const auto& [index, r] : running_)
     under_way.push_back(index);
   for (const auto index : under_way)
-    finish_step(index, false, reason);
+    finish_step(index, false, reason, true);
 }
 
 void ReferenceRun::sim_tick() {
@@ -467,26 +660,32 @@ void ReferenceRun::sim_tick() {
   });
 }
 
-// The virtual-time driver: runs the executor task by task until `done` or
-// until the next task lies past `deadline` (the clock then stops there).
-// Everything else in a run goes through link::Executor and the transport
-// context, so a real-time driver only has to replace this loop.
 void ReferenceRun::drive(const std::function<bool()>& done, Time deadline) {
-  while (!done() && !stuck_) {
-    const auto next = executor_.next_due();
-    if (!next || *next > deadline) {
-      executor_.run_until(deadline);
-      return;
-    }
-    executor_.run_one();
-    // Something that reschedules itself at the same instant forever would
-    // hang the run; no scenario needs this many tasks.
-    if (++tasks_run_ > kMaxTasks) {
-      stuck_ = true;
-      out_.error = "the run stopped making progress at " + link::format_ms(executor_.now()) +
-                   " (more than " + std::to_string(kMaxTasks) + " tasks)";
-    }
+  if (stuck_) return;
+  if (auto error = driver_->drive(done, deadline)) {
+    stuck_ = true;
+    out_.error = *error;
   }
+}
+
+// An external program's shutdown is part of the run: it should stop the
+// car and hang up once its input closes (docs/client-contract.md).
+void ReferenceRun::stop_external_client() {
+  const auto finished = [this] { return client_->finished(); };
+  client_->stop();
+  drive(finished, executor_.now() + kExitGrace);
+  if (finished()) return;
+  timeline_.add(Source::client, "notice",
+                {{"text", "the client did not exit within " + seconds_text(kExitGrace) +
+                              " of its input closing: sent SIGTERM"}});
+  client_->terminate(false);
+  drive(finished, executor_.now() + kTermGrace);
+  if (finished()) return;
+  timeline_.add(
+      Source::client, "notice",
+      {{"text", "the client ignored SIGTERM for " + seconds_text(kTermGrace) + ": sent SIGKILL"}});
+  client_->terminate(true);
+  drive(finished, executor_.now() + kTermGrace);
 }
 
 void ReferenceRun::run() {
@@ -512,6 +711,8 @@ void ReferenceRun::run() {
 }
 
 void ReferenceRun::end() {
+  steps_over_ = true;
+  if (external_) stop_external_client();
   ended_ = true;
   const Time run_end = executor_.now();
   // Scheduled steps still under way (a wait_until that never matched) end
@@ -520,21 +721,37 @@ void ReferenceRun::end() {
   for (const auto& [index, r] : running_)
     under_way.push_back(index);
   for (const auto index : under_way)
-    finish_step(index, false, "still under way when the run ended");
+    finish_step(index, false, "still under way when the run ended", true);
   for (std::size_t i = schedule_base_; i < out_.steps.size(); ++i) {
     if (!out_.steps[i].ran) out_.steps[i].reason = "not run: its moment never came";
   }
   timeline_.close();
   if (sim_timer_ != 0) executor_.cancel(sim_timer_);
-  client_->stop();
+  if (!external_) client_->stop();
   server_->close();
-  drive([] { return false; }, run_end);  // what the closes cause, outside the timeline
+  // What the closes cause, outside the timeline (a moment of real time for
+  // sockets to finish closing).
+  drive([] { return false; }, driver_->real_time() ? run_end + milliseconds(20) : run_end);
 
   out_.timeline = timeline_.take();
   out_.arena = car_->world().arena();
   out_.trajectories = recorder_.trajectories();
   out_.run_time = run_end;
-  out_.expectations = check_all(scenario_.expectations, out_.timeline, run_end);
+  auto expectations = scenario_.expectations;
+  if (external_) {
+    // Unless the scenario says what the exit should be, a clean one.
+    const bool said = std::any_of(expectations.begin(), expectations.end(), [](const auto& e) {
+      return e.what.source == Source::client && e.what.kind == "exit";
+    });
+    if (!said) {
+      Expectation exit;
+      exit.label = "the client exited with code 0 after its input closed";
+      exit.what = Matcher{
+          Source::client, "exit", {FieldTest{"code", FieldTest::Op::equals, 0}}, "client exit 0"};
+      expectations.push_back(std::move(exit));
+    }
+  }
+  out_.expectations = check_all(expectations, out_.timeline, run_end);
 }
 
 }  // namespace
@@ -553,14 +770,17 @@ ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options
                       " --seed " + std::to_string(out.seed);
 
   const bool exec = options.client_exec || std::holds_alternative<ExecClient>(scenario.client);
-  if (exec) {
-    out.real_time = true;
-    out.error = "external clients are not supported yet";
-  } else if (std::get<ReferenceClient>(scenario.client).real_time) {
-    out.real_time = true;
-    out.error = "real-time reference runs are not supported yet";
-  } else {
-    ReferenceRun run(scenario, options, out.seed, out);
+  out.real_time = exec || std::get<ReferenceClient>(scenario.client).real_time;
+  // A program that closes its stdin early must not end hil with SIGPIPE;
+  // the write fails with EPIPE instead.
+  if (exec) std::signal(SIGPIPE, SIG_IGN);
+  std::unique_ptr<Driver> driver;
+  if (out.real_time)
+    driver = std::make_unique<RealTimeDriver>();
+  else
+    driver = std::make_unique<VirtualDriver>();
+  {
+    ReferenceRun run(scenario, options, out.seed, out, std::move(driver));
     run.run();
   }
   out.wall_seconds =

@@ -449,14 +449,9 @@ TEST(RunnerOtherCars, AnUnknownActionFailsItsStepWithTheParsersWords) {
 
 // ------------------------------------------------------------------ other
 
-TEST(Runner, ExternalAndRealTimeClientsAreNotSupportedYet) {
+TEST(Runner, AWorldThatCannotBeBuiltIsTheRunsError) {
   Scenario s = scenario(mocks::CarKind::logi, {action("connect")});
-  s.client = ExecClient{"my-client {host} {port}"};
-  EXPECT_EQ(run_scenario(s).error, "external clients are not supported yet");
-  s.client = ReferenceClient{true};
-  EXPECT_EQ(run_scenario(s).error, "real-time reference runs are not supported yet");
   s.world = "/nonexistent/world.yaml";
-  s.client = ReferenceClient{};
   const auto o = run_scenario(s);
   EXPECT_EQ(o.error.rfind("the world cannot be built: ", 0), 0u) << o.error;
   EXPECT_FALSE(o.passed());
@@ -483,6 +478,61 @@ TEST(Runner, TheExampleScenariosPassWithTheReferenceClient) {
     const auto o = run_scenario(s);
     EXPECT_TRUE(o.passed()) << file << ": " << o.first_failure() << "\n" << steps_summary(o);
   }
+}
+
+// ------------------------------------------------------- expected failures
+
+Step must_fail(Step step, std::string contains = "") {
+  step.expect_failure = true;
+  step.failure_contains = std::move(contains);
+  return step;
+}
+
+Matcher never_seen() {
+  return Matcher{Source::client,
+                 "notice",
+                 {{"text", FieldTest::Op::equals, "no such notice"}},
+                 "a notice that never comes"};
+}
+
+TEST(RunnerExpectedFailure, AStepThatFailsAsExpectedPassesAndTheSequenceGoesOn) {
+  Scenario s = scenario(
+      mocks::CarKind::logi,
+      {must_fail(wait_until(never_seen(), seconds(1)), "within 1 s"), wait(milliseconds(10))});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << steps_summary(o);
+  EXPECT_EQ(o.steps[0].reason, "failed as expected: no 'a notice that never comes' within 1 s");
+  EXPECT_TRUE(o.steps[1].ran);
+  EXPECT_EQ(o.steps[1].started, Time(0) + seconds(1));
+}
+
+TEST(RunnerExpectedFailure, FailingForAnotherReasonFailsTheStep) {
+  Scenario s = scenario(mocks::CarKind::logi,
+                        {must_fail(wait_until(never_seen(), seconds(1)), "Not in manual mode")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_FALSE(o.passed());
+  EXPECT_FALSE(o.steps[0].ok);
+  EXPECT_EQ(o.steps[0].reason,
+            "failed, but not with 'Not in manual mode': no 'a notice that never comes' within 1 s");
+}
+
+TEST(RunnerExpectedFailure, SucceedingFailsTheStep) {
+  Scenario s =
+      scenario(mocks::CarKind::logi, {must_fail(wait(milliseconds(10))), wait(seconds(1))});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_FALSE(o.passed());
+  EXPECT_FALSE(o.steps[0].ok);
+  EXPECT_EQ(o.steps[0].reason, "expected to fail, but it succeeded");
+  EXPECT_FALSE(o.steps[1].ran) << "a failed step stops the sequence";
+}
+
+TEST(RunnerExpectedFailure, TheRunTimingOutIsNotTheFailureThatWasExpected) {
+  Scenario s = scenario(mocks::CarKind::logi, {must_fail(wait_until(never_seen(), seconds(60)))});
+  s.timeout = seconds(2);
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_FALSE(o.passed());
+  EXPECT_FALSE(o.steps[0].ok);
+  EXPECT_EQ(o.steps[0].reason, "timed out after 2 s");
 }
 
 }  // namespace

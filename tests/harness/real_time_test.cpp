@@ -1,0 +1,281 @@
+// The runner under the real-time driver: the reference client over real
+// sockets agreeing with its virtual-time run, and external programs driven
+// by the contract in docs/client-contract.md (stdin actions, result and
+// event lines, placeholders, the end of the run). Times here are real, so
+// the tests check order and content, never exact times.
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "harness/runner.hpp"
+#include "harness/scenario_yaml.hpp"
+
+namespace hil::harness {
+namespace {
+
+using link::milliseconds;
+using link::seconds;
+
+Step action(const std::string& text) {
+  return Step{0, text, ActionStep{text}};
+}
+Step wait(Duration d) {
+  return Step{0, "wait", WaitStep{d}};
+}
+
+Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Step> steps) {
+  Scenario s;
+  s.name = "exec";
+  s.car = kind;
+  s.seed = 3;
+  s.client = ExecClient{std::move(command), seconds(10)};
+  s.steps = std::move(steps);
+  s.settle = milliseconds(100);
+  s.timeout = seconds(20);
+  return s;
+}
+
+std::vector<Record> of(const ScenarioOutcome& o, Source source, const std::string& kind) {
+  std::vector<Record> out;
+  for (const auto& r : o.timeline.records())
+    if (r.source == source && r.kind == kind) out.push_back(r);
+  return out;
+}
+
+std::vector<std::string> lines_of(const ScenarioOutcome& o) {
+  std::vector<std::string> out;
+  for (const auto& r : of(o, Source::client, "output"))
+    out.push_back(r.data["line"].get<std::string>());
+  return out;
+}
+
+// The frames the car decoded, in order: what the client made it do.
+std::vector<std::string> received(const ScenarioOutcome& o) {
+  std::vector<std::string> out;
+  for (const auto& r : of(o, Source::wire, "frame"))
+    if (r.data["dir"] == "to_car" && r.data["stage"] == "delivered" && r.data["valid"] == true)
+      out.push_back(r.data["frame"].get<std::string>());
+  return out;
+}
+
+std::string summary(const ScenarioOutcome& o) {
+  std::string s = o.error + "\n";
+  for (const auto& st : o.steps)
+    s += st.phase + " '" + st.text + "' ok=" + (st.ok ? "1" : "0") + " " + st.reason + "\n";
+  for (const auto& e : o.expectations)
+    s += std::string(e.passed ? "met   " : "UNMET ") + e.label + ": " + e.message + "\n";
+  for (const auto& l : lines_of(o))
+    s += "output: " + l + "\n";
+  return s;
+}
+
+// A client in four lines of shell: answers every action with `ok`, and
+// exits when its input closes.
+constexpr const char* kEchoClient = R"(while read -r line; do echo "ok $line"; done)";
+
+TEST(ExternalClient, EachActionLineGetsItsResultAndAFailGivesItsReason) {
+  const std::string client = R"(while read -r line; do
+    case "$line" in
+      press*) echo "[   2.0000000] FAIL $line: Not in manual mode" ;;
+      *) echo "[   1.0000000] ok   $line" ;;
+    esac
+  done)";
+  Scenario s = exec_scenario(mocks::CarKind::logi, client,
+                             {action("speed 50"), action("press FWD"), action("release")});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.error.empty()) << o.error;
+  EXPECT_TRUE(o.real_time);
+  ASSERT_EQ(o.steps.size(), 3u);
+  EXPECT_TRUE(o.steps[0].ok) << summary(o);
+  EXPECT_FALSE(o.steps[1].ok);
+  EXPECT_EQ(o.steps[1].reason, "Not in manual mode");
+  EXPECT_FALSE(o.steps[2].ran) << "the sequence stops at the failed step";
+  EXPECT_FALSE(o.passed());
+
+  const auto exits = of(o, Source::client, "exit");
+  ASSERT_EQ(exits.size(), 1u) << summary(o);
+  EXPECT_EQ(exits[0].data["code"], 0);
+  ASSERT_FALSE(o.expectations.empty());
+  EXPECT_EQ(o.expectations.back().label, "the client exited with code 0 after its input closed");
+  EXPECT_TRUE(o.expectations.back().passed);
+}
+
+TEST(ExternalClient, EventLinesAndOtherOutputAreRecordedForExpectations) {
+  const std::string client = R"(echo "event connection connecting"
+    echo "event connection connected"
+    while read -r line; do
+      echo "event command SP accepted"
+      echo "a line of its own"
+      echo "to stderr" >&2
+      echo "ok $line"
+    done
+    echo "event connection disconnected")";
+  Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
+  Expectation connected;
+  connected.label = "the client said it connected";
+  connected.what = Matcher{
+      Source::client, "connection", {{"state", FieldTest::Op::equals, "connected"}}, "connected"};
+  s.expectations.push_back(connected);
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+
+  const auto states = of(o, Source::client, "connection");
+  ASSERT_EQ(states.size(), 3u);
+  EXPECT_EQ(states[0].data["state"], "connecting");
+  EXPECT_EQ(states[1].data["state"], "connected");
+  EXPECT_EQ(states[2].data["state"], "disconnected");
+  const auto commands = of(o, Source::client, "command");
+  ASSERT_EQ(commands.size(), 1u);
+  EXPECT_EQ(commands[0].data["command"], "SP");
+  EXPECT_EQ(commands[0].data["state"], "accepted");
+  const auto outputs = of(o, Source::client, "output");
+  ASSERT_EQ(outputs.size(), 2u) << summary(o);
+  for (const auto& r : outputs) {
+    if (r.data["stream"] == "stdout")
+      EXPECT_EQ(r.data["line"], "a line of its own");
+    else
+      EXPECT_EQ(r.data["line"], "to stderr");
+  }
+  EXPECT_LT(states[2].at, of(o, Source::client, "exit").at(0).at + milliseconds(1))
+      << "what it printed on the way out is part of the run";
+}
+
+TEST(ExternalClient, PlaceholdersAndEnvironmentGiveTheCarsRealAddress) {
+  // Connects to the car with the placeholders, reports the environment's
+  // copy, and hangs up when its input ends.
+  const std::string client =
+      R"(python3 -c '
+import os, socket, sys
+s = socket.create_connection((sys.argv[1], int(sys.argv[2])))
+print("env", os.environ["HIL_HOST"], os.environ["HIL_PORT"], os.environ["HIL_ENDPOINT"], flush=True)
+print("arg", sys.argv[1], sys.argv[2], flush=True)
+for line in sys.stdin:
+    print("ok", line.strip(), flush=True)
+s.close()
+' {host} {port})";
+  Scenario s =
+      exec_scenario(mocks::CarKind::logi, client, {action("connect"), wait(milliseconds(200))});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+  const auto lines = lines_of(o);
+  ASSERT_EQ(lines.size(), 2u) << summary(o);
+  const auto opens = of(o, Source::wire, "open");
+  ASSERT_EQ(opens.size(), 1u) << "the program reached the mock car";
+  // "arg 127.0.0.1 PORT": a real port, and the same in the environment.
+  ASSERT_EQ(lines[1].rfind("arg 127.0.0.1 ", 0), 0u) << lines[1];
+  const std::string port = lines[1].substr(std::string("arg 127.0.0.1 ").size());
+  EXPECT_GT(std::stoi(port), 0);
+  EXPECT_EQ(lines[0], "env 127.0.0.1 " + port + " tcp://127.0.0.1:" + port);
+  EXPECT_EQ(of(o, Source::wire, "close").size(), 1u);
+}
+
+TEST(ExternalClient, ASerialCarGivesThePathOfItsPty) {
+  const std::string client = R"sh(while read -r line; do
+    if [ -c "$(readlink -f {pty})" ];
+  then echo "ok $line";
+  else echo "fail $line: no pty at {pty}"; fi
+  done)sh";
+  Scenario s = exec_scenario(mocks::CarKind::arduino, client, {action("V")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_TRUE(o.passed()) << summary(o);
+}
+
+TEST(ExternalClient, AProgramThatExitsEarlyFailsTheActionsItOwes) {
+  Scenario s = exec_scenario(mocks::CarKind::logi, "read -r line; exit 3",
+                             {action("speed 50"), action("speed 80")});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.error.empty()) << o.error;
+  EXPECT_FALSE(o.passed());
+  ASSERT_EQ(o.steps.size(), 2u);
+  EXPECT_FALSE(o.steps[0].ok);
+  EXPECT_EQ(o.steps[0].reason, "the client exited with code 3 before answering");
+  const auto exits = of(o, Source::client, "exit");
+  ASSERT_EQ(exits.size(), 1u);
+  EXPECT_EQ(exits[0].data["code"], 3);
+  EXPECT_FALSE(o.expectations.back().passed) << "exit code 3 is not a clean exit";
+}
+
+TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
+  // Ignores SIGTERM (so do the sleeps it starts) and never exits.
+  const std::string client =
+      R"(trap "" TERM; while read -r line; do echo "ok $line"; done; while :; do sleep 0.05; done)";
+  Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.error.empty()) << o.error;
+  EXPECT_TRUE(o.steps[0].ok);
+  EXPECT_FALSE(o.passed());
+  const auto exits = of(o, Source::client, "exit");
+  ASSERT_EQ(exits.size(), 1u) << summary(o);
+  EXPECT_EQ(exits[0].data["signal"], 9);
+  EXPECT_EQ(exits[0].data["killed"], true);
+  const auto notices = of(o, Source::client, "notice");
+  ASSERT_EQ(notices.size(), 2u);
+  EXPECT_EQ(notices[0].data["text"],
+            "the client did not exit within 5 s of its input closing: sent SIGTERM");
+  EXPECT_EQ(notices[1].data["text"], "the client ignored SIGTERM for 2 s: sent SIGKILL");
+  EXPECT_FALSE(o.expectations.back().passed);
+}
+
+TEST(ExternalClient, AnExpectationOnTheExitCodeReplacesTheCleanExitRule) {
+  Scenario s =
+      exec_scenario(mocks::CarKind::logi, R"(while read -r line; do echo "ok $line"; done; exit 4)",
+                    {action("speed 50")});
+  Expectation exit;
+  exit.label = "exits with 4";
+  exit.what = Matcher{Source::client, "exit", {{"code", FieldTest::Op::equals, 4}}, "exit 4"};
+  s.expectations.push_back(exit);
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_TRUE(o.passed()) << summary(o);
+  EXPECT_EQ(o.expectations.size(), 1u);
+}
+
+TEST(ExternalClient, AnUnknownPlaceholderIsAnErrorBeforeAnythingStarts) {
+  Scenario s = exec_scenario(mocks::CarKind::logi, kEchoClient, {action("speed 50")});
+  RunOptions options;
+  options.client_exec = "client --host {hots}";
+  const ScenarioOutcome o = run_scenario(s, options);
+  EXPECT_EQ(o.error,
+            "the client command 'client --host {hots}': column 15: unknown placeholder '{hots}' "
+            "(known: {host}, {port}, {endpoint}, {pty}, {actions}, {scenario})");
+  EXPECT_FALSE(o.passed());
+}
+
+TEST(ExternalClient, TheActionsFileHoldsEveryActionInScenarioOrder) {
+  Scenario s = exec_scenario(mocks::CarKind::logi,
+                             R"(while read -r line; do echo "ok $line"; done; cat {actions})",
+                             {action("speed 50"), wait(milliseconds(10)), action("mode MAN")});
+  s.setup = {action("connect")};
+  s.teardown = {action("disconnect")};
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+  EXPECT_EQ(lines_of(o),
+            (std::vector<std::string>{"connect", "speed 50", "mode MAN", "disconnect"}));
+}
+
+// One scenario, both drivers: the reference client makes the car do the
+// same things in the same order over real TCP as over mem:// in virtual time.
+TEST(RealTimeReference, AgreesWithTheVirtualTimeRunOfTheSameScenario) {
+  Scenario s = load_scenario(std::string(HIL_SOURCE_DIR) + "/scenarios/logi/logi-buttons.yaml");
+  const ScenarioOutcome virtual_run = run_scenario(s);
+  ASSERT_TRUE(virtual_run.passed()) << summary(virtual_run);
+  EXPECT_FALSE(virtual_run.real_time);
+
+  s.client = ReferenceClient{true};
+  const ScenarioOutcome real_run = run_scenario(s);
+  ASSERT_TRUE(real_run.passed()) << summary(real_run);
+  EXPECT_TRUE(real_run.real_time);
+
+  EXPECT_EQ(received(real_run), received(virtual_run));
+  EXPECT_EQ(received(real_run).size(), 20u) << "the twenty buttons";
+  // Each step ran, in both, and real time took at least the waits' 2 s.
+  ASSERT_EQ(real_run.steps.size(), virtual_run.steps.size());
+  for (std::size_t i = 0; i < real_run.steps.size(); ++i)
+    EXPECT_EQ(real_run.steps[i].ok, virtual_run.steps[i].ok) << real_run.steps[i].text;
+  EXPECT_GE(real_run.run_time, seconds(2));
+  EXPECT_GE(real_run.wall_seconds, 2.0);
+}
+
+}  // namespace
+}  // namespace hil::harness
