@@ -168,6 +168,12 @@ std::optional<std::string> BatchReporter::event_line(logi::Time now, const logi:
   return std::nullopt;
 }
 
+bool car_may_be_moving(const logi::LogiClientCore& core) {
+  if (core.held()) return true;
+  const auto& s = core.last_status();
+  return s && (s->running || s->manual != proto::Direction::stop);
+}
+
 // ---- the run ----
 
 namespace {
@@ -235,13 +241,6 @@ class BatchRun {
     shut_down(kExitInterrupted, true);
   }
 
-  bool car_may_be_moving() const {
-    const auto& core = session_->core();
-    if (core.held()) return true;
-    const auto& s = core.last_status();
-    return s && (s->running || s->manual != proto::Direction::stop);
-  }
-
   /// Ends the run: an emergency stop first if asked and the car may be
   /// moving, then disconnect and leave the io_context.
   void shut_down(int code, bool stop_car) {
@@ -250,7 +249,7 @@ class BatchRun {
     exit_code_ = code;
     runner_->cancel();  // no-op when the run already ended
     const bool connected = session_->core().state() == ConnectionState::connected;
-    if (stop_car && connected && car_may_be_moving()) {
+    if (stop_car && connected && car_may_be_moving(session_->core())) {
       print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
             (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
       session_->emergency_stop();

@@ -62,6 +62,10 @@ class BatchReporter {
   std::optional<logi::proto::Status> shown_;
 };
 
+/// Whether the car may be moving as far as the client knows: a direction
+/// held, or the last STAT showing RUN 1 or a manual direction.
+bool car_may_be_moving(const logi::LogiClientCore& core);
+
 /// "[  1.234 s]": the time stamp every line starts with.
 std::string stamp(logi::Time at);
 

@@ -1,0 +1,287 @@
+#include "apps/logi-client/stdin_actions.hpp"
+
+#include <asio/io_context.hpp>
+
+#include <csignal>
+#include <deque>
+#include <memory>
+#include <ostream>
+#include <utility>
+#include <vector>
+
+#include "apps/common/stdin_lines.hpp"
+#include "client/common/operator_text.hpp"
+#include "client/logi/session.hpp"
+#include "link/asio_executor.hpp"
+#include "link/endpoint.hpp"
+#include "link/transport.hpp"
+
+namespace hil::apps::logi_client {
+
+namespace proto = hil::protocol::logi;
+using logi::ConnectionState;
+
+std::optional<std::string> contract_event_line(const logi::Event& event) {
+  if (const auto* c = std::get_if<logi::ConnectionEvent>(&event)) {
+    switch (c->state) {
+      case ConnectionState::disconnected:
+        return "event connection disconnected";
+      case ConnectionState::connecting:
+        return "event connection connecting";
+      case ConnectionState::connected:
+        return "event connection connected";
+      case ConnectionState::waiting_to_reconnect:
+        return "event connection reconnecting";
+    }
+    return std::nullopt;
+  }
+  if (const auto* c = std::get_if<logi::CommandEvent>(&event)) {
+    return "event command " + proto::kind_of(c->command) + " " +
+           std::string(logi::to_string(c->state));
+  }
+  if (const auto* s = std::get_if<logi::StaleEvent>(&event)) {
+    return s->stale ? "event stale" : "event fresh";
+  }
+  if (const auto* n = std::get_if<logi::NoticeEvent>(&event)) {
+    // One event is one line, whatever the text holds.
+    std::string text = n->text;
+    for (char& ch : text)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    return "event notice " + text;
+  }
+  return std::nullopt;
+}
+
+ActionLine parse_action_line(int number, std::string_view line) {
+  ActionLine out;
+  out.text = std::string(client::trim(line.substr(0, line.find('#')), " \t\r\v\f"));
+  const auto parsed = logi::parse_operator_action(line);
+  if (parsed.error) {
+    if (out.text.empty()) out.text = std::string(client::trim(line, " \t\r\v\f"));
+    out.error = "column " + std::to_string(parsed.error->column) + ": " + parsed.error->message;
+    return out;
+  }
+  if (parsed.action) out.step = logi::OperatorStep{number, out.text, *parsed.action};
+  return out;
+}
+
+namespace {
+
+/// The program's run: stdin lines in, one runner per action, the session,
+/// signals, and the way out.
+class StdinActionsRun {
+ public:
+  StdinActionsRun(const BatchOptions& options, std::ostream& out, std::ostream& err)
+      : options_(options),
+        out_(out),
+        err_(err),
+        signals_(io_),
+        input_(io_, StdinLines::Handlers{
+                        [this](std::string line) { on_line(std::move(line)); },
+                        [this](std::string rest) { on_input_end(std::move(rest)); },
+                        [this] { return !stopping_; },
+                    }) {
+    logi::ClientConfig config;
+    config.keepalive = options.keepalive;
+    session_ = std::make_unique<logi::LogiSession>(
+        context_, link::TcpEndpoint{options.host, options.port}, config,
+        [this](logi::Time now, const logi::Event& e) { on_event(now, e); });
+  }
+
+  int run() {
+    signals_.on_next([this](int signal) { on_signal(signal); });
+    input_.start();
+    io_.run();
+    input_.stop();
+    if (!options_.log_path.empty()) {
+      std::string error;
+      if (!write_log(*session_->log(), options_.log_path, error)) {
+        err_ << "logi-client: " << error << '\n';
+      }
+    }
+    out_.flush();
+    return exit_code_;
+  }
+
+ private:
+  // Every line is flushed at once: a program on the other end of a pipe
+  // (hil) waits for it.
+  void print(const std::string& line) { out_ << line << std::endl; }
+
+  void on_line(std::string line) {
+    pending_.push_back(std::move(line));
+    schedule_next();
+  }
+
+  void on_input_end(std::string rest) {
+    if (!rest.empty()) pending_.push_back(std::move(rest));
+    input_ended_ = true;
+    schedule_next();
+  }
+
+  void schedule_next() {
+    if (busy_ || next_posted_ || stopping_) return;
+    next_posted_ = true;
+    executor_.post([this] {
+      next_posted_ = false;
+      run_next();
+    });
+  }
+
+  /// Starts the next action; answers the lines that do not parse on the
+  /// way; after the last line of ended input, shuts down.
+  void run_next() {
+    if (busy_ || stopping_) return;
+    while (!pending_.empty()) {
+      const std::string line = std::move(pending_.front());
+      pending_.pop_front();
+      ++line_number_;
+      auto parsed = parse_action_line(line_number_, line);
+      if (!parsed.error.empty()) {
+        logi::ActionResult failed;
+        failed.line = line_number_;
+        failed.text = parsed.text;
+        failed.reason = parsed.error;
+        failed.started = failed.ended = executor_.now();
+        print(BatchReporter::result_line(failed));
+        continue;
+      }
+      if (!parsed.step) continue;  // blank or comment: not an action, no result
+      start(std::move(*parsed.step));
+      return;
+    }
+    if (input_ended_) shut_down(kExitOk, true);
+  }
+
+  void start(logi::OperatorStep step) {
+    busy_ = true;
+    const bool is_confirm = std::holds_alternative<logi::op::Confirm>(step.action);
+    std::vector<logi::OperatorStep> steps;
+    steps.push_back(std::move(step));
+    runner_ = std::make_unique<logi::OperatorRunner>(
+        *session_, executor_, std::move(steps), options_.runner,
+        [this](const logi::ActionResult& r) { print(BatchReporter::result_line(r)); },
+        [this](const logi::RunSummary&) {
+          // Leave the runner's callback before it is destroyed.
+          executor_.post([this] {
+            if (stopping_) return;
+            runner_.reset();
+            busy_ = false;
+            run_next();
+          });
+        });
+    if (is_confirm && confirmable_) {
+      // Each action has its own runner; the one for `confirm` learns which
+      // request went unanswered from the event that said so.
+      runner_->on_event(executor_.now(), *confirmable_);
+      confirmable_.reset();
+    }
+    runner_->start();
+  }
+
+  void on_event(logi::Time now, const logi::Event& e) {
+    if (auto line = reporter_.event_line(now, e)) print(*line);
+    if (auto line = contract_event_line(e)) print(*line);
+    if (const auto* c = std::get_if<logi::CommandEvent>(&e)) {
+      if (c->state == logi::CommandState::uncertain && c->resend_on_confirm) confirmable_ = e;
+    } else if (const auto* conn = std::get_if<logi::ConnectionEvent>(&e)) {
+      if (conn->state != ConnectionState::connected) confirmable_.reset();
+    }
+    if (runner_) runner_->on_event(now, e);
+  }
+
+  void on_signal(int signal) {
+    if (stopping_) {
+      // A signal while shutting down: out now, without waiting for the car.
+      print(stamp(executor_.now()) + " interrupted again: leaving at once");
+      exit_code_ = kExitInterrupted;
+      io_.stop();
+      return;
+    }
+    print(stamp(executor_.now()) + " interrupted (" + (signal == SIGTERM ? "SIGTERM" : "SIGINT") +
+          "): stopping");
+    signals_.on_next([this](int s) { on_signal(s); });
+    shut_down(kExitInterrupted, true);
+  }
+
+  /// Ends the run: the action under way and the lines not begun (only
+  /// when interrupted) fail as cancelled; an emergency stop if asked and
+  /// the car may be moving; then disconnect and leave the io_context.
+  void shut_down(int code, bool stop_car) {
+    if (stopping_) return;
+    stopping_ = true;
+    exit_code_ = code;
+    input_.stop();
+    if (runner_) runner_->cancel();  // reports the action under way as cancelled
+    // Lines received but not begun are answered too: one result per line.
+    for (; !pending_.empty(); pending_.pop_front()) {
+      const auto parsed = parse_action_line(++line_number_, pending_.front());
+      if (!parsed.step && parsed.error.empty()) continue;
+      logi::ActionResult cancelled;
+      cancelled.line = line_number_;
+      cancelled.text = parsed.text;
+      cancelled.reason = parsed.error.empty() ? "cancelled" : parsed.error;
+      cancelled.started = cancelled.ended = executor_.now();
+      print(BatchReporter::result_line(cancelled));
+    }
+    const bool connected = session_->core().state() == ConnectionState::connected;
+    if (stop_car && connected && car_may_be_moving(session_->core())) {
+      print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
+            (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
+      session_->emergency_stop();
+      // Wait for the car's answers (or their timeouts), within a bound
+      // that keeps the whole way out under hil's 5 s.
+      stop_deadline_ = executor_.now() + link::seconds(3);
+      poll_stop();
+      return;
+    }
+    finish();
+  }
+
+  void poll_stop() {
+    const auto& core = session_->core();
+    const bool settled = core.in_flight() == 0 && core.queued() == 0;
+    if (settled || core.state() != ConnectionState::connected ||
+        executor_.now() >= stop_deadline_) {
+      finish();
+      return;
+    }
+    executor_.call_after(link::milliseconds(10), [this] { poll_stop(); });
+  }
+
+  void finish() {
+    session_->disconnect();
+    signals_.cancel();
+    executor_.post([this] { io_.stop(); });
+  }
+
+  const BatchOptions& options_;
+  std::ostream& out_;
+  std::ostream& err_;
+  asio::io_context io_;
+  link::AsioExecutor executor_{io_};
+  link::TransportContext context_{executor_, &io_};
+  StopSignals signals_;
+  StdinLines input_;
+  std::unique_ptr<logi::LogiSession> session_;
+  std::unique_ptr<logi::OperatorRunner> runner_;
+  BatchReporter reporter_;
+  std::deque<std::string> pending_;
+  std::optional<logi::Event> confirmable_;
+  int line_number_ = 0;
+  bool busy_ = false;
+  bool next_posted_ = false;
+  bool input_ended_ = false;
+  bool stopping_ = false;
+  int exit_code_ = kExitOk;
+  logi::Time stop_deadline_{0};
+};
+
+}  // namespace
+
+int run_stdin_actions(const BatchOptions& options, std::ostream& out, std::ostream& err) {
+  StdinActionsRun run(options, out, err);
+  return run.run();
+}
+
+}  // namespace hil::apps::logi_client
