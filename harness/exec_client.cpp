@@ -162,6 +162,9 @@ class ExecSession final : public ReferenceSession {
     queue_write(text + "\n");
   }
 
+  // Lines go out as the scenario reaches them; results come back in order.
+  bool concurrent() const override { return true; }
+
   void cancel() override {
     // Results still owed for these actions must not be taken for later ones.
     ignore_results_ += pending_.size();

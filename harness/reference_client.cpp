@@ -61,25 +61,38 @@ class LogiReference final : public ReferenceSession {
       return;
     }
     retired_.clear();
-    const std::uint64_t generation = ++generation_;
+    // Each action has a runner of its own, so a scheduled one (an
+    // emergency stop) goes out beside the action under way; an uncertain
+    // request one runner saw is confirmable by the next.
+    client::logi::OperatorRunnerOptions options;
+    options.confirmable = confirmable_;
+    if (std::holds_alternative<client::logi::op::Confirm>(*parsed.action)) confirmable_.reset();
+    const std::uint64_t id = ++next_id_;
     std::vector<client::logi::OperatorStep> steps{{1, text, *parsed.action}};
     auto result = std::make_shared<client::logi::ActionResult>();
-    current_ = std::make_unique<client::logi::OperatorRunner>(
-        session_, executor_, std::move(steps), client::logi::OperatorRunnerOptions{},
+    auto runner = std::make_unique<client::logi::OperatorRunner>(
+        session_, executor_, std::move(steps), options,
         [result](const client::logi::ActionResult& r) { *result = r; },
-        [this, generation, result, done](const client::logi::RunSummary&) {
-          if (generation != generation_) return;
+        [this, id, result, done](const client::logi::RunSummary&) {
+          const auto it = running_.find(id);
+          if (it == running_.end()) return;           // cancelled
+          retired_.push_back(std::move(it->second));  // it is still on the stack
+          running_.erase(it);
           later(executor_, alive_, [result, done] { done(result->ok, result->reason); });
         });
-    current_->start();
+    auto* started = runner.get();
+    running_.emplace(id, std::move(runner));
+    started->start();
   }
 
+  bool concurrent() const override { return true; }
+
   void cancel() override {
-    ++generation_;
-    if (current_) {
-      current_->cancel();
-      retired_.push_back(std::move(current_));
+    for (auto& [id, runner] : running_) {
+      runner->cancel();
+      retired_.push_back(std::move(runner));
     }
+    running_.clear();
   }
 
   void stop() override {
@@ -124,15 +137,28 @@ class LogiReference final : public ReferenceSession {
             [](const cl::FeedbackEvent&) {},  // so are the FB frames
         },
         event);
-    if (current_) current_->on_event(now, event);
+    namespace cl = client::logi;
+    if (const auto* c = std::get_if<cl::CommandEvent>(&event);
+        c != nullptr && c->state == cl::CommandState::uncertain && c->resend_on_confirm)
+      confirmable_ = c->request;
+    if (const auto* c = std::get_if<cl::ConnectionEvent>(&event);
+        c != nullptr && c->state != cl::ConnectionState::connected)
+      confirmable_.reset();
+    // A runner may end (and leave running_) while it hears the event.
+    std::vector<std::uint64_t> ids;
+    for (const auto& [id, runner] : running_)
+      ids.push_back(id);
+    for (const auto id : ids)
+      if (const auto it = running_.find(id); it != running_.end()) it->second->on_event(now, event);
   }
 
   link::Executor& executor_;
   RunTimeline& timeline_;
   client::logi::LogiSession session_;
-  std::unique_ptr<client::logi::OperatorRunner> current_;
+  std::map<std::uint64_t, std::unique_ptr<client::logi::OperatorRunner>> running_;
   std::vector<std::unique_ptr<client::logi::OperatorRunner>> retired_;
-  std::uint64_t generation_ = 0;
+  std::optional<client::logi::RequestId> confirmable_;
+  std::uint64_t next_id_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

@@ -29,9 +29,13 @@ class ReferenceSession {
   /// Leka); nothing for the others.
   virtual void start() {}
   /// Carries out one operator action; `done` runs once when it ends, on a
-  /// later executor turn or at once. One action at a time.
+  /// later executor turn or at once.
   virtual void execute(const std::string& text, Done done) = 0;
-  /// Abandons the action under way; its `done` is not called.
+  /// Whether execute() may be called again before an earlier action
+  /// ended (a scheduled action beside the sequence's); otherwise the
+  /// runner hands actions over one at a time.
+  virtual bool concurrent() const { return false; }
+  /// Abandons the actions under way; their `done` is not called.
   virtual void cancel() = 0;
   /// Closes the connection at the end of the run (no reconnect).
   virtual void stop() = 0;

@@ -245,7 +245,7 @@ class ReferenceRun {
   Sequence teardown_;
   std::map<std::size_t, Running> running_;
   std::deque<std::size_t> actions_;
-  std::optional<std::size_t> action_under_way_;
+  std::size_t actions_under_way_ = 0;
   std::multimap<std::string, std::size_t> obstacles_;  // name -> arena obstacle index
   bool ended_ = false;
   bool stuck_ = false;
@@ -577,25 +577,28 @@ void ReferenceRun::obstacle(std::size_t index, const ObstacleStep& step) {
   }
 }
 
+// A client that takes actions side by side gets each at once (a scheduled
+// emergency stop beside the sequence's action); others one at a time.
 void ReferenceRun::pump_actions() {
-  if (action_under_way_ || actions_.empty() || ended_) return;
-  const std::size_t index = actions_.front();
-  actions_.pop_front();
-  action_under_way_ = index;
-  const std::string text = std::get<ActionStep>(plan_[index]->action).text;
-  client_->execute(text, [this, index, text](bool ok, const std::string& reason) {
-    action_under_way_.reset();
-    timeline_.add(Source::client, "action",
-                  {{"index", index}, {"text", text}, {"ok", ok}, {"reason", reason}});
-    finish_step(index, ok, reason);
-    pump_actions();
-  });
+  while (!actions_.empty() && !ended_ && (actions_under_way_ == 0 || client_->concurrent())) {
+    const std::size_t index = actions_.front();
+    actions_.pop_front();
+    ++actions_under_way_;
+    const std::string text = std::get<ActionStep>(plan_[index]->action).text;
+    client_->execute(text, [this, index, text](bool ok, const std::string& reason) {
+      --actions_under_way_;
+      timeline_.add(Source::client, "action",
+                    {{"index", index}, {"text", text}, {"ok", ok}, {"reason", reason}});
+      finish_step(index, ok, reason);
+      pump_actions();
+    });
+  }
 }
 
 void ReferenceRun::time_out(Sequence& seq, const std::string& reason) {
   skip_rest(seq, reason);
   client_->cancel();
-  action_under_way_.reset();
+  actions_under_way_ = 0;
   actions_.clear();
   std::vector<std::size_t> under_way;
   for (const auto& [index, r] : running_)

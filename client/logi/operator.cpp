@@ -202,7 +202,8 @@ OperatorRunner::OperatorRunner(LogiSession& session, link::Executor& executor,
       steps_(std::move(steps)),
       options_(options),
       on_result_(std::move(on_result)),
-      on_done_(std::move(on_done)) {}
+      on_done_(std::move(on_done)),
+      last_confirmable_(options_.confirmable) {}
 
 OperatorRunner::~OperatorRunner() {
   *alive_ = false;

@@ -141,6 +141,10 @@ struct OperatorRunnerOptions {
   link::Duration connect_timeout = link::seconds(10);
   /// Go on after a failed action (the run still reports failure).
   bool continue_on_error = false;
+  /// An uncertain ST:RUN or GS seen before this runner started, for its
+  /// `confirm` (a program that runs one runner per action keeps it between
+  /// them).
+  std::optional<RequestId> confirmable;
 };
 
 /// Executes operator actions one after another on a LogiSession. Feed it

@@ -535,5 +535,56 @@ TEST(RunnerExpectedFailure, TheRunTimingOutIsNotTheFailureThatWasExpected) {
   EXPECT_EQ(o.steps[0].reason, "timed out after 2 s");
 }
 
+// ----------------------------------------------- actions beside each other
+
+std::vector<Time> received_at(const ScenarioOutcome& o, const std::string& frame) {
+  std::vector<Time> out;
+  for (const auto& r : wire(o, "to_car", "delivered"))
+    if (r.data["frame"] == frame && r.data["valid"] == true) out.push_back(r.at);
+  return out;
+}
+
+TEST(RunnerConcurrentActions, AScheduledEmergencyStopGoesOutBesideAnActionUnderWay) {
+  // The car swallows SP, so `speed 60` waits through its retries for
+  // seconds; the emergency stop scheduled 300 ms into it must not wait.
+  Scenario s = scenario(mocks::CarKind::logi,
+                        {action("connect"), action("mode MAN"),
+                         car("swallow SP", mocks::Ignore{"SP", std::nullopt, std::nullopt}),
+                         must_fail(action("speed 60")), wait(milliseconds(100))});
+  const Matcher speed_starts{
+      Source::step, "start", {{"text", FieldTest::Op::equals, "speed 60"}}, "speed 60 starts"};
+  s.schedule.push_back(ScheduledStep{Anchor{speed_starts, 1, milliseconds(300)}, action("estop")});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
+
+  const auto speed = step_time(o, "start", "speed 60");
+  ASSERT_TRUE(speed);
+  const auto stops = received_at(o, "MV:STOP");
+  ASSERT_FALSE(stops.empty());
+  EXPECT_EQ(stops.front(), *speed + milliseconds(300));
+  const auto speed_end = step_time(o, "end", "speed 60");
+  ASSERT_TRUE(speed_end);
+  EXPECT_GT(*speed_end, stops.front() + seconds(1)) << "the SP was still under way";
+  const auto estop_end = step_time(o, "end", "estop");
+  ASSERT_TRUE(estop_end);
+  EXPECT_LT(*estop_end, *speed_end);
+}
+
+TEST(RunnerConcurrentActions, ConfirmResendsTheUncertainRunOfAnEarlierStep) {
+  Scenario s =
+      scenario(mocks::CarKind::logi,
+               {action("connect"), action("speed 50"), action("mode AUTO"), action("station 1"),
+                car("swallow ST:RUN", mocks::Ignore{"ST:RUN", 1, std::nullopt}),
+                must_fail(action("run"), "uncertain"), action("confirm"), wait(milliseconds(100))});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
+  const auto confirm = step_time(o, "start", "confirm");
+  ASSERT_TRUE(confirm);
+  const auto runs = received_at(o, "ST:RUN");
+  ASSERT_EQ(runs.size(), 2u)
+      << "one swallowed (ST:RUN is not retried by itself), then the confirmed resend";
+  EXPECT_EQ(runs.back(), *confirm);
+}
+
 }  // namespace
 }  // namespace hil::harness
