@@ -111,7 +111,14 @@ std::optional<ClientLine> event_line(std::string_view rest) {
 }
 
 std::string exit_text(const nlohmann::json& exit) {
-  if (exit.contains("code")) return "the client exited with code " + exit["code"].dump();
+  if (exit.contains("code")) {
+    // The shell's own codes for a command it could not run.
+    const int code = exit["code"].get<int>();
+    return "the client exited with code " + std::to_string(code) +
+           (code == 127   ? " (the shell found no such command)"
+            : code == 126 ? " (the command is not executable)"
+                          : "");
+  }
   return "the client was ended by signal " + exit.value("signal", nlohmann::json(0)).dump();
 }
 

@@ -218,6 +218,18 @@ TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
   EXPECT_FALSE(o.expectations.back().passed);
 }
 
+TEST(ExternalClient, ACommandThatDoesNotExistSaysSo) {
+  Scenario s =
+      exec_scenario(mocks::CarKind::logi, "./no-such-client {host} {port}", {action("connect")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_FALSE(o.passed());
+  EXPECT_EQ(o.steps[0].reason,
+            "the client exited with code 127 (the shell found no such command) before answering");
+  const auto lines = lines_of(o);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("no-such-client"), std::string::npos) << "the shell's own words";
+}
+
 TEST(ExternalClient, AnExpectationOnTheExitCodeReplacesTheCleanExitRule) {
   Scenario s =
       exec_scenario(mocks::CarKind::logi, R"(while read -r line; do echo "ok $line"; done; exit 4)",
