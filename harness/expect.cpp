@@ -92,6 +92,8 @@ std::string op_text(FieldTest::Op op) {
       return ">";
     case FieldTest::Op::greater_equal:
       return ">=";
+    case FieldTest::Op::kind_either_prefix:
+      return "starts with, or is cut short of,";
   }
   return "?";
 }
@@ -203,15 +205,32 @@ bool json_equal(const Json& a, const Json& b) {
   return a == b;
 }
 
+/// The record's value of `field`: a key of its data, or a path into an
+/// object of it ("fields.percent"); nullptr when there is none.
+const Json* field_of(const Record& record, const std::string& field) {
+  if (!record.data.is_object()) return nullptr;
+  if (const auto it = record.data.find(field); it != record.data.end()) return &*it;
+  const Json* at = &record.data;
+  std::size_t from = 0;
+  while (true) {
+    const auto dot = field.find('.', from);
+    if (!at->is_object()) return nullptr;
+    const auto it = at->find(field.substr(from, dot == std::string::npos ? dot : dot - from));
+    if (it == at->end()) return nullptr;
+    at = &*it;
+    if (dot == std::string::npos) return at;
+    from = dot + 1;
+  }
+}
+
 bool test_holds(const FieldTest& test, const Record& record) {
   Json kind_value;
   const Json* value = nullptr;
   if (test.field == "kind") {
     kind_value = record.kind;
     value = &kind_value;
-  } else if (record.data.is_object()) {
-    const auto it = record.data.find(test.field);
-    if (it != record.data.end()) value = &*it;
+  } else {
+    value = field_of(record, test.field);
   }
   if (value == nullptr) return test.op == FieldTest::Op::not_equals;
 
@@ -224,6 +243,12 @@ bool test_holds(const FieldTest& test, const Record& record) {
       return value->is_string() && test.value.is_string() &&
              mocks::kind_matches(test.value.get_ref<const std::string&>(),
                                  value->get_ref<const std::string&>());
+    case FieldTest::Op::kind_either_prefix: {
+      if (!value->is_string() || !test.value.is_string()) return false;
+      const auto& wanted = test.value.get_ref<const std::string&>();
+      const auto& got = value->get_ref<const std::string&>();
+      return mocks::kind_matches(wanted, got) || (!got.empty() && mocks::kind_matches(got, wanted));
+    }
     case FieldTest::Op::contains:
       return value->is_string() && test.value.is_string() &&
              value->get_ref<const std::string&>().find(test.value.get_ref<const std::string&>()) !=
@@ -248,6 +273,23 @@ bool same_source_and_kind(const Matcher& matcher, const Record& record) {
   return record.source == matcher.source && (matcher.kind.empty() || record.kind == matcher.kind);
 }
 
+/// Tests that say which records a matcher is about rather than what they
+/// must hold: a wire frame's direction, stage and kind. `always` judges
+/// every STAT the client received, not every frame on the wire.
+bool selects(const Matcher& matcher, const FieldTest& test) {
+  return matcher.source == Source::wire &&
+         (test.field == "dir" || test.field == "stage" || test.field == "frame");
+}
+
+/// The records `always` judges: the matcher's source and kind, and its
+/// selecting tests.
+bool judged_by(const Matcher& matcher, const Record& record) {
+  if (!same_source_and_kind(matcher, record)) return false;
+  return std::all_of(matcher.tests.begin(), matcher.tests.end(), [&](const FieldTest& test) {
+    return !selects(matcher, test) || test_holds(test, record);
+  });
+}
+
 /// What a failing record had in the fields its tests looked at.
 std::string failed_fields_text(const Matcher& matcher, const Record& record) {
   std::string text;
@@ -256,8 +298,8 @@ std::string failed_fields_text(const Matcher& matcher, const Record& record) {
     if (!text.empty()) text += ", ";
     if (test.field == "kind") {
       text += "kind = " + Json(record.kind).dump();
-    } else if (record.data.is_object() && record.data.contains(test.field)) {
-      text += test.field + " = " + record.data.at(test.field).dump();
+    } else if (const Json* value = field_of(record, test.field)) {
+      text += test.field + " = " + value->dump();
     } else {
       text += "no " + test.field;
     }
@@ -404,7 +446,7 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
     std::vector<std::size_t> judged;
     std::vector<std::size_t> failing;
     for (std::size_t i = 0; i < records.size(); ++i) {
-      if (!same_source_and_kind(e.what, records[i]) || !in_window(records[i].at)) continue;
+      if (!judged_by(e.what, records[i]) || !in_window(records[i].at)) continue;
       judged.push_back(i);
       if (!matches(e.what, records[i])) failing.push_back(i);
     }

@@ -23,8 +23,8 @@ namespace hil::harness {
 // ---------------------------------------------------------------- matching
 
 /// One test on a record: `field` names a key of the record's data, or
-/// "kind"; prefix matching on frame kinds follows the fault rules' rule
-/// (whole ':'- or '.'-separated parts: "MV" matches "MV:STOP").
+/// "kind", or a key inside an object of it ("fields.percent"); prefix matching on frame kinds
+/// follows the fault rules' rule (whole ':'- or '.'-separated parts: "MV" matches "MV:STOP").
 struct FieldTest {
   enum class Op : std::uint8_t {
     equals,
@@ -35,6 +35,10 @@ struct FieldTest {
     less_equal,
     greater,
     greater_equal,
+    /// Either kind is a whole-part prefix of the other, the record's not
+    /// empty: a frame that did not decode is named only as far as the
+    /// decoder got ("FB" for a damaged "FB:SP").
+    kind_either_prefix,
   };
   std::string field;
   Op op = Op::equals;

@@ -14,8 +14,10 @@
 #include "client/leka/operator.hpp"
 #include "client/logi/operator.hpp"
 #include "client/wr8/operator.hpp"
+#include "harness/timeline_recorder.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/behaviour_yaml.hpp"
+#include "protocol/wr8/profile.hpp"
 
 namespace hil::harness {
 
@@ -165,6 +167,32 @@ const Keys kWireDirections = {"received", "sent_by_client", "sent_by_car", "rece
 // "degraded" and "down" are the Arduino link's own states.
 const Keys kClientStates = {"connected",    "disconnected", "connecting", "authenticating",
                             "reconnecting", "degraded",     "down"};
+// What a wire frame matcher may test besides the frame kind.
+const Keys kFrameKeys = {"valid", "error", "text", "hex", "message", "fields"};
+/// The names the cars' decoded messages give their fields (docs/scenarios.md,
+/// "The timeline"), to catch a misspelt one; a name far from all of them is
+/// let through, for a firmware's extra keys and a WR8 profile's own DATA.
+Keys known_frame_fields(mocks::CarKind car) {
+  switch (car) {
+    case mocks::CarKind::logi:
+      return {"percent",     "station", "speed_percent", "running",  "mode", "manual",
+              "distance_cm", "track",   "deviation",     "obstacle", "rpm"};
+    case mocks::CarKind::wr8: {
+      Keys names = {"text", "device_code", "device_id",  "state",        "coi",
+                    "task", "distance_cm", "angle_deg",  "timestamp_ms", "p",
+                    "i",    "d",           "servo_zero", "code",         "unparsed"};
+      for (const auto& p : protocol::wr8::Profile::default_data_parameters())
+        names.push_back(p.unit.empty() ? p.name : p.name + "_" + p.unit);
+      return names;
+    }
+    case mocks::CarKind::arduino:
+      return {"seq", "pwm", "distance_cm", "angle_deg", "info", "code", "text"};
+    case mocks::CarKind::leka:
+      return {"led", "leds", "rgb", "speed", "left", "right", "id"};
+  }
+  return {};
+}
+
 const Keys kWindowKeys = {"within", "after", "at", "between"};
 const Keys kQuantifierKeys = {"never", "count", "at_least", "at_most", "times", "always"};
 
@@ -645,7 +673,7 @@ class Loader {
                   join(kStepKeys));
     }
     Keys allowed = kStepKeys;
-    allowed.push_back("timeout");
+    allowed.insert(allowed.end(), {"timeout", "expect"});
     allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
     check_keys(n, allowed, where);
     std::string key;
@@ -661,6 +689,7 @@ class Loader {
       fail(n["timeout"], where + ": 'timeout' belongs to wait_until");
     }
     s.text = step_text(n, key);
+    if (auto e = n["expect"]) read_expected_failure(e, where, s);
     const YAML::Node v = n[key];
     if (key == "do") {
       s.action = action(v, where);
@@ -680,6 +709,26 @@ class Loader {
       s.action = obstacle(v, where + ": 'obstacle'");
     }
     return s;
+  }
+
+  /// `expect: fail`, or `expect: {fail: "Not in manual mode"}` when the
+  /// failure's reason must contain a text.
+  void read_expected_failure(const YAML::Node& n, const std::string& where, Step& s) const {
+    const std::string what = where + ": 'expect'";
+    const std::string usage = " must be fail or {fail: \"words the reason contains\"}";
+    if (n.IsScalar()) {
+      if (n.Scalar() != "fail") {
+        fail(n, what + usage + ", got '" + n.Scalar() + "'" + suggestion(n.Scalar(), {"fail"}));
+      }
+      s.expect_failure = true;
+      return;
+    }
+    if (!n.IsMap()) fail(n, what + usage);
+    check_keys(n, {"fail"}, what);
+    if (!n["fail"]) fail(n, what + usage);
+    s.expect_failure = true;
+    const YAML::Node reason = n["fail"];
+    if (!reason.IsNull()) s.failure_contains = scalar(reason, what + ": 'fail'");
   }
 
   ActionStep action(const YAML::Node& n, const std::string& where) const {
@@ -815,7 +864,7 @@ class Loader {
     }
     Keys allowed = kMatcherSources;
     allowed.insert(allowed.end(), kWireDirections.begin(), kWireDirections.end());
-    allowed.insert(allowed.end(), {"valid", "error"});
+    allowed.insert(allowed.end(), kFrameKeys.begin(), kFrameKeys.end());
     if (n["step"]) allowed.push_back("at");
     check_keys(n, allowed, where);
     return matcher(n, where);
@@ -841,8 +890,8 @@ class Loader {
       }
     }
     if (!shorthand.empty()) return wire_matcher(n, where);
-    for (const char* k : {"valid", "error"}) {
-      if (n[k]) fail(n[k], where + ": '" + std::string(k) + "' goes with a wire frame key");
+    for (const auto& k : kFrameKeys) {
+      if (n[k]) fail(n[k], where + ": '" + k + "' goes with a wire frame key");
     }
     if (source.empty()) {
       fail(n, where + ": nothing to match: give one of " + join(kMatcherSources) + " (or " +
@@ -879,7 +928,8 @@ class Loader {
     }
     if (!v.IsMap()) fail(v, where + " must be open, close, or a map like {received: \"MV:STOP\"}");
     Keys allowed = kWireDirections;
-    allowed.insert(allowed.end(), {"valid", "error", "by"});
+    allowed.insert(allowed.end(), kFrameKeys.begin(), kFrameKeys.end());
+    allowed.push_back("by");
     check_keys(v, allowed, where);
     if (v["by"])
       fail(v["by"], where + ": 'by' goes with {wire: close} events, write {wire: close}");
@@ -905,16 +955,22 @@ class Loader {
     const bool delivered = key == "received" || key == "received_by_client";
     m.tests.push_back(test("dir", FieldTest::Op::equals, to_car ? "to_car" : "to_client"));
     m.tests.push_back(test("stage", FieldTest::Op::equals, delivered ? "delivered" : "sent"));
+    std::optional<bool> valid;
+    if (auto v = n["valid"]) valid = boolean(v, "'valid'");
     const std::string what = frame == "*" ? std::string("a frame") : frame;
-    if (frame != "*") m.tests.push_back(test("frame", FieldTest::Op::kind_prefix, frame));
+    // A frame that did not decode is named only as far as the decoder got
+    // (a damaged FB:SP may be "FB"), so asking for invalid frames of a kind
+    // also counts those whose shorter name the kind starts with.
+    const auto kind_op =
+        valid == false ? FieldTest::Op::kind_either_prefix : FieldTest::Op::kind_prefix;
+    if (frame != "*") m.tests.push_back(test("frame", kind_op, frame));
     if (key == "received") m.text = "car received " + what;
     if (key == "sent_by_client") m.text = "client sent " + what;
     if (key == "sent_by_car") m.text = "car sent " + what;
     if (key == "received_by_client") m.text = "client received " + what;
-    if (auto valid = n["valid"]) {
-      const bool b = boolean(valid, "'valid'");
-      m.tests.push_back(test("valid", FieldTest::Op::equals, b));
-      m.text += b ? " (valid)" : " (invalid)";
+    if (valid) {
+      m.tests.push_back(test("valid", FieldTest::Op::equals, *valid));
+      m.text += *valid ? " (valid)" : " (invalid)";
     }
     if (auto error = n["error"]) {
       const std::string e = scalar(error, "'error'");
@@ -922,7 +978,118 @@ class Loader {
       m.tests.push_back(test("error", FieldTest::Op::contains, e));
       m.text += " with error " + e;
     }
+    if (auto t = n["text"]) bytes_test(t, "text", where, m);
+    if (auto h = n["hex"]) bytes_test(h, "hex", where, m);
+    if (auto message = n["message"]) {
+      const std::string text = scalar(message, "'message'");
+      if (text.empty()) fail(message, where + ": 'message' must not be empty");
+      m.tests.push_back(test("message", FieldTest::Op::contains, text));
+      m.text += " with message containing '" + text + "'";
+    }
+    if (auto f = n["fields"]) fields_tests(f, where + ": 'fields'", m);
     return m;
+  }
+
+  /// `text: "..."` (the whole frame) or `text: {contains: "..."}`, and the
+  /// same for `hex`, whose digits are written as the timeline writes them.
+  void bytes_test(const YAML::Node& n, const std::string& key, const std::string& where,
+                  Matcher& m) const {
+    const std::string what = where + ": '" + key + "'";
+    const std::string example = key == "text" ? "\"LOGI:SP:050:D7#\" or {contains: \"SP:050\"}"
+                                              : "\"06 01\" or {contains: \"06 01\"}";
+    bool whole = true;
+    YAML::Node value = n;
+    if (n.IsMap()) {
+      check_keys(n, {"contains"}, what);
+      if (!n["contains"]) fail(n, what + " must be " + example);
+      value.reset(n["contains"]);
+      whole = false;
+    } else if (!n.IsScalar()) {
+      fail(n, what + " must be " + example);
+    }
+    std::string wanted = scalar(value, what);
+    if (wanted.empty()) fail(value, what + " must not be empty");
+    if (key == "hex") wanted = hex_digits(value, wanted, what);
+    m.tests.push_back(test(key, whole ? FieldTest::Op::equals : FieldTest::Op::contains, wanted));
+    m.text += " with " + key + (whole ? " " : " containing ") + "'" + wanted + "'";
+  }
+
+  /// "0601ff", "06 01 FF" -> "06 01 FF", as the timeline writes bytes.
+  std::string hex_digits(const YAML::Node& n, const std::string& text,
+                         const std::string& what) const {
+    std::string digits;
+    for (const char c : text) {
+      if (c == ' ' || c == '\t') continue;
+      const bool hex = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+      if (!hex) fail(n, what + " must be hex digits like \"06 01 FF\", got '" + text + "'");
+      digits += static_cast<char>(c >= 'a' ? c - 'a' + 'A' : c);
+    }
+    if (digits.size() % 2 != 0) fail(n, what + " must be whole bytes (two hex digits each)");
+    std::string out;
+    for (std::size_t i = 0; i < digits.size(); i += 2)
+      out += (i == 0 ? "" : " ") + digits.substr(i, 2);
+    return out;
+  }
+
+  /// `fields: {percent: 50, speed_cmps: {at_least: 20, below: 40}, code: BAD_V}`.
+  void fields_tests(const YAML::Node& n, const std::string& where, Matcher& m) const {
+    if (!n.IsMap() || n.size() == 0) {
+      fail(n, where + " must be a map of field names to values, like {percent: 50}");
+    }
+    static const Keys kOps = {"not", "contains", "below", "above", "at_least", "at_most"};
+    std::set<std::string> seen;
+    std::string text;
+    for (auto it : n) {
+      const std::string name = scalar(it.first, "a field name");
+      if (name.empty() || name.find('.') != std::string::npos) {
+        fail(it.first, where + ": '" + name + "' is not a field name");
+      }
+      if (!seen.insert(name).second) fail(it.first, where + ": '" + name + "' is given twice");
+      if (const Keys known = known_frame_fields(scenario_.car); !contains(known, name)) {
+        if (const auto likely = closest(name, known)) {
+          fail(it.first, where + ": " + car_title(scenario_.car) + " frames have no field '" +
+                             name + "' (they have " + join(known) + "); did you mean '" + *likely +
+                             "'?");
+        }
+      }
+      const std::string field = "fields." + name;
+      const YAML::Node v = it.second;
+      text += (text.empty() ? "" : ", ") + name;
+      if (v.IsScalar()) {
+        m.tests.push_back(test(field, FieldTest::Op::equals, field_value(v.Scalar())));
+        text += " = " + v.Scalar();
+        continue;
+      }
+      if (!v.IsMap() || v.size() == 0) {
+        fail(v, where + ": '" + name + "' must be a value (50, BAD_V) or a map with " + join(kOps));
+      }
+      check_keys(v, kOps, where + ": '" + name + "'");
+      for (auto op : v) {
+        const std::string k = op.first.Scalar();
+        const std::string what = where + ": '" + name + "': '" + k + "'";
+        if (k == "not") {
+          m.tests.push_back(
+              test(field, FieldTest::Op::not_equals, field_value(scalar(op.second, what))));
+          text += " not " + op.second.Scalar();
+        } else if (k == "contains") {
+          m.tests.push_back(test(field, FieldTest::Op::contains, scalar(op.second, what)));
+          text += " containing '" + op.second.Scalar() + "'";
+        } else {
+          const double limit = number(op.second, what);
+          const auto op_of = k == "below"      ? FieldTest::Op::less
+                             : k == "above"    ? FieldTest::Op::greater
+                             : k == "at_least" ? FieldTest::Op::greater_equal
+                                               : FieldTest::Op::less_equal;
+          m.tests.push_back(test(field, op_of, limit));
+          text += (k == "below"      ? " < "
+                   : k == "above"    ? " > "
+                   : k == "at_least" ? " >= "
+                                     : " <= ") +
+                  op.second.Scalar();
+        }
+      }
+    }
+    m.text += " with " + text;
   }
 
   Matcher client_matcher(const YAML::Node& v, const std::string& where) const {
@@ -1232,7 +1399,8 @@ class Loader {
     if (!n.IsMap()) fail(n, where + " must be a step's text or a matcher map");
     Keys allowed = kMatcherSources;
     allowed.insert(allowed.end(), kWireDirections.begin(), kWireDirections.end());
-    allowed.insert(allowed.end(), {"valid", "error", "occurrence", "offset"});
+    allowed.insert(allowed.end(), kFrameKeys.begin(), kFrameKeys.end());
+    allowed.insert(allowed.end(), {"occurrence", "offset"});
     if (n["step"]) allowed.push_back("at");
     check_keys(n, allowed, where);
     Anchor a;
@@ -1267,7 +1435,7 @@ class Loader {
       }
       ScheduledStep s;
       Keys allowed = kStepKeys;
-      allowed.insert(allowed.end(), {"at", "when", "occurrence", "offset", "timeout"});
+      allowed.insert(allowed.end(), {"at", "when", "occurrence", "offset", "timeout", "expect"});
       check_keys(item, allowed, where);
       const auto at = item["at"];
       const auto when = item["when"];
@@ -1322,7 +1490,7 @@ class Loader {
     Keys allowed = {"label"};
     allowed.insert(allowed.end(), kMatcherSources.begin(), kMatcherSources.end());
     allowed.insert(allowed.end(), kWireDirections.begin(), kWireDirections.end());
-    allowed.insert(allowed.end(), {"valid", "error"});
+    allowed.insert(allowed.end(), kFrameKeys.begin(), kFrameKeys.end());
     allowed.insert(allowed.end(), kWindowKeys.begin(), kWindowKeys.end());
     allowed.insert(allowed.end(), kQuantifierKeys.begin(), kQuantifierKeys.end());
     allowed.insert(allowed.end(), {"tolerance", "only"});

@@ -54,7 +54,8 @@ std::string_view to_string(Source source);  ///< "wire", "fault", ...
 /// - client "exit" code and sim "station" are JSON numbers (station 2, not "002");
 ///   sim "sample" fields are numbers in metres, degrees and m/s.
 /// What the reference runner writes on top of the fields above:
-/// - wire "frame": also "bytes" (count), "message" (a valid frame decoded, for a person);
+/// - wire "frame": also "bytes" (count), "message" (a valid frame decoded, for a person),
+///   "fields" (the message's name=value pairs as an object, numbers as numbers; absent when none);
 ///   for an invalid one "error" is the decoder's error kind ("bad_checksum", "garbage",
 ///   "bad_format", "truncated", ...) and "detail" its whole message. "open" {"client", "car"};
 ///   "close" also "mode" ("graceful" | "reset"). A refused connection has no open/close, only

@@ -1,11 +1,109 @@
 #include "harness/timeline_recorder.hpp"
 
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
 #include "link/capture/wire_log.hpp"
 
 namespace hil::harness {
+
+// ------------------------------------------------------------ fields
+
+namespace {
+
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
+
+/// Whole decimal numbers without a leading zero, with or without a
+/// fraction: "0", "50", "-3", "1.5", "0.25"; not "030", "1.", "1e3".
+bool is_decimal(std::string_view t) {
+  std::size_t i = 0;
+  if (i < t.size() && t[i] == '-') ++i;
+  const std::size_t first = i;
+  while (i < t.size() && is_digit(t[i]))
+    ++i;
+  const std::size_t digits = i - first;
+  if (digits == 0 || (digits > 1 && t[first] == '0')) return false;
+  if (i == t.size()) return true;
+  if (t[i] != '.') return false;
+  const std::size_t fraction = ++i;
+  while (i < t.size() && is_digit(t[i]))
+    ++i;
+  return i > fraction && i == t.size();
+}
+
+bool is_name_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || is_digit(c) || c == '_' || c == '-';
+}
+
+}  // namespace
+
+nlohmann::json field_value(std::string_view text) {
+  if (!is_decimal(text)) return std::string(text);
+  if (text.find('.') == std::string_view::npos) {
+    std::int64_t whole = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), whole);
+    if (ec == std::errc() && end == text.data() + text.size()) return whole;
+    return std::string(text);  // too long for a number: the digits are what counts
+  }
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec == std::errc() && end == text.data() + text.size()) return value;
+  return std::string(text);
+}
+
+nlohmann::json message_fields(std::string_view message) {
+  auto fields = nlohmann::json::object();
+  std::size_t i = 0;
+  const std::size_t n = message.size();
+  // A quoted run ends at the next quote no backslash escapes.
+  const auto closing_quote = [&](std::size_t open) {
+    std::size_t j = open + 1;
+    while (j < n && message[j] != '"')
+      j += message[j] == '\\' ? std::size_t{2} : std::size_t{1};
+    return std::min(j, n);
+  };
+  while (i < n) {
+    if (message[i] == ' ') {
+      ++i;
+      continue;
+    }
+    if (message[i] == '"') {  // a quoted word that names nothing (Leka's reply "...")
+      i = closing_quote(i) + 1;
+      continue;
+    }
+    std::size_t j = i;
+    if (message[j] == '+') ++j;  // LOGI's keys the profile does not know: "+BAT=87"
+    const std::size_t name_at = j;
+    while (j < n && is_name_char(message[j]))
+      ++j;
+    if (j == name_at || j >= n || message[j] != '=') {
+      while (i < n && message[i] != ' ')
+        ++i;
+      continue;
+    }
+    const std::string name(message.substr(name_at, j - name_at));
+    ++j;
+    nlohmann::json value;
+    if (j < n && message[j] == '"') {
+      const std::size_t end = closing_quote(j);
+      value = std::string(message.substr(j + 1, end - j - 1));
+      i = end + 1;
+    } else {
+      std::size_t end = j;
+      while (end < n && message[end] != ' ')
+        ++end;
+      value = field_value(message.substr(j, end - j));
+      i = end;
+    }
+    if (!fields.contains(name)) fields[name] = std::move(value);
+  }
+  return fields;
+}
 
 // ------------------------------------------------------------ RunTimeline
 
@@ -102,7 +200,11 @@ void WireRecorder::write_frames(std::size_t stage, Time at, link::Direction d,
     link::put_bytes(data, f.raw);
     data["valid"] = f.valid;
     if (f.valid) {
-      if (!f.text.empty()) data["message"] = f.text;
+      if (!f.text.empty()) {
+        auto fields = message_fields(f.text);
+        if (!fields.empty()) data["fields"] = std::move(fields);
+        data["message"] = f.text;
+      }
     } else {
       data["error"] = error_kind(f.text);
       data["detail"] = f.text;

@@ -10,12 +10,23 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "harness/timeline.hpp"
 #include "link/link.hpp"
 #include "link/protocol_adapter.hpp"
 
 namespace hil::harness {
+
+/// A value of a decoded frame's field as records and matchers hold it: a
+/// decimal number ("50", "-3", "1.5") becomes a JSON number, anything else
+/// ("0101", "BAD_V", "(0,0,255)") stays text, so "0101" keeps its digits.
+nlohmann::json field_value(std::string_view text);
+
+/// The `name=value` pairs of a decoded frame's message ("SetSpeed
+/// percent=50" -> {"percent": 50}); a quoted value (info="OK 3") loses its
+/// quotes and stays text; of a name given twice the first is kept.
+nlohmann::json message_fields(std::string_view message);
 
 /// A Timeline being written during a run: every record gets the clock's time.
 class RunTimeline {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "harness/expect.hpp"
+#include "harness/scenario_yaml.hpp"
 
 namespace hil::harness {
 namespace {
@@ -136,6 +137,160 @@ TEST(ExpectMatches, KindPrefixMatchesWholePartsOnly) {
   // The direction and stage still count.
   EXPECT_FALSE(matches(car_received("MV"), Record{ms(0), Source::wire, "frame",
                                                   frame_data("to_car", "sent", "MV:STOP")}));
+}
+
+/// The first expectation's matcher of a LOGI scenario whose expect list is `expectation`.
+Matcher loaded(const std::string& expectation, const std::string& car = "logi") {
+  const auto s = parse_scenario_text("name: t\ncar: " + car + "\nsteps: [" +
+                                         (car == "arduino" ? "PING" : "connect") +
+                                         "]\nexpect:\n  - " + expectation + "\n",
+                                     "t.yaml");
+  return s.expectations.at(0).what;
+}
+
+Record frame_record(const std::string& dir, const std::string& stage, nlohmann::json data) {
+  data["dir"] = dir;
+  data["stage"] = stage;
+  return Record{ms(0), Source::wire, "frame", std::move(data)};
+}
+
+TEST(ExpectMatches, ADamagedFrameNamedOnlyAsFarAsTheDecoderGotCountsAsInvalidOfTheKind) {
+  const Matcher wanted = loaded("{received_by_client: \"FB:SP\", valid: false}");
+  const auto invalid = [](const std::string& kind) {
+    return frame_record("to_client", "delivered",
+                        {{"frame", kind}, {"valid", false}, {"error", "bad_checksum"}});
+  };
+  EXPECT_TRUE(matches(wanted, invalid("FB")));     // the decoder stopped at the code
+  EXPECT_TRUE(matches(wanted, invalid("FB:SP")));  // or got the whole kind
+  EXPECT_FALSE(matches(wanted, invalid("FB:ST")));
+  EXPECT_FALSE(matches(wanted, invalid("F")));  // whole parts only
+  EXPECT_FALSE(matches(wanted, invalid("")));   // garbage names nothing
+  EXPECT_FALSE(matches(wanted, invalid("STAT")));
+  // A valid FB is not what was asked for.
+  EXPECT_FALSE(matches(
+      wanted, frame_record("to_client", "delivered", {{"frame", "FB:MV"}, {"valid", true}})));
+  // Without valid: false a frame must be named in full: a damaged "FB" could
+  // have been any feedback, so it is no FB:SP the client received.
+  EXPECT_FALSE(matches(loaded("{received_by_client: \"FB:SP\"}"), invalid("FB")));
+}
+
+TEST(ExpectMatches, TextIsTheWholeFrameOrASubstringOfIt) {
+  const Record sp30 = frame_record("to_car", "delivered",
+                                   {{"frame", "SP"}, {"valid", true}, {"text", "LOGI:SP:030:D5#"}});
+  EXPECT_TRUE(matches(loaded("{received: SP, text: \"LOGI:SP:030:D5#\"}"), sp30));
+  EXPECT_FALSE(matches(loaded("{received: SP, text: \"SP:030\"}"), sp30));
+  EXPECT_TRUE(matches(loaded("{received: SP, text: {contains: \"SP:030\"}}"), sp30));
+  EXPECT_FALSE(matches(loaded("{received: SP, text: {contains: \"SP:050\"}}"), sp30));
+}
+
+TEST(ExpectMatches, HexIsComparedInTheTimelinesSpellingWhateverTheScenarioWrote) {
+  const Record data = frame_record("to_client", "delivered",
+                                   {{"frame", "DATA"}, {"valid", true}, {"hex", "06 02 64 00"}});
+  EXPECT_TRUE(matches(loaded("{received_by_client: DATA, hex: \"06026400\"}", "wr8"), data));
+  EXPECT_TRUE(
+      matches(loaded("{received_by_client: DATA, hex: {contains: \"02 64\"}}", "wr8"), data));
+  EXPECT_TRUE(
+      matches(loaded("{received_by_client: DATA, hex: {contains: \"0264\"}}", "wr8"), data));
+  EXPECT_FALSE(
+      matches(loaded("{received_by_client: DATA, hex: {contains: \"64 01\"}}", "wr8"), data));
+}
+
+TEST(ExpectMatches, MessageIsASubstringOfTheDecodedMessage) {
+  const Record fb =
+      frame_record("to_client", "delivered",
+                   {{"frame", "FB:MV"}, {"valid", true}, {"message", "Feedback MV rejected"}});
+  EXPECT_TRUE(matches(loaded("{received_by_client: \"FB:MV\", message: rejected}"), fb));
+  EXPECT_FALSE(matches(loaded("{received_by_client: \"FB:MV\", message: accepted}"), fb));
+}
+
+TEST(ExpectMatches, FieldsCompareEachDecodedFieldByValueOrRange) {
+  const Record data =
+      frame_record("to_client", "delivered",
+                   {{"frame", "DATA"},
+                    {"valid", true},
+                    {"fields", {{"state", "RUN"}, {"speed_mps", 0.3}, {"odometry_cm", 12}}}});
+  const auto holds = [&](const std::string& fields) {
+    return matches(loaded("{received_by_client: DATA, fields: " + fields + "}", "wr8"), data);
+  };
+  EXPECT_TRUE(holds("{state: RUN}"));
+  EXPECT_TRUE(holds("{state: RUN, odometry_cm: 12}"));
+  EXPECT_TRUE(holds("{odometry_cm: 12.0}"));  // a number is a number however it is written
+  EXPECT_FALSE(holds("{state: STOP}"));
+  EXPECT_FALSE(holds("{state: RUN, odometry_cm: 13}"));  // every field must hold
+  EXPECT_TRUE(holds("{speed_mps: {at_least: 0.3, below: 0.5}}"));
+  EXPECT_FALSE(holds("{speed_mps: {above: 0.3}}"));
+  EXPECT_FALSE(holds("{speed_mps: {at_most: 0.29}}"));
+  EXPECT_TRUE(holds("{state: {not: STOP}}"));
+  EXPECT_TRUE(holds("{state: {contains: RU}}"));
+  // A field the frame does not have holds only a 'not'.
+  EXPECT_FALSE(holds("{battery_percent: 100}"));
+  EXPECT_TRUE(holds("{battery_percent: {not: 100}}"));
+}
+
+TEST(ExpectMatches, AFieldWithLeadingZerosIsTextAndMatchesOnlyItsOwnDigits) {
+  const Record stat = frame_record(
+      "to_client", "delivered",
+      {{"frame", "STAT"}, {"valid", true}, {"fields", {{"track", "0110"}, {"station", 2}}}});
+  const auto holds = [&](const std::string& fields) {
+    return matches(loaded("{received_by_client: STAT, fields: " + fields + "}"), stat);
+  };
+  EXPECT_TRUE(holds("{track: 0110}"));
+  EXPECT_TRUE(holds("{track: \"0110\"}"));
+  EXPECT_FALSE(holds("{track: 110}"));
+  EXPECT_TRUE(holds("{station: 2}"));
+  EXPECT_FALSE(holds("{station: \"002\"}"));
+}
+
+TEST(ExpectMatches, AFieldPathWalksIntoObjectsAndAFailureShowsWhatTheRecordHad) {
+  const Record r{ms(0), Source::wire, "frame", {{"fields", {{"percent", 30}}}}};
+  EXPECT_TRUE(
+      matches(Matcher{Source::wire, "", {test_of("fields.percent", Op::equals, 30)}, ""}, r));
+  EXPECT_FALSE(
+      matches(Matcher{Source::wire, "", {test_of("fields.percent.x", Op::equals, 30)}, ""}, r));
+  EXPECT_FALSE(
+      matches(Matcher{Source::wire, "", {test_of("fields.speed", Op::equals, 30)}, ""}, r));
+
+  Timeline t;
+  t.add(r);
+  Expectation e;
+  e.what = Matcher{Source::wire, "frame", {test_of("fields.percent", Op::greater, 50)}, ""};
+  e.quantifier = Quantifier::always;
+  const auto outcome = check(e, t, ms(100));
+  EXPECT_FALSE(outcome.passed);
+  EXPECT_NE(outcome.message.find("fields.percent = 30"), std::string::npos) << outcome.message;
+}
+
+TEST(ExpectAlwaysOnFrames, JudgesOnlyTheFramesOfTheDirectionStageAndKindAsked) {
+  Timeline t;
+  const auto stat = [&](Time at, const std::string& dir, const std::string& stage,
+                        const std::string& mode) {
+    t.add(at, Source::wire, "frame",
+          {{"dir", dir},
+           {"stage", stage},
+           {"frame", "STAT"},
+           {"valid", true},
+           {"fields", {{"mode", mode}}}});
+  };
+  stat(ms(500), "to_client", "sent", "MAN");
+  stat(ms(500), "to_client", "delivered", "MAN");
+  t.add(ms(600), Source::wire, "frame",
+        {{"dir", "to_car"}, {"stage", "delivered"}, {"frame", "MD:AUTO"}, {"valid", true}});
+  stat(ms(1000), "to_client", "sent", "AUTO");  // sent, but lost on the way
+  stat(ms(1500), "to_client", "delivered", "MAN");
+  Expectation e;
+  e.what = loaded("{received_by_client: STAT, fields: {mode: MAN}}");
+  e.quantifier = Quantifier::always;
+  const auto outcome = check(e, t, ms(2000));
+  EXPECT_TRUE(outcome.passed) << outcome.message;
+  EXPECT_NE(outcome.message.find("all 2 did"), std::string::npos) << outcome.message;
+
+  stat(ms(1800), "to_client", "delivered", "AUTO");
+  const auto failed = check(e, t, ms(2000));
+  EXPECT_FALSE(failed.passed);
+  EXPECT_NE(
+      failed.message.find("1 of 3 did not: at 1.800 s (the first had fields.mode = \"AUTO\")"),
+      std::string::npos)
+      << failed.message;
 }
 
 TEST(ExpectMatches, TheFieldKindTestsTheRecordsKind) {

@@ -50,6 +50,15 @@ std::string error_of(const std::string& yaml,
   return "";
 }
 
+/// A step that must succeed, as the loader makes it.
+Step step_of(int line, std::string text, StepAction action) {
+  Step s;
+  s.line = line;
+  s.text = std::move(text);
+  s.action = std::move(action);
+  return s;
+}
+
 Matcher car_received(const std::string& frame) {
   return Matcher{Source::wire,
                  "frame",
@@ -207,7 +216,7 @@ TEST(ScenarioYaml, AMinimalScenarioTakesTheDefaults) {
   EXPECT_EQ(s.client, ClientSpec{ReferenceClient{}});
   EXPECT_TRUE(s.faults.rules.empty());
   ASSERT_EQ(s.steps.size(), 1u);
-  EXPECT_EQ(s.steps[0], (Step{3, "connect", ActionStep{"connect"}}));
+  EXPECT_EQ(s.steps[0], step_of(3, "connect", ActionStep{"connect"}));
   EXPECT_TRUE(s.expectations.empty());
 }
 
@@ -344,9 +353,9 @@ TEST(ScenarioYamlSteps, EveryKindOfStep) {
       "  - obstacle: remove\n"                     // 14
       "  - obstacle: {remove: box}\n");            // 15
   ASSERT_EQ(s.steps.size(), 11u);
-  EXPECT_EQ(s.steps[0], (Step{4, "connect", ActionStep{"connect"}}));
-  EXPECT_EQ(s.steps[1], (Step{5, "speed 50", ActionStep{"speed 50"}}));
-  EXPECT_EQ(s.steps[2], (Step{6, "wait 1500ms", WaitStep{milliseconds(1500)}}));
+  EXPECT_EQ(s.steps[0], step_of(4, "connect", ActionStep{"connect"}));
+  EXPECT_EQ(s.steps[1], step_of(5, "speed 50", ActionStep{"speed 50"}));
+  EXPECT_EQ(s.steps[2], step_of(6, "wait 1500ms", WaitStep{milliseconds(1500)}));
   const auto& until = std::get<WaitUntilStep>(s.steps[3].action);
   EXPECT_EQ(
       until.until,
@@ -422,6 +431,46 @@ TEST(ScenarioYamlSteps, ActionsAreCheckedByEachCarsParser) {
             "prompt, not an operator action");
 }
 
+TEST(ScenarioYamlSteps, AnyStepCanBeExpectedToFailWithAReasonItMustGive) {
+  const auto s = parse(
+      "name: t\n"
+      "car: logi\n"
+      "steps:\n"
+      "  - connect\n"
+      "  - {do: \"press FWD\", expect: fail}\n"
+      "  - do: \"press BWD\"\n"
+      "    expect: {fail: \"Not in manual mode\"}\n"
+      "  - wait_until: {client: stale}\n"
+      "    timeout: 1s\n"
+      "    expect: fail\n"
+      "  - {wait: 1s, expect: {fail: }}\n"
+      "schedule:\n"
+      "  - {at: 2s, do: run, expect: fail}\n");
+  ASSERT_EQ(s.steps.size(), 5u);
+  EXPECT_FALSE(s.steps[0].expect_failure);
+  EXPECT_TRUE(s.steps[1].expect_failure);
+  EXPECT_EQ(s.steps[1].failure_contains, "");
+  EXPECT_EQ(s.steps[1].text, "press FWD");  // step matchers still find it by its text
+  EXPECT_TRUE(s.steps[2].expect_failure);
+  EXPECT_EQ(s.steps[2].failure_contains, "Not in manual mode");
+  EXPECT_TRUE(s.steps[3].expect_failure);
+  EXPECT_EQ(std::get<WaitUntilStep>(s.steps[3].action).timeout, seconds(1));
+  EXPECT_TRUE(s.steps[4].expect_failure);
+  EXPECT_EQ(s.steps[4].failure_contains, "");
+  ASSERT_EQ(s.schedule.size(), 1u);
+  EXPECT_TRUE(s.schedule[0].step.expect_failure);
+
+  const std::string head = "name: t\ncar: logi\nsteps:\n  - ";
+  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: fial}\n"),
+            "t.yaml:4:31: step 1: 'expect' must be fail or {fail: \"words the reason contains\"}, "
+            "got 'fial'; did you mean 'fail'?");
+  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: {fails: x}}\n"),
+            "t.yaml:4:32: step 1: 'expect': unknown key 'fails' (allowed: fail); did you mean "
+            "'fail'?");
+  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: {fail: [a, b]}}\n"),
+            "t.yaml:4:38: step 1: 'expect': 'fail' must be a text or a number, not a list");
+}
+
 TEST(ScenarioYamlSteps, ScheduleAtATimeOrOnAnEvent) {
   const auto s = logi(
       "schedule:\n"
@@ -446,7 +495,7 @@ TEST(ScenarioYamlSteps, ScheduleAtATimeOrOnAnEvent) {
       (Matcher{
           Source::step, "start", {{"text", Op::equals, "release"}}, "step 'release' started"}));
   EXPECT_EQ(s.schedule[2].when.offset, milliseconds(-50));
-  EXPECT_EQ(s.schedule[2].step, (Step{19, "estop", ActionStep{"estop"}}));
+  EXPECT_EQ(s.schedule[2].step, step_of(19, "estop", ActionStep{"estop"}));
   EXPECT_EQ(s.schedule[3].when.occurrence, -1);
   EXPECT_EQ(s.schedule[3].when.event->kind, "stale");
 }
@@ -473,6 +522,92 @@ TEST(ScenarioYamlMatchers, WireDirectionsAndStages) {
                                                {"frame", Op::kind_prefix, "FB:MV"},
                                                {"valid", Op::equals, true}}));
   EXPECT_EQ(matcher_of("{wire: close}"), (Matcher{Source::wire, "close", {}, "link closed"}));
+}
+
+TEST(ScenarioYamlMatchers, FrameContentTextHexMessageAndFields) {
+  const auto sp = matcher_of("{received: SP, text: {contains: \"SP:050\"}}");
+  EXPECT_EQ(sp.tests.back(), (FieldTest{"text", Op::contains, "SP:050"}));
+  EXPECT_EQ(sp.text, "car received SP with text containing 'SP:050'");
+  EXPECT_EQ(matcher_of("{received: SP, text: \"LOGI:SP:050:D7#\"}").tests.back(),
+            (FieldTest{"text", Op::equals, "LOGI:SP:050:D7#"}));
+  // Hex in any spacing and case is written as the timeline writes bytes.
+  EXPECT_EQ(matcher_of("{sent_by_car: STAT, hex: \"4c4f 47\"}").tests.back(),
+            (FieldTest{"hex", Op::equals, "4C 4F 47"}));
+  EXPECT_EQ(matcher_of("{sent_by_car: STAT, hex: {contains: 4c4f}}").tests.back(),
+            (FieldTest{"hex", Op::contains, "4C 4F"}));
+  const auto nack = matcher_of("{received_by_client: \"FB:MV\", message: rejected}");
+  EXPECT_EQ(nack.tests.back(), (FieldTest{"message", Op::contains, "rejected"}));
+  EXPECT_EQ(nack.text, "client received FB:MV with message containing 'rejected'");
+
+  const auto stat = matcher_of(
+      "{received_by_client: STAT, fields: {speed_percent: 50, mode: MAN, track: 0110, "
+      "distance_cm: {at_least: 10, below: 300}, manual: {not: FWD}, rpm: {contains: \"0:0\"}}}");
+  EXPECT_EQ(stat.tests, (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
+                                                {"stage", Op::equals, "delivered"},
+                                                {"frame", Op::kind_prefix, "STAT"},
+                                                {"fields.speed_percent", Op::equals, 50},
+                                                {"fields.mode", Op::equals, "MAN"},
+                                                {"fields.track", Op::equals, "0110"},
+                                                {"fields.distance_cm", Op::greater_equal, 10.0},
+                                                {"fields.distance_cm", Op::less, 300.0},
+                                                {"fields.manual", Op::not_equals, "FWD"},
+                                                {"fields.rpm", Op::contains, "0:0"}}));
+  EXPECT_EQ(stat.text,
+            "client received STAT with speed_percent = 50, mode = MAN, track = 0110, distance_cm "
+            ">= 10 < 300, manual not FWD, rpm containing '0:0'");
+  // The same keys in every place a matcher goes.
+  const auto s = logi(
+      "schedule:\n"
+      "  - when: {received: SP, fields: {percent: 50}}\n"
+      "    car: fault\n"
+      "expect:\n"
+      "  - never: {received: SP, text: {contains: \"SP:100\"}}\n"
+      "  - wire: {received: MD, message: MAN}\n"
+      "    after: {received: SP, hex: {contains: 4C}}\n");
+  EXPECT_EQ(s.schedule[0].when.event->tests.back(), (FieldTest{"fields.percent", Op::equals, 50}));
+  EXPECT_EQ(s.expectations[0].quantifier, Quantifier::never);
+  EXPECT_EQ(s.expectations[1].window.from.event->tests.back(),
+            (FieldTest{"hex", Op::contains, "4C"}));
+}
+
+TEST(ScenarioYamlMatchers, InvalidFramesOfAKindIncludeThoseTheDecoderNamedOnlyInPart) {
+  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\", valid: false}").tests,
+            (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
+                                    {"stage", Op::equals, "delivered"},
+                                    {"frame", Op::kind_either_prefix, "FB:SP"},
+                                    {"valid", Op::equals, false}}));
+  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\", valid: true}").tests[2],
+            (FieldTest{"frame", Op::kind_prefix, "FB:SP"}));
+  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\"}").tests[2],
+            (FieldTest{"frame", Op::kind_prefix, "FB:SP"}));
+}
+
+TEST(ScenarioYamlMatchers, FrameContentMistakesAreReportedWhereTheyAre) {
+  const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - ";
+  EXPECT_EQ(error_of(head + "{received: SP, text: {contans: x}}\n"),
+            "t.yaml:5:27: expectation 1: 'text': unknown key 'contans' (allowed: contains); did "
+            "you mean 'contains'?");
+  EXPECT_EQ(error_of(head + "{received: SP, hex: \"4C4\"}\n"),
+            "t.yaml:5:25: expectation 1: 'hex' must be whole bytes (two hex digits each)");
+  EXPECT_EQ(error_of(head + "{received: SP, hex: \"LOGI\"}\n"),
+            "t.yaml:5:25: expectation 1: 'hex' must be hex digits like \"06 01 FF\", got 'LOGI'");
+  EXPECT_EQ(error_of(head + "{received: SP, fields: {precent: 50}}\n"),
+            "t.yaml:5:29: expectation 1: 'fields': LOGI frames have no field 'precent' (they have "
+            "percent, station, speed_percent, running, mode, manual, distance_cm, track, "
+            "deviation, obstacle, rpm); did you mean 'percent'?");
+  EXPECT_EQ(error_of(head + "{received: SP, fields: {percent: {abve: 50}}}\n"),
+            "t.yaml:5:39: expectation 1: 'fields': 'percent': unknown key 'abve' (allowed: not, "
+            "contains, below, above, at_least, at_most); did you mean 'above'?");
+  EXPECT_EQ(error_of(head + "{received: SP, fields: {percent: {above: fast}}}\n"),
+            "t.yaml:5:46: expectation 1: 'fields': 'percent': 'above' must be a number, got "
+            "'fast'");
+  EXPECT_EQ(error_of(head + "{received: SP, fields: percent}\n"),
+            "t.yaml:5:28: expectation 1: 'fields' must be a map of field names to values, like "
+            "{percent: 50}");
+  EXPECT_EQ(error_of(head + "{client: connected, text: x}\n"),
+            "t.yaml:5:31: expectation 1: 'text' goes with a wire frame key");
+  // A name far from every known one is a firmware's own key, and is let through.
+  EXPECT_EQ(error_of(head + "{received_by_client: STAT, fields: {BAT: 87}}\n"), "");
 }
 
 TEST(ScenarioYamlMatchers, ClientEvents) {
