@@ -91,7 +91,7 @@ nlohmann::json message_fields(std::string_view message) {
     nlohmann::json value;
     if (j < n && message[j] == '"') {
       const std::size_t end = closing_quote(j);
-      value = std::string(message.substr(j + 1, end - j - 1));
+      value = field_value(message.substr(j + 1, end - j - 1));
       i = end + 1;
     } else {
       std::size_t end = j;

@@ -24,8 +24,8 @@ namespace hil::harness {
 nlohmann::json field_value(std::string_view text);
 
 /// The `name=value` pairs of a decoded frame's message ("SetSpeed
-/// percent=50" -> {"percent": 50}); a quoted value (info="OK 3") loses its
-/// quotes and stays text; of a name given twice the first is kept.
+/// percent=50" -> {"percent": 50}); a quoted value (info="OK 3") may hold
+/// spaces and loses its quotes; of a name given twice the first is kept.
 nlohmann::json message_fields(std::string_view message);
 
 /// A Timeline being written during a run: every record gets the clock's time.

@@ -55,9 +55,12 @@ TEST(FrameFields, TheNameValuePairsOfAMessage) {
                             {"track", "0110"},
                             {"rpm", "0:0:0:0"},
                             {"BAT", 87}}));
-  // Quoted values keep their spaces and stay text; a quoted word names nothing.
+  // Quoted values keep their spaces and lose their quotes (a number is still
+  // a number, as a scenario writes it); a quoted word names nothing.
   EXPECT_EQ(message_fields("Ack seq=00 info=\"V 160 ok\""),
             (nlohmann::json{{"seq", "00"}, {"info", "V 160 ok"}}));
+  EXPECT_EQ(message_fields("Ack seq=02 info=\"120\""),
+            (nlohmann::json{{"seq", "02"}, {"info", 120}}));
   EXPECT_EQ(message_fields("Nack seq=0A text=\"say \\\"no\\\"\""),
             (nlohmann::json{{"seq", "0A"}, {"text", "say \\\"no\\\""}}));
   EXPECT_EQ(message_fields("reply \"LEKA name=leka state=ok\""), nlohmann::json::object());
