@@ -123,7 +123,7 @@ void LogiClientCore::schedule_reconnect(Time now) {
   const auto index =
       std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), d.size() - 1);
   ++reconnect_attempt_;
-  reconnect_at_ = now + d[index];
+  reconnect_at_ = planted(PlantedBug::no_backoff) ? now : now + d[index];
   note(now, "reconnect attempt " + std::to_string(reconnect_attempt_) + " in " +
                 link::format_ms(d[index]));
   set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
@@ -186,8 +186,10 @@ bool LogiClientCore::is_movement(const proto::Message& m) {
 }
 
 bool LogiClientCore::retryable(const proto::Message& m) const {
-  if (std::holds_alternative<proto::SetSpeed>(m) || std::holds_alternative<proto::SetMode>(m)) {
-    return true;
+  if (std::holds_alternative<proto::SetSpeed>(m)) return !planted(PlantedBug::no_sp_retry);
+  if (std::holds_alternative<proto::SetMode>(m)) return true;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) {
+    return st->run && planted(PlantedBug::retry_run);
   }
   const auto* mv = std::get_if<proto::Move>(&m);
   return mv != nullptr && mv->direction == proto::Direction::stop;
@@ -225,6 +227,7 @@ SubmitResult LogiClientCore::release(Time now) {
   if (!held_) return {0, Refusal::not_held};
   held_.reset();
   keepalive_at_.reset();
+  if (planted(PlantedBug::no_stop_on_release)) return {next_id_++, Refusal::none};
   return submit(now, proto::Move{proto::Direction::stop});
 }
 
@@ -248,8 +251,14 @@ SubmitResult LogiClientCore::emergency_stop(Time now) {
   Pending stop{next_id_++, proto::Move{proto::Direction::stop}};
   stop.switch_mode_on_reject = false;
   const RequestId id = stop.id;
+  const bool also_st_stop = mode_ != proto::Mode::manual;
+  if (also_st_stop && planted(PlantedBug::st_stop_first)) {
+    send(now, Pending{next_id_++, proto::SetRun{false}});
+    send(now, std::move(stop));
+    return {id, Refusal::none};
+  }
   send(now, std::move(stop));
-  if (mode_ != proto::Mode::manual) {
+  if (also_st_stop) {
     Pending st{next_id_++, proto::SetRun{false}};
     send(now, std::move(st));
   }
@@ -354,6 +363,7 @@ void LogiClientCore::on_timeout(Time now, Pending p) {
 
 void LogiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
   if (state_ != ConnectionState::connected) return;
+  if (planted(PlantedBug::read_is_frame)) decoder_ = proto::Decoder(config_.decoder);
   decoder_.feed(bytes, items_);
   auto items = std::exchange(items_, {});
   for (const auto& item : items) {
@@ -412,7 +422,7 @@ void LogiClientCore::on_timer(Time now) {
     on_timeout(now, std::move(p));
   }
   if (state_ == ConnectionState::connected && !stale_ && last_stat_ &&
-      now >= *last_stat_ + config_.stale_after) {
+      now >= *last_stat_ + stale_after()) {
     stale_ = true;
     note(now, "stale: no STAT for " + link::format_ms(now - *last_stat_));
     emit(StaleEvent{true});
@@ -436,10 +446,14 @@ std::optional<Time> LogiClientCore::next_wakeup() const {
   for (const auto& p : flight_)
     consider(p.deadline);
   if (state_ == ConnectionState::connected && !stale_ && last_stat_) {
-    consider(*last_stat_ + config_.stale_after);
+    consider(*last_stat_ + stale_after());
   }
   if (held_ && keepalive_at_) consider(*keepalive_at_);
   return next;
+}
+
+Duration LogiClientCore::stale_after() const {
+  return planted(PlantedBug::stale_at_5s) ? link::seconds(5) : config_.stale_after;
 }
 
 }  // namespace hil::client::logi

@@ -26,6 +26,19 @@ namespace proto = protocol::logi;
 /// Local id of one operator request; 0 is never used (unsolicited feedback).
 using RequestId = std::uint64_t;
 
+/// TEST-ONLY: a known bug planted on purpose so the property tests
+/// (tests/property/) can show that they catch it. Never set outside tests.
+enum class PlantedBug : std::uint8_t {
+  none,
+  no_backoff,          ///< reconnect at once after every loss
+  retry_run,           ///< ST:RUN is resent after a timeout like SP
+  no_stop_on_release,  ///< release() sends no MV:STOP
+  read_is_frame,       ///< each read is decoded alone: a partial frame is dropped
+  stale_at_5s,         ///< the stale warning waits 5 s instead of stale_after
+  no_sp_retry,         ///< SP is never resent after a timeout
+  st_stop_first,       ///< the emergency stop writes ST:STOP before MV:STOP
+};
+
 struct ClientConfig {
   Duration feedback_timeout = link::milliseconds(800);
   /// Resends after a timeout for SP, MD and MV:STOP (3 sends in all).
@@ -38,6 +51,8 @@ struct ClientConfig {
   bool keepalive = false;
   Duration keepalive_period = link::milliseconds(300);
   proto::DecoderOptions decoder;
+  /// TEST-ONLY (see PlantedBug); none in every real use.
+  PlantedBug planted_bug = PlantedBug::none;
 };
 
 enum class ConnectionState : std::uint8_t {
@@ -203,6 +218,8 @@ class LogiClientCore {
   static bool is_movement(const proto::Message& m);
   bool retryable(const proto::Message& m) const;
   static bool resend_on_confirm(const proto::Message& m);
+  Duration stale_after() const;
+  bool planted(PlantedBug bug) const { return config_.planted_bug == bug; }
 
   ClientConfig config_;
   std::shared_ptr<CommLog> log_;

@@ -1,0 +1,858 @@
+#include "tests/property/logi_rig.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include "protocol/common/overloaded.hpp"
+#include "protocol/logi/codec.hpp"
+#include "sim/presets.hpp"
+
+namespace hil::client::logi::prop {
+
+namespace proto = protocol::logi;
+using proto::Direction;
+using proto::Mode;
+
+const char* name_of(Prop p) {
+  switch (p) {
+    case Prop::backoff_delays:
+      return "ReconnectDelaysAre1s2s3sThen3s";
+    case Prop::single_outbound_queue:
+      return "OneCommandAwaitsFeedbackAtATime";
+    case Prop::feedback_timeout_800ms:
+      return "FeedbackTimeoutIsExactly800ms";
+    case Prop::retry_rules:
+      return "OnlySpMdMvStopAreRetriedAtMostTwice";
+    case Prop::stop_on_release:
+      return "ReleaseSendsMvStop";
+    case Prop::stale_after_2s:
+      return "StaleExactly2sAfterTheLastStatAndNotBefore";
+    case Prop::emergency_stop_order:
+      return "EmergencyStopSendsMvStopFirstThenStStopInAuto";
+    case Prop::mode_conflict:
+      return "FbMv0GivesANoticeMdManAndOneRetry";
+    case Prop::safe_state_and_reconfirm:
+      return "SafeStateOnLossAndReconfirmAfterReconnect";
+    case Prop::bad_checksum_dropped:
+      return "BadChecksumFramesAreDroppedLoggedAndTheLinkKept";
+    case Prop::stream_gives_every_frame:
+      return "StickyAndSplitStreamsGiveEveryFrame";
+    case Prop::chassis_rests_after_stop:
+      return "ChassisRestsWithin2120msOfAStopThatGetsThrough";
+    case Prop::connect_disconnect:
+      return "ConnectAndDisconnectByHand";
+    case Prop::status_and_feedback_parsed:
+      return "StatusAndFeedbackParsedAndMatched";
+    case Prop::buttons_send_exact_frames:
+      return "EveryControlSendsItsExactFrame";
+    case Prop::manual_directions:
+      return "ManualControlDrivesEveryDirection";
+    case Prop::auto_flow:
+      return "AutoFlowStationRunStop";
+    case Prop::reconnects_automatically:
+      return "ReconnectsWithoutTheOperator";
+    case Prop::log_has_tx_rx_errors:
+      return "LogHoldsTxRxAndParseErrors";
+    case Prop::telemetry_visible:
+      return "TelemetryShownIsTheLastStat";
+    case Prop::mode_and_direction_shown:
+      return "ModeAndHeldDirectionShown";
+    case Prop::emergency_stop_accessible:
+      return "EmergencyStopAlwaysAccessible";
+    case Prop::checksums_built_right:
+      return "EveryFrameWrittenHasItsRightChecksum";
+    case Prop::count_:
+      break;
+  }
+  return "?";
+}
+
+Focus focus_for(Prop p) {
+  Focus f;
+  switch (p) {
+    case Prop::backoff_delays:
+    case Prop::reconnects_automatically:
+    case Prop::safe_state_and_reconfirm:
+      f.drop_link = 5;
+      f.disconnect = 2;
+      break;
+    case Prop::stale_after_2s:
+    case Prop::telemetry_visible:
+      f.mute = 5;
+      f.faults = 4;
+      break;
+    case Prop::bad_checksum_dropped:
+    case Prop::stream_gives_every_frame:
+    case Prop::status_and_feedback_parsed:
+    case Prop::log_has_tx_rx_errors:
+      f.faults = 8;
+      break;
+    case Prop::feedback_timeout_800ms:
+    case Prop::retry_rules:
+    case Prop::single_outbound_queue:
+      f.ignore = 6;
+      f.reject = 3;
+      f.faults = 4;
+      f.run = 4;
+      f.station = 4;
+      break;
+    case Prop::mode_conflict:
+      f.mode = 8;
+      f.reject = 4;
+      break;
+    case Prop::emergency_stop_order:
+    case Prop::emergency_stop_accessible:
+      f.estop = 8;
+      f.run = 5;
+      f.station = 5;
+      break;
+    case Prop::chassis_rests_after_stop:
+    case Prop::stop_on_release:
+      f.estop = 5;
+      f.faults = 4;
+      f.run = 4;
+      f.station = 4;
+      break;
+    case Prop::auto_flow:
+      f.station = 6;
+      f.run = 6;
+      f.stop = 4;
+      f.mode = 6;
+      break;
+    default:
+      break;
+  }
+  return f;
+}
+
+namespace {
+
+const char* dir_word(Direction d) {
+  switch (d) {
+    case Direction::stop:
+      return "STOP";
+    case Direction::fwd:
+      return "FWD";
+    case Direction::bwd:
+      return "BWD";
+    case Direction::left:
+      return "LEFT";
+    case Direction::right:
+      return "RIGHT";
+    case Direction::lf:
+      return "LF";
+    case Direction::rf:
+      return "RF";
+    case Direction::lb:
+      return "LB";
+    case Direction::rb:
+      return "RB";
+    case Direction::cw:
+      return "CW";
+    case Direction::ccw:
+      return "CCW";
+  }
+  return "?";
+}
+
+bool is_movement(const proto::Message& m) {
+  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction != Direction::stop;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
+  return false;
+}
+bool is_stop(const proto::Message& m) {
+  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction == Direction::stop;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return !st->run;
+  return false;
+}
+
+std::string ms(Duration d) {
+  return link::format_ms(d);
+}
+
+std::string text_of(const protocol::Bytes& b) {
+  return std::string(b.begin(), b.end());
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- the rig
+
+class Rig::Observer final : public link::LinkObserver {
+ public:
+  explicit Observer(Rig* rig) : rig_(rig) {}
+  Rig* rig_;
+  proto::Decoder to_client_sent_;
+  std::vector<proto::Item> items_;
+
+  void on_open(Time at, const std::string&, const std::string&) override {
+    if (!rig_) return;
+    rig_->links.emplace_back();
+    rig_->links.back().opened = at;
+    to_client_sent_ = proto::Decoder{};
+  }
+  void on_sent(Time at, link::Direction d, protocol::ByteView bytes) override {
+    if (!rig_ || rig_->links.empty()) return;
+    auto& l = rig_->links.back();
+    if (d == link::Direction::to_car) {
+      l.to_car_sent.insert(l.to_car_sent.end(), bytes.begin(), bytes.end());
+      return;
+    }
+    // The car's answers as it writes them: what the car did with a command.
+    items_.clear();
+    to_client_sent_.feed(bytes, items_);
+    std::map<proto::Command, int> per_code;
+    for (const auto& item : items_) {
+      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
+      if (f == nullptr) continue;
+      if (const auto* fb = std::get_if<proto::Feedback>(&f->message)) ++per_code[fb->command];
+    }
+    for (const auto& item : items_) {
+      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
+      if (f == nullptr) continue;
+      const auto* fb = std::get_if<proto::Feedback>(&f->message);
+      // Two answers of one code in one write: which command each is for is
+      // not known here, so neither is judged.
+      if (fb == nullptr || !fb->accepted || per_code[fb->command] > 1) continue;
+      rig_->on_car_accepted(at, *fb);
+    }
+  }
+  void on_delivered(Time at, link::Direction d, protocol::ByteView bytes) override {
+    if (!rig_ || rig_->links.empty()) return;
+    auto& l = rig_->links.back();
+    if (d == link::Direction::to_client) {
+      l.to_client_delivered.insert(l.to_client_delivered.end(), bytes.begin(), bytes.end());
+      return;
+    }
+    items_.clear();
+    l.to_car_decoder.feed(bytes, items_);
+    for (const auto& item : items_) {
+      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
+      if (f == nullptr) continue;
+      CarFrame cf{at, rig_->links.size() - 1, f->message, rig_->firmware().state().mode};
+      rig_->car_frames.push_back(cf);
+      // A stop the car will act on: ST:STOP ends a run and manual motion,
+      // MV:STOP ends manual motion (in AUTO there is none to end).
+      const bool effective = std::holds_alternative<proto::SetRun>(cf.message)
+                                 ? is_stop(cf.message)
+                                 : is_stop(cf.message) && cf.car_mode == Mode::manual;
+      if (effective) rig_->chassis_checks_.emplace(at + kBrakeBound, rig_->car_frames.size() - 1);
+    }
+  }
+  void on_fault(const link::FaultEvent& e) override {
+    if (rig_) rig_->faults.push_back(e);
+  }
+  void on_close(Time at, const link::LinkClose& c) override {
+    if (!rig_ || rig_->links.empty()) return;
+    rig_->links.back().closed = at;
+    rig_->links.back().closed_by = c.by;
+  }
+};
+
+Rig::Rig(PlantedBug bug, std::uint64_t link_seed) {
+  observer_ = std::make_shared<Observer>(this);
+  mocks::ServerOptions options = test::on_mem("car");
+  options.name = "logi";
+  options.seed = link_seed;
+  options.observers.push_back(observer_);
+  car_.start_car(sim::logi_car(), std::move(options));
+  ClientConfig config;
+  config.planted_bug = bug;
+  session_ = std::make_unique<LogiSession>(car_.context, link::MemEndpoint{"car"}, config,
+                                           [this](Time t, const Event& e) { on_event(t, e); });
+}
+
+Rig::~Rig() {
+  observer_->rig_ = nullptr;
+  session_.reset();
+}
+
+void Rig::fail(Prop p, std::string why) {
+  auto& list = failures_[static_cast<int>(p)];
+  if (list.size() < 5) list.push_back(ms(now()) + ": " + std::move(why));
+}
+
+void Rig::advance_to(Time until) {
+  for (;;) {
+    const bool chassis_first =
+        !chassis_checks_.empty() &&
+        (rest_checks_.empty() || chassis_checks_.begin()->first <= rest_checks_.begin()->first);
+    if (chassis_first && chassis_checks_.begin()->first <= until) {
+      const auto [due, index] = *chassis_checks_.begin();
+      chassis_checks_.erase(chassis_checks_.begin());
+      car_.executor.run_until(due);
+      check_chassis(due, index);
+      continue;
+    }
+    if (!rest_checks_.empty() && rest_checks_.begin()->first <= until) {
+      const auto [due, op] = *rest_checks_.begin();
+      rest_checks_.erase(rest_checks_.begin());
+      car_.executor.run_until(due);
+      check_rest(due, op);
+      continue;
+    }
+    break;
+  }
+  car_.executor.run_until(until);
+}
+
+bool Rig::at_rest() {
+  car_.world->advance_to(now());
+  return vehicle().chassis().wheel_twist() == sim::Twist{};
+}
+
+void Rig::check_chassis(Time due, std::size_t index) {
+  // Voided by motion the car was told to make after the stop.
+  for (std::size_t i = index + 1; i < car_frames.size() && car_frames[i].at <= due; ++i) {
+    if (is_movement(car_frames[i].message)) return;
+  }
+  if (!at_rest()) {
+    const auto t = vehicle().chassis().wheel_twist();
+    fail(Prop::chassis_rests_after_stop,
+         "still moving " + ms(kBrakeBound) + " after " +
+             proto::describe(car_frames[index].message) + " reached the car at " +
+             ms(car_frames[index].at) + " (vx " + std::to_string(t.vx_mps) + " vy " +
+             std::to_string(t.vy_mps) + " wz " + std::to_string(t.wz_radps) + ")");
+  }
+}
+
+void Rig::check_rest(Time due, std::size_t op_index) {
+  const OpRecord& op = ops[op_index];
+  const Time t = op.at;
+  // The link must have stayed up: a car left alone keeps its motion.
+  for (const auto& l : links) {
+    if (l.closed && *l.closed >= t && *l.closed <= due) return;
+  }
+  // No new motion asked for.
+  std::size_t stops_sent = 0;
+  for (std::size_t i = op.events_before; i < events.size(); ++i) {
+    const auto& [at, e] = events[i];
+    const auto* c = std::get_if<CommandEvent>(&e);
+    if (c == nullptr || c->state != CommandState::sent) continue;
+    if (is_movement(c->command)) return;
+    if (is_stop(c->command) && at <= t + kLastStopAttempt) ++stops_sent;
+  }
+  // The fault schedule let none of the attempts through.
+  std::size_t stops_destroyed = 0;
+  for (const auto& f : faults) {
+    if (f.direction != link::Direction::to_car || f.at < t || f.at > t + kLastStopAttempt) continue;
+    if (f.kind != "drop" && f.kind != "corrupt") continue;
+    if (text_of(f.before).find("STOP") != std::string::npos) ++stops_destroyed;
+  }
+  if (stops_sent > 0 && stops_destroyed >= stops_sent) return;
+  if (!at_rest()) {
+    fail(Prop::chassis_rests_after_stop,
+         std::string(op.kind == OpRecord::Kind::estop ? "emergency stop" : "release") + " at " +
+             ms(t) + ": the chassis still moves " + ms(due - t) + " later (" +
+             std::to_string(stops_sent) + " stop frames sent, " + std::to_string(stops_destroyed) +
+             " destroyed by faults)");
+  }
+}
+
+void Rig::on_car_accepted(Time at, const proto::Feedback& fb) {
+  // The command the car just answered: the last one of that code it received.
+  const proto::Message* cmd = nullptr;
+  for (auto it = car_frames.rbegin(); it != car_frames.rend(); ++it) {
+    if (proto::command_of(it->message) == fb.command) {
+      cmd = &it->message;
+      break;
+    }
+  }
+  if (cmd == nullptr) return;
+  const auto& s = firmware().state();
+  CarAccepted rec{at, *cmd, true, {}};
+  if (const auto* mv = std::get_if<proto::Move>(cmd)) {
+    if (s.manual != mv->direction) rec.ok = false;
+    if (mv->direction != Direction::stop && s.speed_percent > 0 && !s.obstacle) {
+      const auto* m = vehicle().mecanum();
+      const sim::Twist tw = m != nullptr ? m->target() : sim::Twist{};
+      auto sign = [](double v) { return std::abs(v) < 1e-9 ? 0 : (v > 0 ? 1 : -1); };
+      int vx = 0, vy = 0, wz = 0;
+      switch (mv->direction) {
+        case Direction::fwd:
+          vx = 1;
+          break;
+        case Direction::bwd:
+          vx = -1;
+          break;
+        case Direction::left:
+          vy = 1;
+          break;
+        case Direction::right:
+          vy = -1;
+          break;
+        case Direction::lf:
+          vx = 1;
+          vy = 1;
+          break;
+        case Direction::rf:
+          vx = 1;
+          vy = -1;
+          break;
+        case Direction::lb:
+          vx = -1;
+          vy = 1;
+          break;
+        case Direction::rb:
+          vx = -1;
+          vy = -1;
+          break;
+        case Direction::cw:
+          wz = -1;
+          break;
+        case Direction::ccw:
+          wz = 1;
+          break;
+        case Direction::stop:
+          break;
+      }
+      if (sign(tw.vx_mps) != vx || sign(tw.vy_mps) != vy || sign(tw.wz_radps) != wz) rec.ok = false;
+    }
+  } else if (const auto* st = std::get_if<proto::SetRun>(cmd)) {
+    rec.ok = st->run ? s.running : (!s.running && s.manual == Direction::stop);
+  } else if (const auto* gs = std::get_if<proto::SetStation>(cmd)) {
+    rec.ok = s.station == gs->station;
+  }
+  car_accepted.push_back(std::move(rec));
+}
+
+void Rig::on_event(Time t, const Event& e) {
+  events.emplace_back(t, e);
+  if (const auto* c = std::get_if<ConnectionEvent>(&e)) {
+    md_on_connection = false;
+    sp_on_connection = false;
+    shown_mode.reset();
+    if (c->state != ConnectionState::connected) held.reset();
+  } else if (const auto* s = std::get_if<StatusEvent>(&e)) {
+    shown_mode = s->status.mode;
+    last_status = s->status;
+  } else if (const auto* c2 = std::get_if<CommandEvent>(&e)) {
+    if (c2->state == CommandState::accepted) {
+      if (const auto* md = std::get_if<proto::SetMode>(&c2->command)) shown_mode = md->mode;
+    }
+  }
+}
+
+OpRecord Rig::begin_op(OpRecord::Kind kind, int value) {
+  // What the screen shows, checked before every operator action.
+  if (core().last_status() != last_status) {
+    fail(Prop::telemetry_visible, "the status shown is not the last STAT received");
+  }
+  if (core().known_mode() != shown_mode) {
+    fail(Prop::mode_and_direction_shown, "the mode shown is not the last STAT's or accepted MD's");
+  }
+  if (core().held() != held) {
+    fail(Prop::mode_and_direction_shown, "the direction shown is not the one the operator holds");
+  }
+  OpRecord r;
+  r.kind = kind;
+  r.at = now();
+  r.value = value;
+  r.state_before = core().state();
+  r.line_idle = core().in_flight() == 0 && core().queued() == 0;
+  r.known_mode_before = core().known_mode();
+  r.car_running = firmware().state().running;
+  r.events_before = events.size();
+  r.links_before = links.size();
+  return r;
+}
+
+void Rig::end_op(OpRecord r) {
+  r.events_after = events.size();
+  ops.push_back(std::move(r));
+  settle();
+  ops.back().state_after = core().state();
+}
+
+void Rig::op_connect() {
+  auto r = begin_op(OpRecord::Kind::connect, 0);
+  session_->connect();
+  end_op(std::move(r));
+}
+
+void Rig::op_disconnect() {
+  auto r = begin_op(OpRecord::Kind::disconnect, 0);
+  session_->disconnect();
+  held.reset();
+  end_op(std::move(r));
+}
+
+void Rig::op_submit(OpRecord::Kind kind, const proto::Message& m, int value) {
+  auto r = begin_op(kind, value);
+  const bool connected = r.state_before == ConnectionState::connected;
+  const Refusal expected = !connected ? Refusal::not_connected
+                           : is_movement(m) && !(md_on_connection && sp_on_connection)
+                               ? Refusal::mode_speed_unconfirmed
+                               : Refusal::none;
+  r.result = session_->submit(m);
+  if (r.result.refusal != expected) {
+    fail(Prop::safe_state_and_reconfirm,
+         proto::describe(m) + " answered '" + std::string(to_string(r.result.refusal)) +
+             "', expected '" + std::string(to_string(expected)) + "'");
+  }
+  if (r.result) {
+    if (std::holds_alternative<proto::SetMode>(m)) md_on_connection = true;
+    if (std::holds_alternative<proto::SetSpeed>(m)) sp_on_connection = true;
+  }
+  end_op(std::move(r));
+}
+
+void Rig::op_press(Direction d) {
+  auto r = begin_op(OpRecord::Kind::press, static_cast<int>(d));
+  const bool connected = r.state_before == ConnectionState::connected;
+  const Refusal expected = !connected ? Refusal::not_connected
+                           : !(md_on_connection && sp_on_connection)
+                               ? Refusal::mode_speed_unconfirmed
+                               : Refusal::none;
+  r.result = session_->press(d);
+  if (r.result.refusal != expected) {
+    fail(Prop::safe_state_and_reconfirm, std::string("press ") + dir_word(d) + " answered '" +
+                                             std::string(to_string(r.result.refusal)) +
+                                             "', expected '" + std::string(to_string(expected)) +
+                                             "'");
+  }
+  if (r.result) held = d;
+  end_op(std::move(r));
+}
+
+void Rig::op_release() {
+  auto r = begin_op(OpRecord::Kind::release, 0);
+  const bool was_held = held.has_value();
+  r.result = session_->release();
+  held.reset();
+  const Refusal expected = was_held ? Refusal::none : Refusal::not_held;
+  if (r.result.refusal != expected && !(was_held && r.state_before != ConnectionState::connected)) {
+    fail(Prop::stop_on_release, "release answered '" + std::string(to_string(r.result.refusal)) +
+                                    "', expected '" + std::string(to_string(expected)) + "'");
+  }
+  const std::size_t index = ops.size();
+  end_op(std::move(r));
+  const auto& op = ops[index];
+  if (op.result && op.line_idle && !op.car_running)
+    rest_checks_.emplace(op.at + kStopToRest, index);
+}
+
+void Rig::op_estop() {
+  auto r = begin_op(OpRecord::Kind::estop, 0);
+  r.result = session_->emergency_stop();
+  held.reset();
+  const std::size_t index = ops.size();
+  end_op(std::move(r));
+  const auto& op = ops[index];
+  if (op.state_before == ConnectionState::connected) {
+    rest_checks_.emplace(op.at + kStopToRest, index);
+  }
+}
+
+void Rig::car_drop_link(bool reset) {
+  firmware().arm(mocks::Behaviour{
+      "drop", mocks::When{now(), {}, 1},
+      mocks::CloseConnection{reset ? link::CloseMode::reset : link::CloseMode::graceful}});
+  settle();
+}
+
+void Rig::car_arm(mocks::Behaviour b) {
+  firmware().arm(std::move(b));
+  settle();
+}
+
+void Rig::car_faults(link::FaultProfile profile) {
+  server().set_faults(std::move(profile));
+  settle();
+}
+
+std::string Rig::timeline() const {
+  // Events and operator actions in order, for the person reading a failure.
+  std::ostringstream os;
+  std::size_t op = 0;
+  auto show_op = [&](const OpRecord& r) {
+    static const char* names[] = {"connect", "disconnect", "speed", "mode", "press",
+                                  "release", "station",    "run",   "stop", "emergency-stop"};
+    os << "  " << ms(r.at) << "  OPERATOR " << names[static_cast<int>(r.kind)] << " " << r.value
+       << " -> "
+       << (r.result ? "request " + std::to_string(r.result.request)
+                    : std::string(to_string(r.result.refusal)))
+       << "\n";
+  };
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    for (; op < ops.size() && ops[op].events_before <= i; ++op)
+      show_op(ops[op]);
+    const auto& [t, e] = events[i];
+    os << "  " << ms(t) << "  ";
+    std::visit(protocol::Overloaded{
+                   [&](const ConnectionEvent& c) {
+                     os << "connection " << to_string(c.state) << " attempt " << c.attempt;
+                   },
+                   [&](const StatusEvent& s) { os << "STAT " << proto::describe(s.status); },
+                   [&](const FeedbackEvent& f) {
+                     os << "FB " << proto::describe(f.feedback) << " -> request " << f.request;
+                   },
+                   [&](const CommandEvent& c) {
+                     os << "request " << c.request << " " << proto::describe(c.command) << " "
+                        << to_string(c.state) << " attempt " << c.attempt;
+                   },
+                   [&](const StaleEvent& s) { os << (s.stale ? "STALE" : "fresh"); },
+                   [&](const NoticeEvent& n) { os << "notice: " << n.text; },
+                   [&](const ParseErrorEvent& p) {
+                     os << "parse error " << protocol::to_string(p.error.kind) << " '"
+                        << text_of(p.error.raw) << "'";
+                   },
+                   [&](const MovementEvent& m) { os << "movement " << (m.enabled ? "on" : "off"); },
+               },
+               e);
+    os << "\n";
+  }
+  for (; op < ops.size(); ++op)
+    show_op(ops[op]);
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    os << "  link " << k + 1 << ": opened " << ms(links[k].opened);
+    if (links[k].closed)
+      os << ", closed " << ms(*links[k].closed) << " by " << link::to_string(links[k].closed_by);
+    os << "\n";
+  }
+  return os.str();
+}
+
+// ---------------------------------------------------------------- commands
+
+namespace {
+
+struct Connect final : Command {
+  void apply(Model& m) const override { m.want_connected = true; }
+  void run(const Model&, Rig& r) const override { r.op_connect(); }
+  void show(std::ostream& os) const override { os << "connect"; }
+};
+struct Disconnect final : Command {
+  void apply(Model& m) const override {
+    m.want_connected = false;
+    m.pressed = false;
+  }
+  void run(const Model&, Rig& r) const override { r.op_disconnect(); }
+  void show(std::ostream& os) const override { os << "disconnect"; }
+};
+struct Speed final : Command {
+  int percent = 50;
+  explicit Speed(int p) : percent(p) {}
+  void run(const Model&, Rig& r) const override {
+    r.op_submit(OpRecord::Kind::speed, proto::SetSpeed{percent}, percent);
+  }
+  void show(std::ostream& os) const override { os << "speed " << percent; }
+};
+struct SetModeCmd final : Command {
+  bool manual = true;
+  explicit SetModeCmd(bool m) : manual(m) {}
+  void run(const Model&, Rig& r) const override {
+    r.op_submit(OpRecord::Kind::mode, proto::SetMode{manual ? Mode::manual : Mode::automatic},
+                manual ? 1 : 0);
+  }
+  void show(std::ostream& os) const override { os << "mode " << (manual ? "MAN" : "AUTO"); }
+};
+struct Press final : Command {
+  Direction dir = Direction::fwd;
+  explicit Press(Direction d) : dir(d) {}
+  void apply(Model& m) const override { m.pressed = true; }
+  void run(const Model&, Rig& r) const override { r.op_press(dir); }
+  void show(std::ostream& os) const override { os << "press " << dir_word(dir); }
+};
+struct Release final : Command {
+  void apply(Model& m) const override { m.pressed = false; }
+  void run(const Model&, Rig& r) const override { r.op_release(); }
+  void show(std::ostream& os) const override { os << "release"; }
+};
+struct Station final : Command {
+  int station = 1;
+  explicit Station(int s) : station(s) {}
+  void run(const Model&, Rig& r) const override {
+    r.op_submit(OpRecord::Kind::station, proto::SetStation{station}, station);
+  }
+  void show(std::ostream& os) const override { os << "station " << station; }
+};
+struct Run final : Command {
+  void run(const Model&, Rig& r) const override {
+    r.op_submit(OpRecord::Kind::run, proto::SetRun{true}, 1);
+  }
+  void show(std::ostream& os) const override { os << "run"; }
+};
+struct Stop final : Command {
+  void run(const Model&, Rig& r) const override {
+    r.op_submit(OpRecord::Kind::stop, proto::SetRun{false}, 0);
+  }
+  void show(std::ostream& os) const override { os << "stop"; }
+};
+struct EStop final : Command {
+  void apply(Model& m) const override { m.pressed = false; }
+  void run(const Model&, Rig& r) const override { r.op_estop(); }
+  void show(std::ostream& os) const override { os << "emergency-stop"; }
+};
+struct Advance final : Command {
+  Duration d{0};
+  explicit Advance(Duration x) : d(x) {}
+  void checkPreconditions(const Model& m) const override {
+    RC_PRE(m.elapsed + d <= kSessionLength);
+  }
+  void apply(Model& m) const override { m.elapsed += d; }
+  void run(const Model&, Rig& r) const override { r.advance_to(r.now() + d); }
+  void show(std::ostream& os) const override { os << "wait " << ms(d); }
+};
+struct DropLink final : Command {
+  bool reset = true;
+  explicit DropLink(bool x) : reset(x) {}
+  void run(const Model&, Rig& r) const override { r.car_drop_link(reset); }
+  void show(std::ostream& os) const override {
+    os << "car: drop the link (" << (reset ? "reset" : "close") << ")";
+  }
+};
+struct RejectCmd final : Command {
+  std::string kind;
+  std::uint64_t count = 1;
+  RejectCmd(std::string k, std::uint64_t c) : kind(std::move(k)), count(c) {}
+  void run(const Model&, Rig& r) const override {
+    r.car_arm(mocks::Behaviour{"reject", {}, mocks::Reject{kind, count}});
+  }
+  void show(std::ostream& os) const override {
+    os << "car: reject the next " << count << " " << kind;
+  }
+};
+struct IgnoreCmd final : Command {
+  std::string kind;
+  std::uint64_t count = 1;
+  IgnoreCmd(std::string k, std::uint64_t c) : kind(std::move(k)), count(c) {}
+  void run(const Model&, Rig& r) const override {
+    r.car_arm(mocks::Behaviour{"ignore", {}, mocks::Ignore{kind, count, std::nullopt}});
+  }
+  void show(std::ostream& os) const override {
+    os << "car: ignore the next " << count << " " << kind;
+  }
+};
+struct Mute final : Command {
+  Duration d{0};
+  explicit Mute(Duration x) : d(x) {}
+  void run(const Model&, Rig& r) const override {
+    r.car_arm(mocks::Behaviour{"mute", {}, mocks::MuteTelemetry{d}});
+  }
+  void show(std::ostream& os) const override { os << "car: no STAT for " << ms(d); }
+};
+
+/// Fault rules by bit: what the link does to the frames from now on. All
+/// eight rules are always there, in the same order, and the ones left out
+/// never fire: the injector keeps a pending batch's rule by its index, and
+/// a profile with fewer rules would leave that index dangling.
+link::FaultProfile profile_of(unsigned mask) {
+  using namespace link;
+  FaultProfile p;
+  int bit = 0;
+  auto add = [&](const char* name, DirectionFilter d, FaultAction a, std::optional<double> prob) {
+    const bool on = (mask >> bit++) & 1u;
+    FaultRule r;
+    r.name = name;
+    r.direction = d;
+    r.trigger.probability = on ? prob : std::optional<double>(0.0);
+    r.action = std::move(a);
+    p.rules.push_back(std::move(r));
+  };
+  add("corrupt-in", DirectionFilter::to_client, Corrupt{CorruptTarget::checksum, {}, 1}, 0.2);
+  add("drop-in", DirectionFilter::to_client, Drop{}, 0.2);
+  add("split-in", DirectionFilter::to_client, Fragment{{1, 5}, {milliseconds(0), milliseconds(2)}},
+      std::nullopt);
+  add("stick-in", DirectionFilter::to_client, Coalesce{3, milliseconds(200)}, std::nullopt);
+  add("noise-in", DirectionFilter::to_client, Garbage{{1, 8}, {}}, 0.25);
+  add("drop-out", DirectionFilter::to_car, Drop{}, 0.3);
+  add("corrupt-out", DirectionFilter::to_car, Corrupt{CorruptTarget::checksum, {}, 1}, 0.2);
+  add("split-out", DirectionFilter::to_car, Fragment{{1, 4}, {milliseconds(0), milliseconds(0)}},
+      std::nullopt);
+  return p;
+}
+
+struct Faults final : Command {
+  unsigned mask = 0;
+  explicit Faults(unsigned m) : mask(m) {}
+  void run(const Model&, Rig& r) const override { r.car_faults(profile_of(mask)); }
+  void show(std::ostream& os) const override {
+    os << "link faults:";
+    for (const auto& rule : profile_of(mask).rules) {
+      if (rule.trigger.probability != 0.0) os << " " << rule.name;
+    }
+    if (mask == 0) os << " none";
+  }
+};
+
+template <class C, class... Args>
+CommandPtr make(Args&&... args) {
+  return std::make_shared<const C>(std::forward<Args>(args)...);
+}
+
+const std::vector<std::string>& car_kinds() {
+  // Stops are never swallowed or refused by the car: the safety property
+  // is about faults on the link, which the client can see and retry.
+  static const std::vector<std::string> kinds = {"SP",     "MD",      "GS",   "ST:RUN",
+                                                 "MV:FWD", "MV:LEFT", "MV:CW"};
+  return kinds;
+}
+
+}  // namespace
+
+std::function<rc::Gen<CommandPtr>(const Model&)> gen_command(Focus f) {
+  return [f](const Model& m) {
+    namespace g = rc::gen;
+    using Entry = std::pair<std::size_t, rc::Gen<CommandPtr>>;
+    std::vector<Entry> entries;
+    auto add = [&](int w, rc::Gen<CommandPtr> gen) {
+      if (w > 0) entries.emplace_back(static_cast<std::size_t>(w), std::move(gen));
+    };
+    add(m.want_connected ? 1 : f.connect * 4, g::lazy([] { return g::just(make<Connect>()); }));
+    add(m.want_connected ? f.disconnect : 0, g::lazy([] { return g::just(make<Disconnect>()); }));
+    add(f.speed, g::map(g::element(0, 30, 50, 80, 100, 7), [](int p) { return make<Speed>(p); }));
+    add(f.mode, g::map(g::arbitrary<bool>(), [](bool b) { return make<SetModeCmd>(b); }));
+    add(m.pressed ? 1 : f.press,
+        g::map(g::inRange(1, 11), [](int d) { return make<Press>(static_cast<Direction>(d)); }));
+    add(m.pressed ? f.release * 3 : 1, g::lazy([] { return g::just(make<Release>()); }));
+    add(f.station, g::map(g::element(1, 2, 3), [](int s) { return make<Station>(s); }));
+    add(f.run, g::lazy([] { return g::just(make<Run>()); }));
+    add(f.stop, g::lazy([] { return g::just(make<Stop>()); }));
+    add(f.estop, g::lazy([] { return g::just(make<EStop>()); }));
+    const auto left_ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(kSessionLength - m.elapsed).count();
+    if (left_ms > 0) {
+      const int top = static_cast<int>(std::min<long long>(left_ms, 3000));
+      add(f.advance,
+          g::map(g::oneOf(g::inRange(1, std::min(top, 50) + 1), g::inRange(1, top + 1),
+                          g::element(100, 200, 500, 800, 1000, 2000)),
+                 [top](int x) { return make<Advance>(milliseconds(std::min(x, top))); }));
+    }
+    add(f.drop_link, g::map(g::arbitrary<bool>(), [](bool b) { return make<DropLink>(b); }));
+    add(f.reject, g::map(g::pair(g::elementOf(car_kinds()), g::inRange<std::uint64_t>(1, 3)),
+                         [](const std::pair<std::string, std::uint64_t>& p) {
+                           return make<RejectCmd>(p.first, p.second);
+                         }));
+    add(f.ignore, g::map(g::pair(g::elementOf(car_kinds()), g::inRange<std::uint64_t>(1, 4)),
+                         [](const std::pair<std::string, std::uint64_t>& p) {
+                           return make<IgnoreCmd>(p.first, p.second);
+                         }));
+    add(f.mute, g::map(g::inRange(500, 4001), [](int x) { return make<Mute>(milliseconds(x)); }));
+    add(f.faults, g::map(g::inRange(0u, 256u), [](unsigned x) { return make<Faults>(x); }));
+    std::size_t total = 0;
+    for (const auto& e : entries)
+      total += e.first;
+    return g::mapcat(g::inRange<std::size_t>(0, total), [entries](std::size_t x) {
+      for (const auto& e : entries) {
+        if (x < e.first) return e.second;
+        x -= e.first;
+      }
+      return entries.back().second;
+    });
+  };
+}
+
+void run_property(Prop p, PlantedBug bug) {
+  const auto seed = *rc::gen::inRange<std::uint64_t>(1, 1u << 30);
+  Rig rig(bug, seed);
+  rc::state::check(Model{}, rig, gen_command(focus_for(p)));
+  if (rig.now() < kSessionLength) rig.advance_to(kSessionLength);
+  const std::string why = check(p, rig);
+  if (!why.empty()) RC_FAIL(std::string(name_of(p)) + ": " + why + "\n" + rig.timeline());
+}
+
+}  // namespace hil::client::logi::prop
