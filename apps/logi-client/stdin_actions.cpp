@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <deque>
+#include <map>
 #include <memory>
 #include <ostream>
 #include <utility>
@@ -109,12 +110,23 @@ class StdinActionsRun {
   void print(const std::string& line) { out_ << line << std::endl; }
 
   void on_line(std::string line) {
-    pending_.push_back(std::move(line));
+    Line entry;
+    entry.parsed = parse_action_line(++line_number_, line);
+    if (entry.parsed.step &&
+        std::holds_alternative<logi::op::EmergencyStop>(entry.parsed.step->action) &&
+        (busy_ || !pending_.empty()) && !stopping_) {
+      // An emergency stop never waits for the actions before it; only its
+      // result line does, so that results still come in the order of the
+      // lines.
+      entry.early_result = std::make_shared<std::optional<std::string>>();
+      start_early(*entry.parsed.step, entry.early_result);
+    }
+    pending_.push_back(std::move(entry));
     schedule_next();
   }
 
   void on_input_end(std::string rest) {
-    if (!rest.empty()) pending_.push_back(std::move(rest));
+    if (!rest.empty()) on_line(std::move(rest));
     input_ended_ = true;
     schedule_next();
   }
@@ -128,38 +140,64 @@ class StdinActionsRun {
     });
   }
 
-  /// Starts the next action; answers the lines that do not parse on the
-  /// way; after the last line of ended input, shuts down.
+  static logi::ActionResult failure(const ActionLine& line, std::string reason, logi::Time now) {
+    logi::ActionResult failed;
+    failed.line = line.step ? line.step->line : 0;
+    failed.text = line.text;
+    failed.reason = std::move(reason);
+    failed.started = failed.ended = now;
+    return failed;
+  }
+
+  /// Starts the next action; answers the lines that do not parse, and the
+  /// emergency stops that already ran, on the way; after the last line of
+  /// ended input, shuts down.
   void run_next() {
     if (busy_ || stopping_) return;
     while (!pending_.empty()) {
-      const std::string line = std::move(pending_.front());
-      pending_.pop_front();
-      ++line_number_;
-      auto parsed = parse_action_line(line_number_, line);
-      if (!parsed.error.empty()) {
-        logi::ActionResult failed;
-        failed.line = line_number_;
-        failed.text = parsed.text;
-        failed.reason = parsed.error;
-        failed.started = failed.ended = executor_.now();
-        print(BatchReporter::result_line(failed));
+      Line& front = pending_.front();
+      if (front.early_result) {
+        if (!*front.early_result) return;  // still under way: its result comes when it ends
+        print(**front.early_result);
+        pending_.pop_front();
         continue;
       }
-      if (!parsed.step) continue;  // blank or comment: not an action, no result
-      start(std::move(*parsed.step));
+      if (!front.parsed.error.empty()) {
+        print(
+            BatchReporter::result_line(failure(front.parsed, front.parsed.error, executor_.now())));
+        pending_.pop_front();
+        continue;
+      }
+      if (!front.parsed.step) {  // blank or comment: not an action, no result
+        pending_.pop_front();
+        continue;
+      }
+      logi::OperatorStep step = std::move(*front.parsed.step);
+      pending_.pop_front();
+      start(std::move(step));
       return;
     }
-    if (input_ended_) shut_down(kExitOk, true);
+    if (input_ended_ && early_.empty()) shut_down(kExitOk, true);
+  }
+
+  /// Runner options for one action: `confirm` learns which request went
+  /// unanswered before it (each action has a runner of its own).
+  logi::OperatorRunnerOptions runner_options(const logi::OperatorStep& step) {
+    auto options = options_.runner;
+    if (std::holds_alternative<logi::op::Confirm>(step.action)) {
+      options.confirmable = confirmable_;
+      confirmable_.reset();
+    }
+    return options;
   }
 
   void start(logi::OperatorStep step) {
     busy_ = true;
-    const bool is_confirm = std::holds_alternative<logi::op::Confirm>(step.action);
+    auto options = runner_options(step);
     std::vector<logi::OperatorStep> steps;
     steps.push_back(std::move(step));
     runner_ = std::make_unique<logi::OperatorRunner>(
-        *session_, executor_, std::move(steps), options_.runner,
+        *session_, executor_, std::move(steps), options,
         [this](const logi::ActionResult& r) { print(BatchReporter::result_line(r)); },
         [this](const logi::RunSummary&) {
           // Leave the runner's callback before it is destroyed.
@@ -170,24 +208,39 @@ class StdinActionsRun {
             run_next();
           });
         });
-    if (is_confirm && confirmable_) {
-      // Each action has its own runner; the one for `confirm` learns which
-      // request went unanswered from the event that said so.
-      runner_->on_event(executor_.now(), *confirmable_);
-      confirmable_.reset();
-    }
     runner_->start();
+  }
+
+  void start_early(const logi::OperatorStep& step,
+                   std::shared_ptr<std::optional<std::string>> result) {
+    const std::uint64_t id = ++early_ids_;
+    auto runner = std::make_unique<logi::OperatorRunner>(
+        *session_, executor_, std::vector<logi::OperatorStep>{step}, options_.runner,
+        [result](const logi::ActionResult& r) { *result = BatchReporter::result_line(r); },
+        [this, id](const logi::RunSummary&) {
+          executor_.post([this, id] {
+            early_.erase(id);
+            if (!stopping_) run_next();
+          });
+        });
+    auto* started = runner.get();
+    early_.emplace(id, std::move(runner));
+    started->start();
   }
 
   void on_event(logi::Time now, const logi::Event& e) {
     if (auto line = reporter_.event_line(now, e)) print(*line);
     if (auto line = contract_event_line(e)) print(*line);
     if (const auto* c = std::get_if<logi::CommandEvent>(&e)) {
-      if (c->state == logi::CommandState::uncertain && c->resend_on_confirm) confirmable_ = e;
+      if (c->state == logi::CommandState::uncertain && c->resend_on_confirm) {
+        confirmable_ = c->request;
+      }
     } else if (const auto* conn = std::get_if<logi::ConnectionEvent>(&e)) {
       if (conn->state != ConnectionState::connected) confirmable_.reset();
     }
     if (runner_) runner_->on_event(now, e);
+    for (auto& [id, runner] : early_)
+      runner->on_event(now, e);
   }
 
   void on_signal(int signal) {
@@ -213,16 +266,21 @@ class StdinActionsRun {
     exit_code_ = code;
     input_.stop();
     if (runner_) runner_->cancel();  // reports the action under way as cancelled
+    for (auto& [id, runner] : early_)
+      runner->cancel();  // fills in their results
     // Lines received but not begun are answered too: one result per line.
     for (; !pending_.empty(); pending_.pop_front()) {
-      const auto parsed = parse_action_line(++line_number_, pending_.front());
-      if (!parsed.step && parsed.error.empty()) continue;
-      logi::ActionResult cancelled;
-      cancelled.line = line_number_;
-      cancelled.text = parsed.text;
-      cancelled.reason = parsed.error.empty() ? "cancelled" : parsed.error;
-      cancelled.started = cancelled.ended = executor_.now();
-      print(BatchReporter::result_line(cancelled));
+      const Line& line = pending_.front();
+      if (line.early_result) {
+        print(*line.early_result
+                  ? **line.early_result
+                  : BatchReporter::result_line(failure(line.parsed, "cancelled", executor_.now())));
+        continue;
+      }
+      if (!line.parsed.step && line.parsed.error.empty()) continue;
+      print(BatchReporter::result_line(
+          failure(line.parsed, line.parsed.error.empty() ? "cancelled" : line.parsed.error,
+                  executor_.now())));
     }
     const bool connected = session_->core().state() == ConnectionState::connected;
     if (stop_car && connected && car_may_be_moving(session_->core())) {
@@ -266,8 +324,16 @@ class StdinActionsRun {
   std::unique_ptr<logi::LogiSession> session_;
   std::unique_ptr<logi::OperatorRunner> runner_;
   BatchReporter reporter_;
-  std::deque<std::string> pending_;
-  std::optional<logi::Event> confirmable_;
+  /// A line of stdin waiting its turn.
+  struct Line {
+    ActionLine parsed;
+    /// An emergency stop started at once: its result line once it ended.
+    std::shared_ptr<std::optional<std::string>> early_result;
+  };
+  std::deque<Line> pending_;
+  std::map<std::uint64_t, std::unique_ptr<logi::OperatorRunner>> early_;
+  std::uint64_t early_ids_ = 0;
+  std::optional<logi::RequestId> confirmable_;
   int line_number_ = 0;
   bool busy_ = false;
   bool next_posted_ = false;

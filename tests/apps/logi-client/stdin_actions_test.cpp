@@ -179,6 +179,27 @@ TEST(LogiClientStdinActions, ConfirmSendsAgainTheRunWhoseFeedbackWasLost) {
   EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
 }
 
+TEST(LogiClientStdinActions, AnEmergencyStopGoesOutAtOnceBesideAnActionAwaitingFeedback) {
+  const TempDir temp("logi-client-stdin-estop");
+  const auto faults = temp.write(
+      "lost-sp.yaml", "rules:\n  - {kind: drop, direction: to_car, match: \"SP\", first: 1}\n");
+  MockLogi car({"--faults", faults.string()});
+  ASSERT_FALSE(car.port().empty()) << car.output();
+  auto client = stdin_client(car.port());
+  ASSERT_TRUE(client.write_stdin("connect\nmode MAN\nspeed 60\n"));
+  EXPECT_TRUE(client.wait_for_line("event command SP sent")) << client.output();
+  // The SP never reached the car: it is sent again only after 800 ms. The
+  // stop does not wait for that ...
+  ASSERT_TRUE(client.write_stdin("estop\n"));
+  EXPECT_TRUE(client.wait_for_line("event command MV:STOP accepted")) << client.output();
+  EXPECT_TRUE(client.wait_for_line("event command SP sent")) << client.output();
+  // ... but its result line keeps its place after the speed's.
+  EXPECT_TRUE(client.wait_for_line("] ok   speed 60")) << client.output();
+  EXPECT_TRUE(client.wait_for_line("] ok   estop")) << client.output();
+  client.close_stdin();
+  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+}
+
 TEST(LogiClientStdinActions, TheStaleWarningAndItsEndAreEventLines) {
   const TempDir temp("logi-client-stdin-stale");
   const auto faults =
