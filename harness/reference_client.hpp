@@ -10,6 +10,9 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "harness/timeline_recorder.hpp"
 #include "link/endpoint.hpp"
@@ -50,12 +53,30 @@ class ReferenceSession {
   virtual void terminate(bool hard) { (void)hard; }
 };
 
+/// One option of a car's reference client that a scenario may set
+/// (`client: {reference: {settings: {max_retries: 0}}}`).
+struct ReferenceSetting {
+  std::string name;   ///< "max_retries"
+  std::string takes;  ///< what a value looks like: "a duration (800ms)"
+  std::string what;   ///< what it changes, for people
+};
+
+/// The options the car's reference client takes, in a fixed order.
+std::vector<ReferenceSetting> reference_settings(mocks::CarKind car);
+
+/// Why `value` (a text, or an array of texts for a list) cannot be the
+/// option `name` of the car's reference client; nullopt when it can.
+std::optional<std::string> reference_setting_problem(mocks::CarKind car, const std::string& name,
+                                                     const nlohmann::json& value);
+
 /// The car's reference client on `endpoint`, writing client records to
-/// `timeline`. `context` and `timeline` must outlive it.
-std::unique_ptr<ReferenceSession> make_reference_session(mocks::CarKind car,
-                                                         link::TransportContext& context,
-                                                         link::Endpoint endpoint,
-                                                         RunTimeline& timeline);
+/// `timeline`, its library's defaults changed by `settings` (names to values
+/// that reference_setting_problem() accepts; a bad one is a programmer
+/// error and throws std::invalid_argument). `context` and `timeline` must
+/// outlive it.
+std::unique_ptr<ReferenceSession> make_reference_session(
+    mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
+    RunTimeline& timeline, const nlohmann::json& settings = nlohmann::json::object());
 
 /// Why `text` is not an operator action of the car's vocabulary, or nullopt
 /// when it is one ("1:7: unknown direction 'UP'").

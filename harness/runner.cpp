@@ -325,7 +325,11 @@ bool ReferenceRun::make_client(const link::Endpoint& endpoint) {
                                : exec               ? &exec->command
                                                     : nullptr;
   if (command == nullptr) {
-    client_ = make_reference_session(scenario_.car, context_, endpoint, timeline_);
+    client_ = make_reference_session(
+        scenario_.car, context_, endpoint, timeline_,
+        std::holds_alternative<ReferenceClient>(scenario_.client)
+            ? std::get<ReferenceClient>(scenario_.client).settings
+            : nlohmann::json::object());
     return true;
   }
   external_ = true;

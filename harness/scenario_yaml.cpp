@@ -14,6 +14,7 @@
 #include "client/leka/operator.hpp"
 #include "client/logi/operator.hpp"
 #include "client/wr8/operator.hpp"
+#include "harness/reference_client.hpp"
 #include "harness/timeline_recorder.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/behaviour_yaml.hpp"
@@ -537,10 +538,11 @@ class Loader {
       ReferenceClient r;
       const auto ref = n["reference"];
       if (ref.IsMap()) {
-        check_keys(ref, {"real_time"}, "'client: reference'");
+        check_keys(ref, {"real_time", "settings"}, "'client: reference'");
         if (auto rt = ref["real_time"]) r.real_time = boolean(rt, "'real_time'");
+        if (auto settings = ref["settings"]) r.settings = reference_settings_of(settings);
       } else if (!ref.IsNull()) {
-        fail(ref, "'reference' takes a map like {real_time: true}, or nothing");
+        fail(ref, "'reference' takes a map like {real_time: true, settings: {...}}, or nothing");
       }
       return r;
     }
@@ -556,6 +558,34 @@ class Loader {
     }
     check_keys(n, {"reference", "exec", "startup_timeout"}, "'client'");
     fail(n, "'client' needs 'reference' or 'exec'");
+  }
+
+  /// `settings: {max_retries: 0, reconnect_delays: [1s, 2s]}`: options of
+  /// the car's client library, each checked by the library's own rules.
+  nlohmann::json reference_settings_of(const YAML::Node& n) const {
+    const std::string where = "'client: reference: settings'";
+    if (!n.IsMap()) fail(n, where + " must be a map like {max_retries: 0}");
+    Keys names;
+    for (const auto& s : reference_settings(scenario_.car))
+      names.push_back(s.name);
+    check_keys(n, names, where + " (" + car_title(scenario_.car) + ")");
+    auto out = nlohmann::json::object();
+    for (auto it : n) {
+      const std::string name = it.first.Scalar();
+      nlohmann::json value;
+      if (it.second.IsSequence()) {
+        value = nlohmann::json::array();
+        for (const auto& item : it.second)
+          value.push_back(scalar(item, where + ": '" + name + "'"));
+      } else {
+        value = scalar(it.second, where + ": '" + name + "'");
+      }
+      if (auto problem = reference_setting_problem(scenario_.car, name, value)) {
+        fail(it.second, where + ": " + *problem);
+      }
+      out[name] = std::move(value);
+    }
+    return out;
   }
 
   void check_placeholders(const YAML::Node& cmd) const {

@@ -261,6 +261,59 @@ TEST(ScenarioYaml, ExecClientKeepsItsCommandAndStartupTimeout) {
             ClientSpec{ReferenceClient{}});
 }
 
+TEST(ScenarioYaml, ReferenceClientSettingsAreCheckedByTheCarsClientLibrary) {
+  const auto logi_client = std::get<ReferenceClient>(
+      parse("name: t\ncar: logi\nsteps: [connect]\n"
+            "client:\n"
+            "  reference:\n"
+            "    real_time: true\n"
+            "    settings: {max_retries: 0, keepalive: on, reconnect_delays: [1s, 500ms]}\n")
+          .client);
+  EXPECT_TRUE(logi_client.real_time);
+  EXPECT_EQ(logi_client.settings,
+            (nlohmann::json{
+                {"max_retries", "0"}, {"keepalive", "on"}, {"reconnect_delays", {"1s", "500ms"}}}));
+  EXPECT_EQ(std::get<ReferenceClient>(
+                parse("name: t\ncar: wr8\nsteps: [connect]\n"
+                      "client: {reference: {settings: {auth: WRONG-AUTH, auth_timeout: 1s}}}\n")
+                    .client)
+                .settings,
+            (nlohmann::json{{"auth", "WRONG-AUTH"}, {"auth_timeout", "1s"}}));
+
+  const auto error = [](const std::string& car, const std::string& settings) {
+    return error_of("name: t\ncar: " + car + "\nsteps: [" +
+                    (car == "arduino" ? "PING" : "connect") +
+                    "]\nclient: {reference: {settings: " + settings + "}}\n");
+  };
+  EXPECT_EQ(error("logi", "{max_retrys: 1}"),
+            "t.yaml:4:33: 'client: reference: settings' (LOGI): unknown key 'max_retrys' "
+            "(allowed: feedback_timeout, max_retries, reconnect_delays, stale_after, keepalive, "
+            "keepalive_period); did you mean 'max_retries'?");
+  EXPECT_EQ(error("logi", "{max_retries: 11}"),
+            "t.yaml:4:46: 'client: reference: settings': 'max_retries' must be a whole number "
+            "0..10, got '11'");
+  EXPECT_EQ(error("logi", "{feedback_timeout: 800}"),
+            "t.yaml:4:51: 'client: reference: settings': 'feedback_timeout' must be a duration "
+            "above 0 with a unit (800ms, 2s), got '800'");
+  EXPECT_EQ(error("logi", "{reconnect_delays: []}"),
+            "t.yaml:4:51: 'client: reference: settings': 'reconnect_delays' must be a list of "
+            "durations above 0, like [1s, 2s, 3s], got '[]'");
+  EXPECT_EQ(error("wr8", "{auth: SHORT}"),
+            "t.yaml:4:39: 'client: reference: settings': 'auth' must be a text of exactly 10 "
+            "printable characters, got 'SHORT'");
+  EXPECT_EQ(error("arduino", "{keepalive: true}"),
+            "t.yaml:4:33: 'client: reference: settings' (Arduino): unknown key 'keepalive' "
+            "(allowed: base_timeout, max_retries, max_bad_cs_resends, health_check_interval, "
+            "reconnect_base_delay, max_reconnect_attempts, reconnect_ping_retries)");
+  // Zero is "never" where the library says so, and refused elsewhere.
+  EXPECT_EQ(error("arduino", "{health_check_interval: 0s}"), "");
+  EXPECT_EQ(error("leka", "{info_timeout: 0s}"),
+            "t.yaml:4:47: 'client: reference: settings': 'info_timeout' must be a duration above "
+            "0 with a unit (800ms, 2s), got '0s'");
+  EXPECT_EQ(error("leka", "max_retries"),
+            "t.yaml:4:32: 'client: reference: settings' must be a map like {max_retries: 0}");
+}
+
 TEST(ScenarioYaml, FilesAreFoundRelativeToTheScenario) {
   const auto s = load_scenario(kData + "/relative.yaml");
   EXPECT_EQ(s.world, kData + "/worlds/corridor.yaml");
