@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Runs the decoder, proxy, simulation and mock-car benchmarks on a
-# RelWithDebInfo build and rewrites their sections of docs/performance.md
-# with the results.
-# Usage: bench/run.sh [decoder] [proxy] [sim] [mock]
+# Runs the decoder, proxy, simulation, mock-car and random-session
+# benchmarks on a RelWithDebInfo build and rewrites their sections of
+# docs/performance.md with the results.
+# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [session]
 #   With no section named, runs them all. Each section is rewritten only when
 #   its benchmark ran to the end, so one section can be refreshed alone
 #   (bench/run.sh mock). Run on an otherwise idle machine.
@@ -12,12 +12,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 sections=("$@")
-[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock)
+[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock session)
 for section in "${sections[@]}"; do
   case $section in
-    decoder | proxy | sim | mock) ;;
+    decoder | proxy | sim | mock | session) ;;
     *)
-      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock)" >&2
+      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, session)" >&2
       exit 2
       ;;
   esac
@@ -107,6 +107,21 @@ run_mock() {
     echo
   } >"$work/mock.section"
   splice mock-bench "$work/mock.section"
+}
+
+run_session() {
+  cmake --build "$build" --target session_bench
+  "$build"/bench/session_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --hil_min_sessions_per_s=20 --hil_markdown="$work/session.md"
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh session\` (best of 5 repetitions of at least 0.5 s, CPU time):"
+    echo
+    cat "$work/session.md"
+    echo
+  } >"$work/session.section"
+  splice session-bench "$work/session.section"
 }
 
 for section in "${sections[@]}"; do
