@@ -68,6 +68,47 @@ ActionLine parse_action_line(int number, std::string_view line) {
 
 namespace {
 
+/// Whether the car may be moving, for the stop at the end: it may after the
+/// car accepted a move or a run (or left one unanswered) until a stop was
+/// accepted, the link went down, or a STAT that had shown it moving shows it
+/// at rest; and whenever the last STAT shows it moving. A move the car
+/// refused does not count, though the direction stays held in the client.
+class MotionTracker {
+ public:
+  void on_event(const logi::Event& e) {
+    if (const auto* c = std::get_if<logi::CommandEvent>(&e)) {
+      const bool ended_ok = c->state == logi::CommandState::accepted;
+      const bool maybe = ended_ok || c->state == logi::CommandState::uncertain;
+      if (const auto* m = std::get_if<proto::Move>(&c->command)) {
+        if (m->direction != proto::Direction::stop && maybe) commanded_ = true;
+        if (m->direction == proto::Direction::stop && ended_ok) commanded_ = false;
+      } else if (const auto* r = std::get_if<proto::SetRun>(&c->command)) {
+        if (r->run && maybe) commanded_ = true;
+        if (!r->run && ended_ok) commanded_ = false;
+      }
+    } else if (const auto* s = std::get_if<logi::StatusEvent>(&e)) {
+      const bool moving = s->status.running || s->status.manual != proto::Direction::stop;
+      if (moving) {
+        seen_moving_ = true;
+      } else if (seen_moving_) {
+        seen_moving_ = false;
+        commanded_ = false;  // it moved and has stopped (an arrival, say)
+      }
+    } else if (const auto* conn = std::get_if<logi::ConnectionEvent>(&e)) {
+      if (conn->state != ConnectionState::connected) commanded_ = seen_moving_ = false;
+    }
+  }
+
+  bool may_be_moving(const logi::LogiClientCore& core) const {
+    const auto& s = core.last_status();
+    return commanded_ || (s && (s->running || s->manual != proto::Direction::stop));
+  }
+
+ private:
+  bool commanded_ = false;
+  bool seen_moving_ = false;
+};
+
 /// The program's run: stdin lines in, one runner per action, the session,
 /// signals, and the way out.
 class StdinActionsRun {
@@ -238,6 +279,7 @@ class StdinActionsRun {
     } else if (const auto* conn = std::get_if<logi::ConnectionEvent>(&e)) {
       if (conn->state != ConnectionState::connected) confirmable_.reset();
     }
+    motion_.on_event(e);
     if (runner_) runner_->on_event(now, e);
     for (auto& [id, runner] : early_)
       runner->on_event(now, e);
@@ -283,7 +325,7 @@ class StdinActionsRun {
                   executor_.now())));
     }
     const bool connected = session_->core().state() == ConnectionState::connected;
-    if (stop_car && connected && car_may_be_moving(session_->core())) {
+    if (stop_car && connected && motion_.may_be_moving(session_->core())) {
       print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
             (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
       session_->emergency_stop();
@@ -334,6 +376,7 @@ class StdinActionsRun {
   std::map<std::uint64_t, std::unique_ptr<logi::OperatorRunner>> early_;
   std::uint64_t early_ids_ = 0;
   std::optional<logi::RequestId> confirmable_;
+  MotionTracker motion_;
   int line_number_ = 0;
   bool busy_ = false;
   bool next_posted_ = false;

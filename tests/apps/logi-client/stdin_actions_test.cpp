@@ -120,6 +120,24 @@ TEST(LogiClientStdinActions, AnswersEachActionAsItArrivesAndStopsTheCarWhenStdin
   EXPECT_TRUE(contains(frames.back(), "LOGI:MV:STOP:88#")) << frames.back();
 }
 
+TEST(LogiClientStdinActions, AMoveTheCarRefusedIsNoReasonForAStopAtTheEnd) {
+  const TempDir temp("logi-client-stdin-refused");
+  const std::string wire = temp.file("wire.ndjson");
+  MockLogi car(
+      {"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml", "--log", wire});
+  ASSERT_FALSE(car.port().empty()) << car.output();
+  auto client = stdin_client(car.port());
+  ASSERT_TRUE(client.write_stdin("connect\nspeed 50\nmode MAN\npress FWD\n"));
+  EXPECT_TRUE(client.wait_for_line("] FAIL press FWD: rejected by the car (FB:MV:0)"))
+      << client.output();
+  client.close_stdin();
+  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  EXPECT_FALSE(contains(client.output(), "emergency stop")) << client.output();
+  ASSERT_EQ(car.stop(), 0) << car.output();
+  for (const auto& frame : delivered_to_car(read_file(wire)))
+    EXPECT_FALSE(contains(frame, "MV:STOP")) << frame;
+}
+
 TEST(LogiClientStdinActions, ABadLineOrARefusedActionFailsThatLineOnlyAndTheExitIsStill0) {
   MockLogi car;
   ASSERT_FALSE(car.port().empty()) << car.output();
