@@ -18,11 +18,19 @@ namespace {
 using link::milliseconds;
 using link::seconds;
 
+// A step as a scenario file would give it (line 0: built in code).
+Step step_of(std::string text, StepAction action) {
+  Step s;
+  s.text = std::move(text);
+  s.action = std::move(action);
+  return s;
+}
+
 Step action(const std::string& text) {
-  return Step{0, text, ActionStep{text}};
+  return step_of(text, ActionStep{text});
 }
 Step wait(Duration d) {
-  return Step{0, "wait", WaitStep{d}};
+  return step_of("wait", WaitStep{d});
 }
 
 Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Step> steps) {

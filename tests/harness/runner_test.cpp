@@ -20,20 +20,29 @@ namespace {
 using link::milliseconds;
 using link::seconds;
 
+// A step as a scenario file would give it (line 0: built in code).
+Step step_of(std::string text, StepAction action) {
+  Step s;
+  s.text = std::move(text);
+  s.action = std::move(action);
+  return s;
+}
+
 Step action(const std::string& text) {
-  return Step{0, text, ActionStep{text}};
+  return step_of(text, ActionStep{text});
 }
 Step wait(Duration d) {
-  return Step{0, "wait", WaitStep{d}};
+  return step_of("wait", WaitStep{d});
 }
 Step wait_until(Matcher m, Duration timeout) {
-  return Step{0, "wait until " + m.text, WaitUntilStep{std::move(m), timeout}};
+  std::string text = "wait until " + m.text;
+  return step_of(std::move(text), WaitUntilStep{std::move(m), timeout});
 }
 Step car(std::string text, mocks::Action a) {
-  return Step{0, text, CarStep{mocks::Behaviour{text, {}, std::move(a)}}};
+  return step_of(text, CarStep{mocks::Behaviour{text, {}, std::move(a)}});
 }
 Step faults(std::string text, link::FaultProfile p) {
-  return Step{0, std::move(text), FaultsStep{std::move(p)}};
+  return step_of(std::move(text), FaultsStep{std::move(p)});
 }
 
 Matcher sim_kind(std::string kind) {
@@ -380,8 +389,8 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
 TEST(RunnerOtherCars, AnObstaclePutAheadOfTheWr8IsHitAndCanBeTakenAway) {
   Scenario s = scenario(
       mocks::CarKind::wr8,
-      {action("connect"), Step{0, "parcel", ObstacleStep{true, 0.05, "parcel"}},
-       action("drive 100"), wait(seconds(1)), Step{0, "lift", ObstacleStep{false, 0, "parcel"}}});
+      {action("connect"), step_of("parcel", ObstacleStep{true, 0.05, "parcel"}),
+       action("drive 100"), wait(seconds(1)), step_of("lift", ObstacleStep{false, 0, "parcel"})});
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
   const auto hits = of(o, Source::sim, "collision");
@@ -393,7 +402,7 @@ TEST(RunnerOtherCars, AnObstaclePutAheadOfTheWr8IsHitAndCanBeTakenAway) {
   ASSERT_EQ(o.arena.obstacles.size(), 1u + sim::default_warehouse_arena().obstacles.size());
 
   Scenario lift_nothing =
-      scenario(mocks::CarKind::logi, {Step{0, "lift", ObstacleStep{false, 0, "parcel"}}});
+      scenario(mocks::CarKind::logi, {step_of("lift", ObstacleStep{false, 0, "parcel"})});
   EXPECT_EQ(run_scenario(lift_nothing).first_failure(),
             "step line 0 (lift): no obstacle named 'parcel' to take away");
 }
