@@ -349,7 +349,22 @@ std::string check_stop_on_release(const Rig& rig) {
     if (op.kind != OpRecord::Kind::release || !op.result) continue;
     const auto it = steps.find(op.result.request);
     const std::string what = "release at " + ms(op.at);
-    if (it == steps.end() || it->second.empty()) return what + ": no MV:STOP was ever written";
+    if (it == steps.end() || it->second.empty()) {
+      if (op.line_idle) return what + " on an idle line: no MV:STOP was written";
+      // On a busy line it waits its turn: no later operator request may go first.
+      for (const auto& later : rig.ops) {
+        if (!later.result || later.kind == OpRecord::Kind::estop ||
+            later.result.request <= op.result.request) {
+          continue;
+        }
+        const auto l = steps.find(later.result.request);
+        if (l != steps.end() && !l->second.empty()) {
+          return what + ": no MV:STOP written, yet request " +
+                 std::to_string(later.result.request) + " queued after it was";
+        }
+      }
+      continue;
+    }
     const auto* first = std::get_if<CommandEvent>(it->second.front().e);
     if (first == nullptr) return what + ": odd first event";
     if (first->state == CommandState::cancelled) continue;  // the link went first
@@ -559,14 +574,17 @@ std::string check_bad_checksum(const Rig& rig) {
 
 std::string check_fb_matching(const Rig& rig) {
   if (auto why = compare_streams(rig); !why.empty()) return why;
-  std::vector<std::pair<RequestId, proto::Command>> waiting;  // in send order
+  std::vector<std::pair<RequestId, proto::Command>> waiting;  // in order of last send
   for (const auto& [t, e] : rig.events) {
     if (const auto* c = std::get_if<CommandEvent>(&e)) {
       const auto code = *proto::command_of(c->command);
       auto it = std::find_if(waiting.begin(), waiting.end(),
                              [&](const auto& w) { return w.first == c->request; });
       if (c->state == CommandState::sent) {
-        if (it == waiting.end()) waiting.emplace_back(c->request, code);
+        // The car answers in the order frames reach it, so a resend goes to
+        // the back: its answer follows those of frames written before it.
+        if (it != waiting.end()) waiting.erase(it);
+        waiting.emplace_back(c->request, code);
       } else if (it != waiting.end()) {
         waiting.erase(it);
       }
@@ -797,7 +815,8 @@ std::string check_estop_accessible(const Rig& rig) {
   for (const auto& op : rig.ops) {
     if (op.kind != OpRecord::Kind::estop) continue;
     const bool connected = op.state_before == ConnectionState::connected;
-    if (connected != static_cast<bool>(op.result)) {
+    const Refusal want = connected ? Refusal::none : Refusal::not_connected;
+    if (op.result.refusal != want) {
       return "emergency stop at " + ms(op.at) + " answered '" +
              std::string(to_string(op.result.refusal)) + "' while " +
              std::string(to_string(op.state_before));
@@ -835,7 +854,96 @@ std::string first_failure(Rig& rig, Prop p) {
   return f.empty() ? std::string() : f.front();
 }
 
+template <class E, class Pred>
+bool any_event(const Rig& rig, Pred pred) {
+  return std::any_of(rig.events.begin(), rig.events.end(), [&](const auto& te) {
+    const auto* e = std::get_if<E>(&te.second);
+    return e != nullptr && pred(*e);
+  });
+}
+template <class Pred>
+bool any_op(const Rig& rig, Pred pred) {
+  return std::any_of(rig.ops.begin(), rig.ops.end(), pred);
+}
+
 }  // namespace
+
+bool exercised(Prop p, const Rig& rig) {
+  const auto connected_estop = [](const OpRecord& op) {
+    return op.kind == OpRecord::Kind::estop && op.state_before == ConnectionState::connected;
+  };
+  switch (p) {
+    case Prop::backoff_delays:
+    case Prop::safe_state_and_reconfirm:
+      return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {
+        return c.state == ConnectionState::waiting_to_reconnect;
+      });
+    case Prop::reconnects_automatically:
+      return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {
+        return c.state == ConnectionState::connecting && c.attempt > 0;
+      });
+    case Prop::single_outbound_queue:
+      return any_op(rig, [](const OpRecord& op) {
+        return !op.line_idle && op.result && op.kind != OpRecord::Kind::estop;
+      });
+    case Prop::feedback_timeout_800ms:
+    case Prop::retry_rules:
+      return any_event<CommandEvent>(rig, [](const CommandEvent& c) {
+        return c.state == CommandState::uncertain || c.attempt > 1;
+      });
+    case Prop::stop_on_release:
+      return any_op(
+          rig, [](const OpRecord& op) { return op.kind == OpRecord::Kind::release && op.result; });
+    case Prop::stale_after_2s:
+      return any_event<StaleEvent>(rig, [](const StaleEvent& s) { return s.stale; });
+    case Prop::emergency_stop_order:
+    case Prop::emergency_stop_accessible:
+      return any_op(rig, connected_estop);
+    case Prop::mode_conflict:
+      return any_event<NoticeEvent>(rig, [](const NoticeEvent&) { return true; });
+    case Prop::bad_checksum_dropped:
+      return any_event<ParseErrorEvent>(rig, [](const ParseErrorEvent& e) {
+        return e.error.kind == protocol::ErrorKind::bad_checksum;
+      });
+    case Prop::stream_gives_every_frame:
+      return std::any_of(rig.faults.begin(), rig.faults.end(), [](const link::FaultEvent& f) {
+        return f.direction == link::Direction::to_client &&
+               (f.kind == "fragment" || f.kind == "coalesce");
+      });
+    case Prop::chassis_rests_after_stop:
+      return rig.stop_claims > 0;
+    case Prop::connect_disconnect:
+      return any_op(rig, [](const OpRecord& op) { return op.kind == OpRecord::Kind::disconnect; });
+    case Prop::status_and_feedback_parsed:
+      return any_event<FeedbackEvent>(rig, [](const FeedbackEvent&) { return true; });
+    case Prop::buttons_send_exact_frames:
+    case Prop::checksums_built_right:
+      return any_event<CommandEvent>(
+          rig, [](const CommandEvent& c) { return c.state == CommandState::sent; });
+    case Prop::manual_directions:
+      return std::any_of(rig.car_accepted.begin(), rig.car_accepted.end(),
+                         [](const CarAccepted& a) {
+                           const auto* mv = std::get_if<proto::Move>(&a.command);
+                           return mv != nullptr && mv->direction != Direction::stop;
+                         });
+    case Prop::auto_flow:
+      return std::any_of(rig.car_accepted.begin(), rig.car_accepted.end(),
+                         [](const CarAccepted& a) {
+                           const auto* st = std::get_if<proto::SetRun>(&a.command);
+                           return st != nullptr && st->run;
+                         });
+    case Prop::log_has_tx_rx_errors:
+      return any_event<ParseErrorEvent>(rig, [](const ParseErrorEvent&) { return true; });
+    case Prop::telemetry_visible:
+      return any_event<StatusEvent>(rig, [](const StatusEvent&) { return true; });
+    case Prop::mode_and_direction_shown:
+      return any_op(
+          rig, [](const OpRecord& op) { return op.kind == OpRecord::Kind::press && op.result; });
+    case Prop::count_:
+      break;
+  }
+  return false;
+}
 
 std::string check(Prop p, Rig& rig) {
   if (auto why = first_failure(rig, p); !why.empty()) return why;

@@ -120,7 +120,7 @@ Focus focus_for(Prop p) {
       f.station = 6;
       f.run = 6;
       f.stop = 4;
-      f.mode = 6;
+      f.press = 1;  // a press switches the car to MAN, where RUN is refused
       break;
     default:
       break;
@@ -276,25 +276,31 @@ void Rig::fail(Prop p, std::string why) {
 }
 
 void Rig::advance_to(Time until) {
+  // One task at a time: a stop reaching the car adds a check 520 ms ahead,
+  // and the clock must stop there even within one long wait.
   for (;;) {
-    const bool chassis_first =
-        !chassis_checks_.empty() &&
-        (rest_checks_.empty() || chassis_checks_.begin()->first <= rest_checks_.begin()->first);
-    if (chassis_first && chassis_checks_.begin()->first <= until) {
-      const auto [due, index] = *chassis_checks_.begin();
+    std::optional<Time> check_due;
+    if (!chassis_checks_.empty()) check_due = chassis_checks_.begin()->first;
+    if (!rest_checks_.empty() && (!check_due || rest_checks_.begin()->first < *check_due)) {
+      check_due = rest_checks_.begin()->first;
+    }
+    const Time target = check_due && *check_due < until ? *check_due : until;
+    const auto next = car_.executor.next_due();
+    if (next && *next <= target) {
+      car_.executor.run_one();
+      continue;
+    }
+    if (!check_due || *check_due > until) break;
+    car_.executor.run_until(*check_due);
+    if (!chassis_checks_.empty() && chassis_checks_.begin()->first == *check_due) {
+      const std::size_t index = chassis_checks_.begin()->second;
       chassis_checks_.erase(chassis_checks_.begin());
-      car_.executor.run_until(due);
-      check_chassis(due, index);
-      continue;
-    }
-    if (!rest_checks_.empty() && rest_checks_.begin()->first <= until) {
-      const auto [due, op] = *rest_checks_.begin();
+      check_chassis(*check_due, index);
+    } else {
+      const std::size_t op = rest_checks_.begin()->second;
       rest_checks_.erase(rest_checks_.begin());
-      car_.executor.run_until(due);
-      check_rest(due, op);
-      continue;
+      check_rest(*check_due, op);
     }
-    break;
   }
   car_.executor.run_until(until);
 }
@@ -309,6 +315,7 @@ void Rig::check_chassis(Time due, std::size_t index) {
   for (std::size_t i = index + 1; i < car_frames.size() && car_frames[i].at <= due; ++i) {
     if (is_movement(car_frames[i].message)) return;
   }
+  ++stop_claims;
   if (!at_rest()) {
     const auto t = vehicle().chassis().wheel_twist();
     fail(Prop::chassis_rests_after_stop,
@@ -343,6 +350,7 @@ void Rig::check_rest(Time due, std::size_t op_index) {
     if (text_of(f.before).find("STOP") != std::string::npos) ++stops_destroyed;
   }
   if (stops_sent > 0 && stops_destroyed >= stops_sent) return;
+  ++stop_claims;
   if (!at_rest()) {
     fail(Prop::chassis_rests_after_stop,
          std::string(op.kind == OpRecord::Kind::estop ? "emergency stop" : "release") + " at " +
@@ -849,8 +857,19 @@ std::function<rc::Gen<CommandPtr>(const Model&)> gen_command(Focus f) {
 void run_property(Prop p, PlantedBug bug) {
   const auto seed = *rc::gen::inRange<std::uint64_t>(1, 1u << 30);
   Rig rig(bug, seed);
-  rc::state::check(Model{}, rig, gen_command(focus_for(p)));
+  // Every session starts with the operator connecting, and holds at least
+  // 40 actions (rapidcheck's early, small sizes would leave most of the
+  // 60 s idle).
+  rig.op_connect();
+  Model model;
+  model.want_connected = true;
+  const auto gen = gen_command(focus_for(p));
+  const auto commands = *rc::gen::withSize([model, gen](int size) {
+    return rc::gen::resize(std::max(40, size * 2), rc::state::gen::commands(model, gen));
+  });
+  rc::state::runAll(commands, model, rig);
   if (rig.now() < kSessionLength) rig.advance_to(kSessionLength);
+  RC_TAG(exercised(p, rig) ? "exercised" : "not exercised");
   const std::string why = check(p, rig);
   if (!why.empty()) RC_FAIL(std::string(name_of(p)) + ": " + why + "\n" + rig.timeline());
 }

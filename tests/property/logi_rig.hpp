@@ -189,6 +189,8 @@ class Rig {
   std::optional<protocol::logi::Mode> shown_mode;  ///< last STAT's or accepted MD's mode
   std::optional<protocol::logi::Status> last_status;
   std::vector<CarAccepted> car_accepted;
+  /// Chassis checks that made a claim (not voided by later motion or loss).
+  std::size_t stop_claims = 0;
 
  private:
   class Observer;
@@ -225,6 +227,10 @@ std::function<rc::Gen<CommandPtr>(const Model&)> gen_command(Focus focus);
 
 /// The check of property `p` over a finished session; empty when it holds.
 std::string check(Prop p, Rig& rig);
+
+/// Whether the session reached the situation property `p` is about (for
+/// the distribution rapidcheck prints: how often each rule was tested).
+bool exercised(Prop p, const Rig& rig);
 
 /// One random session of 60 s under `bug`, then property `p` checked.
 /// This is the body of every named property (RC_ASSERT inside).

@@ -66,7 +66,10 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"OneReadTakenAsOneFrame", PlantedBug::read_is_frame, Prop::stream_gives_every_frame},
         Case{"StaleAt5s", PlantedBug::stale_at_5s, Prop::stale_after_2s},
         Case{"NoSpRetry", PlantedBug::no_sp_retry, Prop::retry_rules},
-        Case{"StStopBeforeMvStop", PlantedBug::st_stop_first, Prop::emergency_stop_order}),
+        Case{"StStopBeforeMvStop", PlantedBug::st_stop_first, Prop::emergency_stop_order},
+        // The end-to-end property sees a missing stop too: the car drives on.
+        Case{"NoMvStopOnReleaseLeavesTheCarMoving", PlantedBug::no_stop_on_release,
+             Prop::chassis_rests_after_stop}),
     [](const ::testing::TestParamInfo<Case>& param) { return std::string(param.param.name); });
 
 }  // namespace

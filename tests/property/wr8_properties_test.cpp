@@ -674,8 +674,12 @@ struct CarMisbehaves : Wr8Command {
   }
 };
 
-RC_GTEST_PROP(Wr8ClientProperties,
-              UnderAnyFaultsLoginComesFirstAndEveryAnswerMatchesItsCoiAcrossTheWrap, ()) {
+/// A random session: a random fault schedule, a connect, then random
+/// tasks, settings, bursts of checks, waits, vehicle misbehaviour,
+/// disconnects and connects (each submit checks the COI or the refusal at
+/// once), then 40 s for every answer, timeout and reconnect to play out;
+/// `check` reads the whole run.
+void after_a_random_session(void (*check)(const Wr8Rig&)) {
   Wr8Rig rig(*gen_faults());
   rig.acts.emplace_back(rig.now(), OperatorAct::connect);
   rig.session->connect();
@@ -684,9 +688,36 @@ RC_GTEST_PROP(Wr8ClientProperties,
       rc::state::gen::execOneOfWithArgs<SubmitTask, SubmitTask, SubmitTask, SubmitSettings, Burst,
                                         Advance, Advance, Advance, Connect, Connect, Connect,
                                         Disconnect, CarMisbehaves>());
-  // Let every answer, timeout and reconnect play out, then check the whole run.
   rig.car.executor.run_for(seconds(40));
-  check_all(rig);
+  RC_LOG() << dump(rig);
+  check(rig);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties, NothingButAuthGoesOutBeforeTheLoginOnEveryConnection, ()) {
+  after_a_random_session(check_login_first);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties,
+              EveryAnswerMatchesItsOpenRequestByCoiAcrossTheWrapAndEveryTimeoutComesOnTime, ()) {
+  after_a_random_session(check_coi_correlation);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties, ADropCancelsEveryOpenRequestInThatInstantAndNothingElseDoes,
+              ()) {
+  after_a_random_session(check_cancellations);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties, DataIsTakenAsSentAndGoesStaleExactly500MsAfterTheLast, ()) {
+  after_a_random_session(check_data_stream);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties, ReconnectsBackOff1248SAndALoginWithoutReplyFailsAtExactly2S,
+              ()) {
+  after_a_random_session(check_reconnects);
+}
+
+RC_GTEST_PROP(Wr8ClientProperties, ADriveReportedCompletedHasMovedTheCarItsDistance, ()) {
+  after_a_random_session(check_drives);
 }
 
 RC_GTEST_PROP(Wr8ClientProperties, OnACleanLinkEveryTaskEndsWithTheVehiclesAnswer, ()) {
