@@ -5,16 +5,15 @@
 // operator session, checked from its frame log, its events and the chassis.
 //
 // Each property was seen to fail with its rule broken on purpose in a copy
-// of the client (never in this tree), then the copy was thrown away:
-//   - timeout not doubled (base_timeout * (attempt + 1)): the attempt-time
-//     properties fail;
-//   - a BAD_CS NACK counted as a retry instead of a resend: the core
-//     model and the session's attempt classification fail;
-//   - any ACK taken whatever its SEQ: the SEQ-matching properties fail (a
-//     duplicated or stale ACK taken for the next request);
-//   - the reconnect check skipped (OPEN as soon as the port reopens): the
-//     reconnect property fails;
-//   - the reconnect delay fixed at 0.5 s: the link-state property fails.
+// of client/arduino/client_core.cpp (never in this tree), then the copy was
+// thrown away; 300 sessions per property found each of these:
+//   - timeouts growing base x (attempt + 1) instead of doubling, a BAD_CS
+//     resend counted as a retry: EachAttemptWaitsTwiceTheLast... and
+//     EveryRetryComesOnItsDoubledTimeout...;
+//   - an ACK taken whatever its SEQ: EachAttemptWaitsTwiceTheLast... and
+//     AnAnswerIsTakenOnlyForTheRequestWithItsSeq...;
+//   - a reopened port counted OPEN without its PING, the reconnect delay
+//     kept at 0.5 s instead of doubling: TheLinkMovesAlongItsStateMachine....
 // RC_PARAMS="seed=..." printed with a failure replays it.
 
 #include <gtest/gtest.h>
@@ -560,7 +559,8 @@ void check_results(const ArduinoRig& rig, const std::vector<WireFrame>& wire,
         RC_ASSERT(d.at ==
                   last_send + config.base_timeout * (std::int64_t{1} << config.max_retries));
       }
-      if (r.code == ResultCode::nack && r.nack == std::optional(proto::Nack{proto::NackCode::bad_cs}))
+      if (r.code == ResultCode::nack &&
+          r.nack == std::optional(proto::Nack{proto::NackCode::bad_cs}))
         RC_ASSERT(r.bad_cs_resends == config.max_bad_cs_resends);
       continue;
     }
@@ -843,8 +843,8 @@ void after_a_random_session(Check check) {
   check(rig, wire);
 }
 
-RC_GTEST_PROP(ArduinoClientProperties, AnAnswerIsTakenOnlyForTheRequestWithItsSeqAndSaysWhatTheRobotSaid,
-              ()) {
+RC_GTEST_PROP(ArduinoClientProperties,
+              AnAnswerIsTakenOnlyForTheRequestWithItsSeqAndSaysWhatTheRobotSaid, ()) {
   after_a_random_session([](const ArduinoRig& rig, const std::vector<WireFrame>& wire) {
     check_results(rig, wire, check_attempt_times(rig, wire), ResultRules::answers);
   });
@@ -864,7 +864,8 @@ RC_GTEST_PROP(ArduinoClientProperties,
 
 RC_GTEST_PROP(ArduinoClientProperties, RequestsAreServedOneAtATimeInOrderAndEachEndsExactlyOnce,
               ()) {
-  after_a_random_session([](const ArduinoRig& rig, const std::vector<WireFrame>&) { check_order(rig); });
+  after_a_random_session(
+      [](const ArduinoRig& rig, const std::vector<WireFrame>&) { check_order(rig); });
 }
 
 RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAndTheLinkStaysOpen,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 
@@ -854,7 +855,29 @@ std::function<rc::Gen<CommandPtr>(const Model&)> gen_command(Focus f) {
   };
 }
 
+namespace {
+/// HIL_LOGI_PLANTED_BUG=<name> plants a bug in every session of the
+/// properties program, to watch a property catch it and replay the failure.
+PlantedBug bug_from_environment() {
+  static const PlantedBug bug = [] {
+    const char* name = std::getenv("HIL_LOGI_PLANTED_BUG");
+    if (name == nullptr) return PlantedBug::none;
+    const std::string n = name;
+    if (n == "no_backoff") return PlantedBug::no_backoff;
+    if (n == "retry_run") return PlantedBug::retry_run;
+    if (n == "no_stop_on_release") return PlantedBug::no_stop_on_release;
+    if (n == "read_is_frame") return PlantedBug::read_is_frame;
+    if (n == "stale_at_5s") return PlantedBug::stale_at_5s;
+    if (n == "no_sp_retry") return PlantedBug::no_sp_retry;
+    if (n == "st_stop_first") return PlantedBug::st_stop_first;
+    return PlantedBug::none;
+  }();
+  return bug;
+}
+}  // namespace
+
 void run_property(Prop p, PlantedBug bug) {
+  if (bug == PlantedBug::none) bug = bug_from_environment();
   const auto seed = *rc::gen::inRange<std::uint64_t>(1, 1u << 30);
   Rig rig(bug, seed);
   // Every session starts with the operator connecting, and holds at least
