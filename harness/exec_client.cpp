@@ -99,6 +99,19 @@ std::optional<ClientLine> event_line(std::string_view rest) {
     line.record_data["text"] = std::string(args);
     return line;
   }
+  if (what == "parse_error" && !args.empty()) {
+    line.record_kind = "parse_error";
+    line.record_data["text"] = std::string(args);
+    return line;
+  }
+  if (what == "movement") {
+    const auto [state, reason] = first_word(args);
+    if (state != "enabled" && state != "disabled") return std::nullopt;
+    line.record_kind = "movement";
+    line.record_data["enabled"] = state == "enabled";
+    line.record_data["reason"] = std::string(reason);
+    return line;
+  }
   if (what == "login") {
     const auto [result, reason] = first_word(args);
     if (result != "ok" && result != "failed") return std::nullopt;

@@ -1133,9 +1133,14 @@ class Loader {
             word == "stale" ? "client warned of stale telemetry" : "client telemetry fresh again";
         return m;
       }
+      if (word == "parse_error") {
+        m.kind = word;
+        m.text = "client reported a frame it could not parse";
+        return m;
+      }
       if (!contains(kClientStates, word)) {
         Keys known = kClientStates;
-        known.insert(known.end(), {"stale", "fresh"});
+        known.insert(known.end(), {"stale", "fresh", "parse_error"});
         fail(v, where + ": unknown client state '" + word + "' (expected " + join(known) + ")" +
                     suggestion(word, known));
       }
@@ -1147,8 +1152,8 @@ class Loader {
     if (!v.IsMap()) {
       fail(v, where + " must be a state (connected, stale, ...) or a map like {notice: \"text\"}");
     }
-    static const Keys kKinds = {"notice", "command",    "exit", "output",
-                                "action", "connection", "login"};
+    static const Keys kKinds = {"notice",     "command", "exit",     "output",     "action",
+                                "connection", "login",   "movement", "parse_error"};
     Keys allowed = kKinds;
     allowed.insert(allowed.end(), {"state", "ok", "reason"});
     check_keys(v, allowed, where);
@@ -1187,6 +1192,23 @@ class Loader {
         const auto code = static_cast<std::int64_t>(whole(x, "'exit'", 0));
         m.tests.push_back(test("code", FieldTest::Op::equals, code));
         m.text += " with " + std::to_string(code);
+      }
+    } else if (kind == "parse_error") {
+      only({});
+      const std::string text = scalar(x, "'parse_error'");
+      m.kind = "parse_error";
+      m.tests.push_back(test("text", FieldTest::Op::contains, text));
+      m.text = "client could not parse a frame: '" + text + "'";
+    } else if (kind == "movement") {
+      only({"reason"});
+      const bool enabled = boolean(x, "'movement'");
+      m.kind = "movement";
+      m.tests.push_back(test("enabled", FieldTest::Op::equals, enabled));
+      m.text = enabled ? "client enabled movement" : "client disabled movement";
+      if (auto reason = v["reason"]) {
+        const std::string r = scalar(reason, "'reason'");
+        m.tests.push_back(test("reason", FieldTest::Op::contains, r));
+        m.text += " because of '" + r + "'";
       }
     } else if (kind == "login") {
       only({"reason"});

@@ -63,6 +63,18 @@ TEST(ClientLines, EventLinesBecomeTheReferenceClientsRecords) {
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
   EXPECT_EQ(line.record_data["text"], "Not in manual mode");
 
+  line = parse_client_line("event parse_error bad_checksum: checksum 00, computed 4D");
+  ASSERT_EQ(line.kind, ClientLine::Kind::event);
+  EXPECT_EQ(line.record_kind, "parse_error");
+  EXPECT_EQ(line.record_data["text"], "bad_checksum: checksum 00, computed 4D");
+
+  line = parse_client_line("event movement disabled not connected");
+  ASSERT_EQ(line.kind, ClientLine::Kind::event);
+  EXPECT_EQ(line.record_kind, "movement");
+  EXPECT_EQ(line.record_data["enabled"], false);
+  EXPECT_EQ(line.record_data["reason"], "not connected");
+  EXPECT_EQ(parse_client_line("event movement enabled").record_data["enabled"], true);
+
   line = parse_client_line("event login failed wrong key");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
   EXPECT_EQ(line.record_data["ok"], false);

@@ -663,6 +663,26 @@ TEST(ScenarioYamlMatchers, FrameContentMistakesAreReportedWhereTheyAre) {
   EXPECT_EQ(error_of(head + "{received_by_client: STAT, fields: {BAT: 87}}\n"), "");
 }
 
+TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
+  EXPECT_EQ(
+      matcher_of("{client: parse_error}"),
+      (Matcher{Source::client, "parse_error", {}, "client reported a frame it could not parse"}));
+  EXPECT_EQ(matcher_of("{client: {parse_error: bad_checksum}}"),
+            (Matcher{Source::client,
+                     "parse_error",
+                     {{"text", Op::contains, "bad_checksum"}},
+                     "client could not parse a frame: 'bad_checksum'"}));
+  EXPECT_EQ(matcher_of("{client: {movement: false, reason: not connected}}"),
+            (Matcher{Source::client,
+                     "movement",
+                     {{"enabled", Op::equals, false}, {"reason", Op::contains, "not connected"}},
+                     "client disabled movement because of 'not connected'"}));
+  const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - client: ";
+  EXPECT_NE(error_of(head + "{movement: maybe}\n"), "");
+  EXPECT_EQ(error_of(head + "{parse_error: x, state: y}\n"),
+            "t.yaml:5:37: expectation 1: 'client': 'state' does not go with 'parse_error'");
+}
+
 TEST(ScenarioYamlMatchers, ClientEvents) {
   EXPECT_EQ(matcher_of("{client: stale}"),
             (Matcher{Source::client, "stale", {}, "client warned of stale telemetry"}));
@@ -843,7 +863,7 @@ TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
       error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {client: conected}\n"),
       "t.yaml:5:14: expectation 1: 'client': unknown client state 'conected' (expected "
       "connected, disconnected, connecting, authenticating, reconnecting, degraded, down, stale, "
-      "fresh); did you mean 'connected'?");
+      "fresh, parse_error); did you mean 'connected'?");
   EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, count: 1, "
                      "never: true}\n"),
             "t.yaml:5:27: expectation 1: 'never' and 'count' do not go together");
