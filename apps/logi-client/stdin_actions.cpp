@@ -22,6 +22,17 @@ namespace hil::apps::logi_client {
 namespace proto = hil::protocol::logi;
 using logi::ConnectionState;
 
+namespace {
+
+/// One event is one line, whatever the text holds.
+std::string one_line(std::string text) {
+  for (char& ch : text)
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  return text;
+}
+
+}  // namespace
+
 std::optional<std::string> contract_event_line(const logi::Event& event) {
   if (const auto* c = std::get_if<logi::ConnectionEvent>(&event)) {
     switch (c->state) {
@@ -44,11 +55,17 @@ std::optional<std::string> contract_event_line(const logi::Event& event) {
     return s->stale ? "event stale" : "event fresh";
   }
   if (const auto* n = std::get_if<logi::NoticeEvent>(&event)) {
-    // One event is one line, whatever the text holds.
-    std::string text = n->text;
-    for (char& ch : text)
-      if (ch == '\n' || ch == '\r') ch = ' ';
-    return "event notice " + text;
+    return "event notice " + one_line(n->text);
+  }
+  if (const auto* p = std::get_if<logi::ParseErrorEvent>(&event)) {
+    std::string text(protocol::to_string(p->error.kind));
+    if (!p->error.detail.empty()) text += ": " + p->error.detail;
+    return "event parse_error " + one_line(text);
+  }
+  if (const auto* m = std::get_if<logi::MovementEvent>(&event)) {
+    std::string line = m->enabled ? "event movement enabled" : "event movement disabled";
+    if (!m->reason.empty()) line += " " + one_line(m->reason);
+    return line;
   }
   return std::nullopt;
 }

@@ -16,9 +16,10 @@ namespace hil::apps::logi_client {
 
 /// The contract's event line for a session event, if it has one:
 /// "event connection connected", "event command MV:FWD accepted",
-/// "event stale", "event fresh", "event notice <text>". The connection
-/// states are named as hil's own reference client records them
-/// (WaitingToReconnect is "reconnecting").
+/// "event stale", "event fresh", "event notice <text>",
+/// "event parse_error <error>", "event movement enabled|disabled [reason]".
+/// The connection states are named as hil's own reference client records
+/// them (WaitingToReconnect is "reconnecting").
 std::optional<std::string> contract_event_line(const logi::Event& event);
 
 /// One line of standard input, read as an operator action.

@@ -56,6 +56,15 @@ TEST(LogiClientStdinActions, EventLinesNameStatesAsHilsReferenceClientRecordsThe
   EXPECT_EQ(lc::contract_event_line(logi::StaleEvent{false}), "event fresh");
   EXPECT_EQ(lc::contract_event_line(logi::NoticeEvent{"Not in manual mode,\nswitching to MAN"}),
             "event notice Not in manual mode, switching to MAN");
+  protocol::DecodeError bad;
+  bad.kind = protocol::ErrorKind::bad_checksum;
+  bad.detail = "expected 35, got 00";
+  EXPECT_EQ(
+      lc::contract_event_line(logi::ParseErrorEvent{bad}),
+      "event parse_error " + std::string(protocol::to_string(bad.kind)) + ": expected 35, got 00");
+  EXPECT_EQ(lc::contract_event_line(logi::MovementEvent{false, "not connected"}),
+            "event movement disabled not connected");
+  EXPECT_EQ(lc::contract_event_line(logi::MovementEvent{true, ""}), "event movement enabled");
   // Telemetry is on the wire; hil needs no line for it.
   EXPECT_EQ(lc::contract_event_line(logi::StatusEvent{}), std::nullopt);
 }
