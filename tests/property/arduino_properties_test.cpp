@@ -498,13 +498,17 @@ std::vector<Exchange> check_attempt_times(const ArduinoRig& rig,
     if (rig.links[i].to != LinkState::degraded) continue;
     const Time from = rig.links[i].at;
     std::optional<Time> to;
+    bool down = false;
     for (std::size_t j = i + 1; j < rig.links.size() && !to; ++j) {
-      if (rig.links[j].to != LinkState::reconnecting && rig.links[j].to != LinkState::degraded)
+      if (rig.links[j].to != LinkState::reconnecting && rig.links[j].to != LinkState::degraded) {
         to = rig.links[j].at;
+        down = rig.links[j].to == LinkState::down;
+      }
     }
     for (auto& x : out) {
       const Time began = wire[x.first].at;
-      if (began > from && (!to || began < *to)) {
+      // The last attempt may fail (and the link go DOWN) in the instant it began.
+      if (began > from && (!to || began < *to || (down && began == *to))) {
         RC_ASSERT(std::holds_alternative<proto::Ping>(wire[x.first].message->body));
         x.reconnect_check = true;
       }
@@ -764,7 +768,7 @@ struct Advance : ArduinoCommand {
 
 struct CarMisbehaves : ArduinoCommand {
   int kind = *rc::gen::inRange(0, 4);
-  int ms = *rc::gen::inRange(100, 15'000);
+  int ms = *rc::gen::inRange(100, 30'000);
   void apply(OperatorModel&) const override {}
   void run(const OperatorModel&, ArduinoRig& rig) const override {
     mocks::Action action;

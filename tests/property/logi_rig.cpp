@@ -235,12 +235,6 @@ class Rig::Observer final : public link::LinkObserver {
       if (f == nullptr) continue;
       CarFrame cf{at, rig_->links.size() - 1, f->message, rig_->firmware().state().mode};
       rig_->car_frames.push_back(cf);
-      // A stop the car will act on: ST:STOP ends a run and manual motion,
-      // MV:STOP ends manual motion (in AUTO there is none to end).
-      const bool effective = std::holds_alternative<proto::SetRun>(cf.message)
-                                 ? is_stop(cf.message)
-                                 : is_stop(cf.message) && cf.car_mode == Mode::manual;
-      if (effective) rig_->chassis_checks_.emplace(at + kBrakeBound, rig_->car_frames.size() - 1);
     }
   }
   void on_fault(const link::FaultEvent& e) override {
@@ -334,6 +328,12 @@ void Rig::check_rest(Time due, std::size_t op_index) {
   for (const auto& l : links) {
     if (l.closed && *l.closed >= t && *l.closed <= due) return;
   }
+  // The attempts that count are the stops the car acts on in its mode: in
+  // AUTO only ST:STOP (MV:STOP is refused there), in MAN both.
+  const bool in_auto = op.car_mode == Mode::automatic;
+  const auto acts_on = [&](const proto::Message& m) {
+    return is_stop(m) && (!in_auto || std::holds_alternative<proto::SetRun>(m));
+  };
   // No new motion asked for.
   std::size_t stops_sent = 0;
   for (std::size_t i = op.events_before; i < events.size(); ++i) {
@@ -341,14 +341,16 @@ void Rig::check_rest(Time due, std::size_t op_index) {
     const auto* c = std::get_if<CommandEvent>(&e);
     if (c == nullptr || c->state != CommandState::sent) continue;
     if (is_movement(c->command)) return;
-    if (is_stop(c->command) && at <= t + kLastStopAttempt) ++stops_sent;
+    if (acts_on(c->command) && at <= t + kLastStopAttempt) ++stops_sent;
   }
-  // The fault schedule let none of the attempts through.
+  // The fault schedule let none of those attempts through.
   std::size_t stops_destroyed = 0;
   for (const auto& f : faults) {
     if (f.direction != link::Direction::to_car || f.at < t || f.at > t + kLastStopAttempt) continue;
     if (f.kind != "drop" && f.kind != "corrupt") continue;
-    if (text_of(f.before).find("STOP") != std::string::npos) ++stops_destroyed;
+    if (text_of(f.before).find(in_auto ? "ST:STOP" : "STOP") != std::string::npos) {
+      ++stops_destroyed;
+    }
   }
   if (stops_sent > 0 && stops_destroyed >= stops_sent) return;
   ++stop_claims;
@@ -364,13 +366,18 @@ void Rig::check_rest(Time due, std::size_t op_index) {
 void Rig::on_car_accepted(Time at, const proto::Feedback& fb) {
   // The command the car just answered: the last one of that code it received.
   const proto::Message* cmd = nullptr;
-  for (auto it = car_frames.rbegin(); it != car_frames.rend(); ++it) {
-    if (proto::command_of(it->message) == fb.command) {
-      cmd = &it->message;
+  std::size_t index = 0;
+  for (std::size_t i = car_frames.size(); i-- > 0;) {
+    if (proto::command_of(car_frames[i].message) == fb.command) {
+      cmd = &car_frames[i].message;
+      index = i;
       break;
     }
   }
   if (cmd == nullptr) return;
+  // The car acted on a stop (its answer says so; a frame delivered to a car
+  // that is hanging up may never be read): the chassis must rest 520 ms on.
+  if (is_stop(*cmd)) chassis_checks_.emplace(at + kBrakeBound, index);
   const auto& s = firmware().state();
   CarAccepted rec{at, *cmd, true, {}};
   if (const auto* mv = std::get_if<proto::Move>(cmd)) {
@@ -464,6 +471,7 @@ OpRecord Rig::begin_op(OpRecord::Kind kind, int value) {
   r.line_idle = core().in_flight() == 0 && core().queued() == 0;
   r.known_mode_before = core().known_mode();
   r.car_running = firmware().state().running;
+  r.car_mode = firmware().state().mode;
   r.events_before = events.size();
   r.links_before = links.size();
   return r;

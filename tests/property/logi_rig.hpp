@@ -123,7 +123,8 @@ struct OpRecord {
   ConnectionState state_before = ConnectionState::disconnected;
   bool line_idle = false;  ///< nothing in flight or queued before the call
   std::optional<protocol::logi::Mode> known_mode_before;
-  bool car_running = false;       ///< the car was in an auto run
+  bool car_running = false;                                         ///< the car was in an auto run
+  protocol::logi::Mode car_mode = protocol::logi::Mode::automatic;  ///< the car's own mode
   std::size_t links_before = 0;   ///< connections the wire had seen before the call
   std::size_t events_before = 0;  ///< index into events of the first event of the call
   std::size_t events_after = 0;   ///< one past the last

@@ -10,15 +10,17 @@
 // Each property was seen to fail with its rule broken on purpose in a copy
 // of client/wr8/core.cpp (never in this tree), then the copy was thrown
 // away; 300 sessions per property found each of these:
-//   - a TASK allowed while authenticating:
-//     NothingButAuthGoesOutBeforeTheLoginOnEveryConnection;
-//   - the next COI taken without skipping open ones, a RESPONSE for no open
-//     COI credited to the oldest open request, the answer timeout 1000 ms
-//     instead of 500: EveryAnswerMatchesItsOpenRequestByCoi...;
+//   - a TASK allowed while authenticating, the next COI taken without
+//     skipping open ones: every session property (the submit check), and
+//     NothingButAuthGoesOutBeforeTheLoginOnEveryConnection for the first;
+//   - a RESPONSE for no open COI credited to the oldest open request, the
+//     answer timeout 1000 ms instead of 500:
+//     EveryAnswerMatchesItsOpenRequestByCoiAcrossTheWrap...;
 //   - the reconnect series not started again by a login:
-//     ReconnectsBackOff1248S...;
+//     ReconnectsBackOff1248SAndALoginWithoutReplyFailsAtExactly2S;
 //   - the stale timer not restarted by each DATA:
-//     DataIsTakenAsSentAndGoesStaleExactly500MsAfterTheLast.
+//     DataIsTakenAsSentAndGoesStaleExactly500MsAfterTheLast and
+//     OnACleanLinkEveryTaskEndsWithTheVehiclesAnswer.
 // RC_PARAMS="seed=..." printed with a failure replays it.
 
 #include <gtest/gtest.h>
