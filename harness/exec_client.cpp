@@ -224,6 +224,10 @@ class ExecSession final : public ReferenceSession {
     posix_spawn_file_actions_adddup2(&actions, in[0], 0);
     posix_spawn_file_actions_adddup2(&actions, out[1], 1);
     posix_spawn_file_actions_adddup2(&actions, err[1], 2);
+    // Nothing else of hil's: the sockets of other runs going on at the
+    // same time (hil run -j) must not stay open in this program, or a
+    // close or reset there would not reach their clients.
+    posix_spawn_file_actions_addclosefrom_np(&actions, 3);
     posix_spawnattr_t attr;
     posix_spawnattr_init(&attr);
     // Its own process group, so a wrapper's children end with it; signals
@@ -501,7 +505,6 @@ ClientLine parse_client_line(std::string_view raw) {
   if (w == "ok") {
     line.kind = ClientLine::Kind::result;
     line.ok = true;
-    line.reason = std::string(rest);
     return line;
   }
   if (w == "fail") {

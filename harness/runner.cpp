@@ -325,11 +325,10 @@ bool ReferenceRun::make_client(const link::Endpoint& endpoint) {
                                : exec               ? &exec->command
                                                     : nullptr;
   if (command == nullptr) {
-    client_ = make_reference_session(
-        scenario_.car, context_, endpoint, timeline_,
-        std::holds_alternative<ReferenceClient>(scenario_.client)
-            ? std::get<ReferenceClient>(scenario_.client).settings
-            : nlohmann::json::object());
+    client_ = make_reference_session(scenario_.car, context_, endpoint, timeline_,
+                                     std::holds_alternative<ReferenceClient>(scenario_.client)
+                                         ? std::get<ReferenceClient>(scenario_.client).settings
+                                         : nlohmann::json::object());
     return true;
   }
   external_ = true;
@@ -719,6 +718,10 @@ void ReferenceRun::run() {
 
 void ReferenceRun::end() {
   steps_over_ = true;
+  // Expectations judge the session up to here: an external program's
+  // shutdown after its input closed (a last stop, the hang-up) is the
+  // contract's business, judged by its exit.
+  const Time session_end = executor_.now();
   if (external_) stop_external_client();
   ended_ = true;
   const Time run_end = executor_.now();
@@ -745,20 +748,25 @@ void ReferenceRun::end() {
   out_.trajectories = recorder_.trajectories();
   out_.run_time = run_end;
   auto expectations = scenario_.expectations;
+  const auto on_exit = [](const Expectation& e) {
+    return e.what.source == Source::client && e.what.kind == "exit";
+  };
   if (external_) {
     // Unless the scenario says what the exit should be, a clean one.
-    const bool said = std::any_of(expectations.begin(), expectations.end(), [](const auto& e) {
-      return e.what.source == Source::client && e.what.kind == "exit";
-    });
+    const bool said = std::any_of(expectations.begin(), expectations.end(), on_exit);
     if (!said) {
       Expectation exit;
       exit.label = "the client exited with code 0 after its input closed";
+      exit.window.from.offset = session_end - Time(0);
+      exit.window.within = run_end - session_end;
       exit.what = Matcher{
           Source::client, "exit", {FieldTest{"code", FieldTest::Op::equals, 0}}, "client exit 0"};
       expectations.push_back(std::move(exit));
     }
   }
-  out_.expectations = check_all(expectations, out_.timeline, run_end);
+  // An expectation on the exit looks past the session's end, where the exit is.
+  for (const auto& e : expectations)
+    out_.expectations.push_back(check(e, out_.timeline, on_exit(e) ? run_end : session_end));
 }
 
 }  // namespace

@@ -226,6 +226,52 @@ TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
   EXPECT_FALSE(o.expectations.back().passed);
 }
 
+TEST(ExternalClient, TheProgramInheritsNoSocketOrFileOfHils) {
+  // The car's listener is open in hil while the program starts; a program
+  // holding it (or another run's connection, under hil run -j) would keep
+  // connections alive that the scenario closes.
+  // The shell's own descriptors, listed by a child so listing opens none.
+  const std::string client = R"sh(python3 -c '
+import os
+fds = "/proc/%d/fd" % os.getppid()
+for n in sorted(os.listdir(fds), key=int):
+    if int(n) > 2:
+        print("extra fd", n, "->", os.readlink(fds + "/" + n))
+'
+  while read -r line; do echo "ok"; done)sh";
+  Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_TRUE(o.passed()) << summary(o);
+  EXPECT_EQ(lines_of(o), std::vector<std::string>{}) << summary(o);
+}
+
+TEST(ExternalClient, AnOkResultHasNoReason) {
+  Scenario s = exec_scenario(mocks::CarKind::logi, kEchoClient, {action("speed 50")});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+  const auto actions = of(o, Source::client, "action");
+  ASSERT_EQ(actions.size(), 1u);
+  EXPECT_EQ(actions[0].data["reason"], "");
+}
+
+TEST(ExternalClient, WhatTheProgramDoesAfterItsInputClosedIsNotJudgedByTheScenario) {
+  // A last frame-like output after the end: the scenario's "never" does
+  // not see it; the clean exit is still required.
+  const std::string client =
+      R"sh(while read -r line; do echo "ok"; done; echo "event command ST:STOP accepted")sh";
+  Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
+  Expectation never;
+  never.label = "no ST:STOP during the session";
+  never.quantifier = Quantifier::never;
+  never.what = Matcher{
+      Source::client, "command", {{"command", FieldTest::Op::equals, "ST:STOP"}}, "ST:STOP"};
+  s.expectations.push_back(never);
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_TRUE(o.passed()) << summary(o);
+  EXPECT_EQ(of(o, Source::client, "command").size(), 1u) << "still in the timeline";
+  EXPECT_EQ(o.expectations.size(), 2u);
+}
+
 TEST(ExternalClient, ACommandThatDoesNotExistSaysSo) {
   Scenario s =
       exec_scenario(mocks::CarKind::logi, "./no-such-client {host} {port}", {action("connect")});
