@@ -633,6 +633,31 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
     }
   }
   const auto exchanges = check_attempt_times(rig, wire);
+  // OPEN degrades only in the instant a request or the health check ran out
+  // of attempts or the port closed under it; and every request that ran out
+  // of attempts degrades it then.
+  for (const auto& l : rig.links) {
+    if (l.from != LinkState::open || l.to != LinkState::degraded) continue;
+    const bool request_timed_out = std::any_of(
+        rig.done.begin(), rig.done.end(),
+        [&](const auto& d) { return d.at == l.at && d.result.code == ResultCode::timeout; });
+    const bool health_check_timed_out =
+        std::any_of(exchanges.begin(), exchanges.end(), [&](const Exchange& x) {
+          return !x.reconnect_check && x.retries == config.max_retries &&
+                 std::holds_alternative<proto::Ping>(wire[x.first].message->body) &&
+                 wire[x.sends.back()].at +
+                         config.base_timeout * (std::int64_t{1} << config.max_retries) ==
+                     l.at;
+        });
+    const bool port_closed = std::count(rig.closes.begin(), rig.closes.end(), l.at) != 0;
+    RC_ASSERT(request_timed_out || health_check_timed_out || port_closed);
+  }
+  for (const auto& d : rig.done) {
+    if (d.result.code != ResultCode::timeout) continue;
+    RC_ASSERT(std::any_of(rig.links.begin(), rig.links.end(), [&](const LinkChanged& l) {
+      return l.at == d.at && l.to == LinkState::degraded;
+    }));
+  }
   // Reopen attempts: within one DEGRADED series the next attempt's PING goes
   // out 0.5 s x 2^failures after the previous attempt failed (timed exactly
   // when it failed by its full timeout, not by the port closing), and DOWN

@@ -31,8 +31,9 @@ HIL_LOGI_PROP(StickyAndSplitStreamsGiveEveryFrame, stream_gives_every_frame)
 // End to end, from the physics (logi_rig.hpp, kBrakeBound and kStopToRest):
 // top speed 0.5 m/s braked at 1 m/s^2 rests in 500 ms (+ two 1/120 s
 // steps: 520 ms after a stop reaches the car); a stop written at once is
-// attempted at 0, 800 and 1600 ms, so whenever one attempt gets through
-// the chassis is at rest 2120 ms after the release or emergency stop.
+// attempted at 0, 800 and 1600 ms, so whenever one attempt the car acts on
+// gets through (in AUTO: ST:STOP) the chassis is at rest 2120 ms after the
+// release or emergency stop.
 HIL_LOGI_PROP(ChassisRestsWithin2120msOfAStopThatGetsThrough, chassis_rests_after_stop)
 
 // ---- section 10: the checklist ----

@@ -44,7 +44,8 @@ inline constexpr Duration kBrakeBound = milliseconds(520);
 inline constexpr Duration kLastStopAttempt = milliseconds(1600);
 /// End to end: the chassis rests within 1600 + 520 = 2120 ms of a stop that
 /// is written at once (emergency stop, release on an idle line) whenever at
-/// least one of its attempts reaches the car.
+/// least one of its attempts that the car acts on in its mode reaches it (in
+/// AUTO only ST:STOP: the car refuses MV:STOP there).
 inline constexpr Duration kStopToRest = kLastStopAttempt + kBrakeBound;
 
 /// The named properties; each has one check over a recorded session.
