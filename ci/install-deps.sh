@@ -16,6 +16,7 @@ packages=(
   nlohmann-json3-dev         # NDJSON wire logs and timelines
   tshark                     # reads the pcap files hil writes (tested)
   libncurses-dev             # the logi-client terminal UI
+  libcpp-httplib-dev         # hil mock --view: the live view's web server
   python3-jsonschema python3-yaml  # checks scenario files against scenarios/schema.json (tested)
 )
 

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <numbers>
@@ -26,6 +27,8 @@
 #include "mocks/car.hpp"
 #include "mocks/server.hpp"
 #include "sim/arena_yaml.hpp"
+#include "view/live_model.hpp"
+#include "view/server.hpp"
 
 namespace hil::apps {
 namespace {
@@ -48,7 +51,28 @@ struct MockArgs {
   bool quiet = false;
   bool no_status = false;
   bool commands = false;
+  bool view = false;
+  std::string view_port;  ///< empty: the default port
 };
+
+constexpr std::uint16_t kDefaultViewPort = 8080;
+
+// "--view" alone, "--view 8081", "--view 0" (any free port).
+std::optional<std::uint16_t> parse_view_port(const std::string& text) {
+  if (text.empty()) return kDefaultViewPort;
+  if (text.size() > 5 || text.find_first_not_of("0123456789") != std::string::npos)
+    return std::nullopt;
+  const unsigned long port = std::stoul(text);
+  if (port > 65535) return std::nullopt;
+  return static_cast<std::uint16_t>(port);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 // "/tmp/hil-arduino0" -> "/tmp/hil-arduino1" for car 1; a path that does not
 // end in a number gets "-<index>" appended.
@@ -316,6 +340,12 @@ int run_mock(const MockArgs& args) {
         std::chrono::duration<double>(1.0 / *args.data_hz));
   }
   const std::uint64_t seed = args.seed ? *args.seed : std::random_device{}();
+  const auto view_port = parse_view_port(args.view_port);
+  if (args.view && !view_port) {
+    std::cerr << "hil mock: --view takes a port number 0..65535 (0: any free port), got \""
+              << args.view_port << "\"\n";
+    return 2;
+  }
 
   asio::io_context io;
   link::AsioExecutor executor(io);
@@ -324,6 +354,7 @@ int run_mock(const MockArgs& args) {
   const auto log = [&status](const std::string& line) { status.log(line); };
 
   std::vector<RunningCar> cars;
+  std::vector<std::shared_ptr<view::WireWatch>> watches;
   for (std::size_t i = 0; i < args.count; ++i) {
     mocks::CarOptions options = base;
     options.name = "car" + std::to_string(i);
@@ -344,6 +375,10 @@ int run_mock(const MockArgs& args) {
     server.wire_log_path = args.wire_log;
     server.name = running.car->name();
     if (!args.quiet) server.log = log;
+    if (args.view) {
+      watches.push_back(std::make_shared<view::WireWatch>(running.car->firmware().adapter()));
+      server.observers.push_back(watches.back());
+    }
     running.server =
         std::make_unique<mocks::MockServer>(context, running.car->firmware(), std::move(server));
     const auto listening = endpoint_for(args, *kind, i);
@@ -368,6 +403,28 @@ int run_mock(const MockArgs& args) {
             << faults.rules.size() << " fault rule(s), " << behaviours.size()
             << " behaviour(s), seed " << seed << " (replay with --seed " << seed
             << "); Ctrl-C stops" << std::endl;
+
+  // Declared after the cars: destroyed first, so the page never outlives them.
+  std::unique_ptr<view::LiveModel> view_model;
+  std::unique_ptr<view::LiveViewServer> view_server;
+  if (args.view) {
+    std::vector<view::ViewedCar> viewed;
+    const std::string faults_text = args.faults.empty() ? std::string() : read_text(args.faults);
+    for (std::size_t i = 0; i < cars.size(); ++i)
+      viewed.push_back(view::ViewedCar{cars[i].car.get(), cars[i].server.get(), watches[i], faults,
+                                       faults_text});
+    view_model = std::make_unique<view::LiveModel>(std::move(viewed));
+    view::ViewOptions options;
+    options.port = *view_port;
+    view_server = std::make_unique<view::LiveViewServer>(io, executor, *view_model, options);
+    try {
+      view_server->start();
+    } catch (const std::exception& e) {
+      std::cerr << "hil mock: --view: " << e.what() << " (choose another port: --view PORT)\n";
+      return 1;
+    }
+    std::cout << "view: " << view_server->url() << std::endl;
+  }
 
   std::unique_ptr<DeskConsole> console;
   if (DeskConsole::available(args.commands)) {
@@ -402,6 +459,7 @@ int run_mock(const MockArgs& args) {
       c.server->close();
     }
     if (console) console->stop();
+    if (view_server) view_server->stop();
     std::cout << "hil mock: stopping (" << served << " client(s) served)" << std::endl;
     executor.call_after(link::milliseconds(100), [&io] { io.stop(); });
   });
@@ -449,6 +507,13 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_flag("--commands", args->commands,
                 "Read desk commands from stdin even when it is not a terminal (they are read "
                 "from a terminal anyway; type 'help')");
+  auto* view_option =
+      cmd->add_option("--view", args->view_port,
+                      "Serve a live view of the cars on http://127.0.0.1:PORT/ (default " +
+                          std::to_string(kDefaultViewPort) +
+                          "; 0 picks a free port): the arena, the car, its sensors, the wire, and "
+                          "a panel for faults and behaviours (docs/live-view.md)")
+          ->expected(0, 1);
   cmd->add_flag("--no-status", args->no_status,
                 "No status line (it is off anyway when not a terminal)");
   cmd->footer(
@@ -457,8 +522,12 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "  hil mock wr8 --count 3 --port 9100            # three WR8 vehicles on 9100..9102\n"
       "  hil mock arduino --pty /tmp/robot0            # open /tmp/robot0 at 9600 baud\n"
       "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
+      "  hil mock logi --view                          # and watch it on http://127.0.0.1:8080/\n"
       "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
-  cmd->callback([&run, args] { run = [args] { return run_mock(*args); }; });
+  cmd->callback([&run, args, view_option] {
+    args->view = view_option->count() > 0;
+    run = [args] { return run_mock(*args); };
+  });
 }
 
 }  // namespace hil::apps

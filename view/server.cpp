@@ -1,0 +1,186 @@
+#include "view/server.hpp"
+
+#include <httplib.h>
+
+#include <asio/post.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <future>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "view/page.hpp"
+
+namespace hil::view {
+
+// What the HTTP threads and the io thread share, all behind one mutex: the
+// latest snapshot as text (the io thread writes it, every event stream
+// reads it) and whether the server is stopping.
+struct LiveViewServer::Shared {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::string snapshot = "{\"cars\":[]}";
+  std::uint64_t version = 0;
+  bool stopping = false;
+  std::atomic<int> viewers{0};
+  httplib::Server http;
+  std::thread thread;
+};
+
+namespace {
+
+constexpr auto kApiWait = std::chrono::seconds(5);
+constexpr std::size_t kMaxBodyBytes = 256 * 1024;
+constexpr int kHttpThreads = 48;  // every open event stream holds one
+
+void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
+  res.status = status;
+  res.set_content(body.dump(), "application/json");
+}
+
+}  // namespace
+
+LiveViewServer::LiveViewServer(asio::io_context& io, link::Executor& executor, LiveModel& model,
+                               ViewOptions options)
+    : io_(io),
+      executor_(executor),
+      model_(model),
+      options_(std::move(options)),
+      shared_(std::make_shared<Shared>()) {}
+
+LiveViewServer::~LiveViewServer() {
+  stop();
+}
+
+std::string LiveViewServer::url() const {
+  return "http://" + options_.host + ":" + std::to_string(port_) + "/";
+}
+
+void LiveViewServer::start() {
+  auto shared = shared_;
+  auto& http = shared->http;
+  http.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
+  http.set_keep_alive_timeout(2);
+  http.set_payload_max_length(kMaxBodyBytes);
+
+  http.Get("/", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(std::string(live_view_page()), "text/html; charset=utf-8");
+  });
+  http.Get("/api/state", [shared](const httplib::Request&, httplib::Response& res) {
+    std::lock_guard lock(shared->mutex);
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(shared->snapshot, "application/json");
+  });
+  http.Get("/events", [shared](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    ++shared->viewers;
+    auto seen = std::make_shared<std::uint64_t>(0);
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [shared, seen](std::size_t, httplib::DataSink& sink) {
+          std::string chunk;
+          {
+            std::unique_lock lock(shared->mutex);
+            shared->changed.wait_for(lock, std::chrono::milliseconds(500),
+                                     [&] { return shared->stopping || shared->version != *seen; });
+            if (shared->stopping) return false;
+            if (shared->version == *seen) {
+              chunk = ": idle\n\n";  // a comment line: finds a viewer that went away
+            } else {
+              *seen = shared->version;
+              chunk = "data: " + shared->snapshot + "\n\n";
+            }
+          }
+          return sink.write(chunk.data(), chunk.size());
+        },
+        [shared](bool) { --shared->viewers; });
+  });
+  // Every action runs on the cars' thread; this thread waits for its reply.
+  http.Post(R"(/api/(\w+))", [this, shared](const httplib::Request& req, httplib::Response& res) {
+    auto promise = std::make_shared<std::promise<Reply>>();
+    auto reply = promise->get_future();
+    asio::post(io_, [this, promise, action = req.matches[1].str(), body = req.body] {
+      promise->set_value(model_.handle(action, body));
+    });
+    // Waits in short steps so stop() (which runs on the cars' thread and
+    // joins this one) never waits out the whole limit.
+    const auto deadline = std::chrono::steady_clock::now() + kApiWait;
+    while (reply.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      bool stopping = false;
+      {
+        std::lock_guard lock(shared->mutex);
+        stopping = shared->stopping;
+      }
+      if (stopping || std::chrono::steady_clock::now() > deadline) {
+        send_json(
+            res, 503,
+            {{"error", stopping ? "the cars are stopping" : "the cars did not answer in time"}});
+        return;
+      }
+    }
+    try {
+      const Reply r = reply.get();
+      send_json(res, r.status, r.body);
+    } catch (const std::future_error&) {
+      send_json(res, 503, {{"error", "the cars are stopping"}});
+    }
+  });
+  http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (res.status == 404) {
+      send_json(res, 404, {{"error", "nothing at " + req.path + " (see docs/live-view.md)"}});
+    } else if (res.body.empty()) {
+      send_json(res, res.status,
+                {{"error", "bad request (HTTP " + std::to_string(res.status) +
+                               "): a POST needs a JSON body, {} at least"}});
+    }
+  });
+
+  if (options_.port == 0) {
+    const int port = http.bind_to_any_port(options_.host);
+    if (port <= 0) throw std::runtime_error("cannot bind " + options_.host);
+    port_ = static_cast<std::uint16_t>(port);
+  } else {
+    if (!http.bind_to_port(options_.host, options_.port))
+      throw std::runtime_error("cannot bind " + options_.host + ":" +
+                               std::to_string(options_.port) + " (in use?)");
+    port_ = options_.port;
+  }
+  running_ = true;
+  refresh();
+  shared->thread = std::thread([shared] { shared->http.listen_after_bind(); });
+}
+
+void LiveViewServer::refresh() {
+  if (!running_) return;
+  model_.sample();
+  auto snapshot = model_.snapshot(executor_.now());
+  snapshot["viewers"] = shared_->viewers.load();
+  snapshot["updates_per_s"] = options_.updates_per_s;
+  std::string text = snapshot.dump();
+  {
+    std::lock_guard lock(shared_->mutex);
+    shared_->snapshot = std::move(text);
+    ++shared_->version;
+  }
+  shared_->changed.notify_all();
+  timer_ = executor_.call_after(link::milliseconds(1000 / std::max(1, options_.updates_per_s)),
+                                [this] { refresh(); });
+}
+
+void LiveViewServer::stop() {
+  if (!running_) return;
+  running_ = false;
+  if (timer_ != 0) executor_.cancel(timer_);
+  {
+    std::lock_guard lock(shared_->mutex);
+    shared_->stopping = true;
+  }
+  shared_->changed.notify_all();
+  shared_->http.stop();
+  if (shared_->thread.joinable()) shared_->thread.join();
+}
+
+}  // namespace hil::view
