@@ -367,6 +367,7 @@ struct ArduinoRig {
     session->set_event_handler([this](const Event& e) {
       if (const auto* l = std::get_if<LinkChanged>(&e)) {
         links.push_back(*l);
+        turned_away.push_back(car.server->turned_away());
       } else if (const auto* d = std::get_if<RequestDone>(&e)) {
         auto& chassis = dynamic_cast<sim::DifferentialChassis&>(car.firmware->vehicle().chassis());
         done.push_back({car.executor.now(), d->id, d->result, car.firmware->moving(),
@@ -384,9 +385,12 @@ struct ArduinoRig {
   std::vector<LinkChanged> links;
   std::vector<Done> done;
   std::map<RequestId, proto::Body> bodies;
-  std::vector<RequestId> queued;              ///< requests that did not end at once, in order
-  std::vector<Time> closes;                   ///< when a link to the robot closed
-  std::vector<Time> car_opens;                ///< when a link to the robot opened
+  std::vector<RequestId> queued;  ///< requests that did not end at once, in order
+  std::vector<Time> closes;       ///< when a link to the robot closed
+  std::vector<Time> car_opens;    ///< when a link to the robot opened
+  /// Connections the robot turned away (still busy with the last one), as
+  /// counted at each link change.
+  std::vector<std::uint64_t> turned_away;
   std::vector<Time> operator_opens{Time{0}};  ///< when the operator opened the port
   test::VirtualCar<mocks::ArduinoFirmware> car;
   std::unique_ptr<ArduinoSession> session;
@@ -636,7 +640,8 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
   // OPEN degrades only in the instant a request or the health check ran out
   // of attempts or the port closed under it; and every request that ran out
   // of attempts degrades it then.
-  for (const auto& l : rig.links) {
+  for (std::size_t i = 0; i < rig.links.size(); ++i) {
+    const LinkChanged& l = rig.links[i];
     if (l.from != LinkState::open || l.to != LinkState::degraded) continue;
     const bool request_timed_out = std::any_of(
         rig.done.begin(), rig.done.end(),
@@ -649,7 +654,12 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
                          config.base_timeout * (std::int64_t{1} << config.max_retries) ==
                      l.at;
         });
-    const bool port_closed = std::count(rig.closes.begin(), rig.closes.end(), l.at) != 0;
+    // Turned away: the count went up since the last change before this instant.
+    std::uint64_t turned_away_before = 0;
+    for (std::size_t j = 0; j < i && rig.links[j].at < l.at; ++j)
+      turned_away_before = rig.turned_away[j];
+    const bool port_closed = std::count(rig.closes.begin(), rig.closes.end(), l.at) != 0 ||
+                             rig.turned_away[i] > turned_away_before;
     RC_ASSERT(request_timed_out || health_check_timed_out || port_closed);
   }
   for (const auto& d : rig.done) {
