@@ -17,6 +17,7 @@ packages=(
   tshark                     # reads the pcap files hil writes (tested)
   libncurses-dev             # the logi-client terminal UI
   libcpp-httplib-dev         # hil mock --view: the live view's web server
+  chromium chromium-driver   # the live view's browser test (~130 MB download, ~440 MB installed)
   python3-jsonschema python3-yaml  # checks scenario files against scenarios/schema.json (tested)
 )
 
