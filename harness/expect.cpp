@@ -398,7 +398,8 @@ std::optional<Time> resolve(const Anchor& anchor, const Timeline& timeline) {
   return seen[static_cast<std::size_t>(index)] + anchor.offset;
 }
 
-ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time run_end) {
+ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time run_end,
+                         Duration slack) {
   ExpectationOutcome outcome = start_outcome(e);
   const std::string what = quoted(matcher_text(e.what));
   const std::string window_label = window_text(e.window);
@@ -422,12 +423,24 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
 
   const Time from = *start;
   const Time to = e.window.within ? from + *e.window.within : run_end;
+  // With slack (real time) the edges are known only to within it: what
+  // must happen may fall in the wider window, what must not is looked for
+  // in the narrower one. An edge that is an event or the end of the run
+  // is where it is; a run time or an edge `within` after one moves.
+  const bool movable_start = !e.window.from.event && slack > Duration(0);
+  const bool movable_end = e.window.within.has_value() && slack > Duration(0);
+  const Time wide_from = movable_start ? std::max(Time(0), from - slack) : from;
+  const Time wide_to = movable_end ? to + slack : to;
+  const Time narrow_from = movable_start ? from + slack : from;
+  const Time narrow_to = movable_end ? std::max(narrow_from, to - slack) : to;
   outcome.window_from = from;
   outcome.window_to = to;
-  const auto in_window = [&](Time at) { return at >= from && at <= to; };
+  const auto in_window = [&](Time at) { return at >= wide_from && at <= wide_to; };
+  const auto in_narrow = [&](Time at) { return at >= narrow_from && at <= narrow_to; };
 
   std::string where = "between " + seconds_text(from) + " and " + seconds_text(to);
   if (e.window.from.event) where += " (" + window_label + ")";
+  if (slack > Duration(0)) where += " (± " + seconds_text(slack) + " for real time)";
 
   const auto& records = timeline.records();
   std::vector<std::size_t> all_matches;
@@ -446,7 +459,7 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
     std::vector<std::size_t> judged;
     std::vector<std::size_t> failing;
     for (std::size_t i = 0; i < records.size(); ++i) {
-      if (!judged_by(e.what, records[i]) || !in_window(records[i].at)) continue;
+      if (!judged_by(e.what, records[i]) || !in_narrow(records[i].at)) continue;
       judged.push_back(i);
       if (!matches(e.what, records[i])) failing.push_back(i);
     }
@@ -484,13 +497,14 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
       order[i] = i;
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return e.times[a] < e.times[b]; });
+    const Duration tolerance = e.tolerance + slack;
     std::vector<std::optional<std::size_t>> claimed(e.times.size());
     std::vector<bool> used(window_matches.size(), false);
     for (const auto t : order) {
       const Time target = from + e.times[t];
       for (std::size_t m = 0; m < window_matches.size(); ++m) {
         const Time at = records[window_matches[m]].at;
-        if (used[m] || at < target - e.tolerance || at > target + e.tolerance) continue;
+        if (used[m] || at < target - tolerance || at > target + tolerance) continue;
         used[m] = true;
         claimed[t] = m;
         break;
@@ -503,7 +517,7 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
     std::string message = "expected " + what + (e.only ? " only at " : " at ");
     for (std::size_t i = 0; i < targets.size(); ++i)
       message += (i == 0 ? "" : ", ") + seconds_text(targets[i]);
-    message += " (± " + seconds_text(e.tolerance) + ") " + where;
+    message += " (± " + seconds_text(tolerance) + ") " + where;
 
     std::vector<Time> hit_times;
     std::string missing;
@@ -538,7 +552,8 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
     std::vector<Time> extra_times;
     if (e.only)
       for (std::size_t m = 0; m < window_matches.size(); ++m)
-        if (!used[m]) extra_times.push_back(records[window_matches[m]].at);
+        if (!used[m] && in_narrow(records[window_matches[m]].at))
+          extra_times.push_back(records[window_matches[m]].at);
 
     outcome.passed = missing.empty() && extra_times.empty();
     message += hit_times.empty() ? ", found none of them" : ", found at " + times_text(hit_times);
@@ -552,7 +567,10 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
     return outcome;
   }
 
-  // The counting quantifiers.
+  // The counting quantifiers: a lower bound is met in the wide window, an
+  // upper bound in the narrow one (the same window without slack).
+  const auto narrow_found = static_cast<std::uint64_t>(
+      std::count_if(window_times.begin(), window_times.end(), in_narrow));
   std::string wanted;
   bool needs_more = false;
   switch (e.quantifier) {
@@ -563,11 +581,11 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
       break;
     case Quantifier::never:
       wanted = "no";
-      outcome.passed = found == 0;
+      outcome.passed = narrow_found == 0;
       break;
     case Quantifier::exactly:
       wanted = "exactly " + std::to_string(e.count);
-      outcome.passed = found == e.count;
+      outcome.passed = narrow_found <= e.count && e.count <= found;
       needs_more = found < e.count;
       break;
     case Quantifier::at_least:
@@ -577,15 +595,21 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
       break;
     case Quantifier::at_most:
       wanted = "at most " + std::to_string(e.count);
-      outcome.passed = found <= e.count;
+      outcome.passed = narrow_found <= e.count;
       break;
     case Quantifier::at_times:
     case Quantifier::always:
       break;
   }
+  // An upper bound failed in the narrow window: show what was found there.
+  const bool upper_only = e.quantifier == Quantifier::never || e.quantifier == Quantifier::at_most;
+  std::vector<Time> shown_times = window_times;
+  if (upper_only) std::erase_if(shown_times, [&](Time at) { return !in_narrow(at); });
+  const std::uint64_t shown_found = upper_only ? narrow_found : found;
   std::string message = "expected " + wanted + " " + what + " " + where;
-  message += found == 0 ? ", found none"
-                        : ", found " + std::to_string(found) + ": at " + times_text(window_times);
+  message += shown_found == 0
+                 ? ", found none"
+                 : ", found " + std::to_string(shown_found) + ": at " + times_text(shown_times);
   std::vector<std::size_t> shown = window_matches;
   if (!outcome.passed && needs_more) {
     const auto nearest = nearest_outside(timeline, all_matches, from, to);
@@ -603,11 +627,11 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
 }
 
 std::vector<ExpectationOutcome> check_all(const std::vector<Expectation>& expectations,
-                                          const Timeline& timeline, Time run_end) {
+                                          const Timeline& timeline, Time run_end, Duration slack) {
   std::vector<ExpectationOutcome> outcomes;
   outcomes.reserve(expectations.size());
   for (const auto& e : expectations)
-    outcomes.push_back(check(e, timeline, run_end));
+    outcomes.push_back(check(e, timeline, run_end, slack));
   return outcomes;
 }
 

@@ -19,10 +19,20 @@ bool matches(const Matcher& matcher, const Record& record);
 std::optional<Time> resolve(const Anchor& anchor, const Timeline& timeline);
 
 /// The verdict on one expectation for a run that ended at `run_end`.
-ExpectationOutcome check(const Expectation& expectation, const Timeline& timeline, Time run_end);
+/// `slack` is room for a run in real time, where frames and events come
+/// some milliseconds later than in virtual time: a window edge that is a
+/// run time or lies `within` after another edge is known only to within
+/// `slack`, so what must happen (exists, at_least, the lower bound of
+/// exactly) may fall in the window widened by it, what must not (never,
+/// at_most, the upper bound of exactly, always) is looked for in the
+/// window narrowed by it, and `times` get it on their tolerance. Edges
+/// that are events or the end of the run stay put. Zero changes nothing.
+ExpectationOutcome check(const Expectation& expectation, const Timeline& timeline, Time run_end,
+                         Duration slack = Duration(0));
 
 /// Every expectation of a scenario, in order.
 std::vector<ExpectationOutcome> check_all(const std::vector<Expectation>& expectations,
-                                          const Timeline& timeline, Time run_end);
+                                          const Timeline& timeline, Time run_end,
+                                          Duration slack = Duration(0));
 
 }  // namespace hil::harness

@@ -764,9 +764,12 @@ void ReferenceRun::end() {
       expectations.push_back(std::move(exit));
     }
   }
+  const Duration slack = options_.time_slack    ? *options_.time_slack
+                         : driver_->real_time() ? kRealTimeSlack
+                                                : Duration(0);
   // An expectation on the exit looks past the session's end, where the exit is.
   for (const auto& e : expectations)
-    out_.expectations.push_back(check(e, out_.timeline, on_exit(e) ? run_end : session_end));
+    out_.expectations.push_back(check(e, out_.timeline, on_exit(e) ? run_end : session_end, slack));
 }
 
 }  // namespace

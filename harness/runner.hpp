@@ -13,6 +13,10 @@
 
 namespace hil::harness {
 
+/// The default slack of a run in real time: a loaded 2-core machine
+/// delays a frame or a client's answer by tens of milliseconds.
+inline constexpr Duration kRealTimeSlack = std::chrono::milliseconds(100);
+
 struct RunOptions {
   /// Overrides the scenario's seed (and a random choice when it has none).
   std::optional<std::uint64_t> seed;
@@ -21,6 +25,10 @@ struct RunOptions {
   std::optional<std::string> client_exec;
   /// Where reports may put files of this run (wire log); empty: nowhere.
   std::string work_dir;
+  /// Room for real time in every expectation (check() in
+  /// harness/expect.hpp); nullopt: 0 in virtual time, kRealTimeSlack in
+  /// real time.
+  std::optional<Duration> time_slack;
   /// Period of the simulation samples in the timeline.
   Duration sample_period{std::chrono::milliseconds(100)};
 };

@@ -20,6 +20,7 @@
 #include "harness/report.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "link/faults/profile_yaml.hpp"
 
 namespace hil::apps {
 namespace {
@@ -38,6 +39,7 @@ struct RunArgs {
   std::vector<std::string> tags;
   std::vector<std::string> exclude_tags;
   std::optional<std::string> client_exec;
+  std::string slack;  ///< as written ("100ms"); empty: the runner's default
   std::vector<std::string> sets;
   int jobs = 0;
   bool list = false;
@@ -82,6 +84,7 @@ std::string repro_command(const RunArgs& args, const std::string& file,
   for (const auto& s : args.sets)
     out += " --set " + shell_quote(s);
   if (args.client_exec) out += " --client-exec " + shell_quote(*args.client_exec);
+  if (!args.slack.empty()) out += " --slack " + shell_quote(args.slack);
   return out;
 }
 
@@ -251,6 +254,7 @@ int run_scenarios(const RunArgs& args) {
         harness::RunOptions options;
         options.seed = tasks[k].seed;
         options.client_exec = args.client_exec;
+        if (!args.slack.empty()) options.time_slack = link::parse_duration(args.slack);
         if (!args.report_dir.empty()) {
           const fs::path folder = fs::path(args.report_dir) / entry.folder;
           std::error_code ec;
@@ -354,6 +358,14 @@ void register_run(CLI::App& app, std::function<int()>& run) {
                   "Run every scenario against this program instead of its client "
                   "({host} {port} {pty} {actions} ... as in docs/client-contract.md)")
       ->type_name("CMD");
+  cmd->add_option("--slack", args->slack,
+                  "Room for real time: windows where something must happen grow by D, windows "
+                  "where it must not shrink by D (default 100ms in real time, 0 in virtual time)")
+      ->type_name("D")
+      ->check([](const std::string& text) {
+        return link::parse_duration(text) ? std::string()
+                                          : "'" + text + "' is not a duration (e.g. 100ms, 0.5s)";
+      });
   cmd->add_option("--set", args->sets, "Set a scenario variable: name=value (repeatable)")
       ->type_name("NAME=VALUE")
       ->allow_extra_args(false);

@@ -978,5 +978,75 @@ RC_GTEST_PROP(ExpectProperties, MatchesAtTheAskedTimesAlwaysSatisfyAtTimes, ()) 
   RC_ASSERT(o.passed);
 }
 
+// ------------------------------------------------------- real-time slack
+
+Window run_times(std::int64_t from_ms, std::int64_t to_ms) {
+  return Window{Anchor{std::nullopt, 1, milliseconds(from_ms)}, milliseconds(to_ms - from_ms)};
+}
+
+TEST(ExpectSlack, WhatMustHappenMayFallInTheWidenedWindow) {
+  Timeline t;
+  add_delivered(t, ms(5050), "MV:STOP");
+  const auto e = expect_in(car_received("MV:STOP"), run_times(5000, 5001));
+  EXPECT_FALSE(check(e, t, ms(10000)).passed);
+  EXPECT_FALSE(check(e, t, ms(10000), milliseconds(40)).passed) << "50 ms late is past 40 ms";
+  const auto o = check(e, t, ms(10000), milliseconds(100));
+  EXPECT_TRUE(o.passed) << o.message;
+  EXPECT_NE(o.message.find("(± 0.100 s for real time)"), std::string::npos) << o.message;
+}
+
+TEST(ExpectSlack, WhatMustNotHappenIsLookedForInTheNarrowedWindow) {
+  Timeline t;
+  add_delivered(t, ms(2050), "MV:FWD");
+  add_delivered(t, ms(3950), "MV:FWD");
+  const auto e = expect_in(car_received("MV:FWD"), run_times(2000, 4000), Quantifier::never);
+  EXPECT_FALSE(check(e, t, ms(10000)).passed);
+  EXPECT_TRUE(check(e, t, ms(10000), milliseconds(100)).passed);
+  add_delivered(t, ms(3000), "MV:FWD");
+  const auto o = check(e, t, ms(10000), milliseconds(100));
+  EXPECT_FALSE(o.passed) << "well inside the window it still counts";
+  EXPECT_NE(o.message.find("found 1: at 3.000 s"), std::string::npos) << o.message;
+}
+
+TEST(ExpectSlack, ExactlyTakesItsLowerBoundWideAndItsUpperBoundNarrow) {
+  // A STAT every 500 ms; the window ends just before the one at 12 s.
+  Timeline t;
+  for (int i = 1; i <= 24; ++i)
+    add_delivered(t, ms(500 * i), "STAT");
+  const auto e = expect_in(car_received("STAT"), run_times(0, 11999), Quantifier::exactly, 23);
+  EXPECT_TRUE(check(e, t, ms(13000)).passed);
+  EXPECT_TRUE(check(e, t, ms(13000), milliseconds(100)).passed)
+      << "the one at 12.0 s lies in the slack only";
+  const auto too_few =
+      expect_in(car_received("STAT"), run_times(0, 11999), Quantifier::exactly, 25);
+  EXPECT_FALSE(check(too_few, t, ms(13000), milliseconds(100)).passed);
+  const auto too_many =
+      expect_in(car_received("STAT"), run_times(0, 11999), Quantifier::exactly, 21);
+  EXPECT_FALSE(check(too_many, t, ms(13000), milliseconds(100)).passed)
+      << "22 are well inside: more than 21 whatever the edges";
+}
+
+TEST(ExpectSlack, AnEventEdgeDoesNotMove) {
+  Timeline t;
+  add_delivered(t, ms(990), "MV:STOP");  // before the release: not caused by it
+  add_step_end(t, ms(1000), "release");
+  Window after_release{Anchor{step_end("release"), 1, Duration(0)}, milliseconds(300)};
+  const auto e = expect_in(car_received("MV:STOP"), after_release);
+  EXPECT_FALSE(check(e, t, ms(5000), milliseconds(100)).passed);
+  add_delivered(t, ms(1350), "MV:STOP");  // 50 ms past the window's end
+  EXPECT_TRUE(check(e, t, ms(5000), milliseconds(100)).passed);
+}
+
+TEST(ExpectSlack, TimesGetTheSlackOnTheirTolerance) {
+  Timeline t;
+  t.add(ms(6080), Source::client, "connection", {{"state", "connecting"}});
+  Expectation e =
+      expect_in(client_state("connecting"), run_times(5000, 20000), Quantifier::at_times);
+  e.times = {seconds(1)};
+  e.tolerance = milliseconds(1);
+  EXPECT_FALSE(check(e, t, ms(20000)).passed);
+  EXPECT_TRUE(check(e, t, ms(20000), milliseconds(100)).passed);
+}
+
 }  // namespace
 }  // namespace hil::harness

@@ -102,6 +102,17 @@ TEST(HilRunCli, MalformedOptionsAreUsageErrors) {
   EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --jobs 0").exit_code, 2);
   EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --seed x").exit_code, 2);
   EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --tags nobody-has-this").exit_code, 2);
+  const auto slack = run_hil("run " + kData + "/pass.yaml --slack 100");
+  EXPECT_EQ(slack.exit_code, 2);
+  EXPECT_THAT(slack.output, HasSubstr("'100' is not a duration (e.g. 100ms, 0.5s)"));
+}
+
+TEST(HilRunCli, SlackIsTakenAndCarriedIntoTheReproCommand) {
+  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --slack 50ms").exit_code, 0);
+  const auto r = run_hil("run " + kData + "/fail.yaml --seed 77 --slack 250ms");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.output, HasSubstr("--seed 77 --slack 250ms\n"));
+  EXPECT_THAT(r.output, HasSubstr("(± 0.250 s for real time)"));
 }
 
 TEST(HilRunCli, AFileThatDoesNotLoadIsAFailedRowWithItsLineAndColumn) {
