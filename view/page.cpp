@@ -122,6 +122,7 @@ constexpr std::string_view kPage = R"HTML(<!doctype html>
 "use strict";
 const $ = (id) => document.getElementById(id);
 const canvas = $("arena"), ctx = canvas.getContext("2d");
+let profileEdited = false;
 let state = null, carIndex = 0, updates = 0, lastUpdates = [], picked = null;
 
 const PRESETS = {
@@ -262,6 +263,8 @@ function show(s) {
   showFrames("to_car", car.frames.to_car);
   showFrames("to_client", car.frames.to_client);
   showFaults(car);
+  // The rules in force, unless someone is editing them.
+  if (!profileEdited && document.activeElement !== $("profile")) $("profile").value = car.fault_profile || "";
   $("mode").textContent = car.mode + (car.in_fault ? " \u00b7 FAULT" : "");
   $("mode").className = "pill" + (car.in_fault ? " bad" : "");
   $("client").textContent = car.client_connected ? "client connected" : "no client";
@@ -286,9 +289,10 @@ async function api(action, body) {
     return r.ok ? j : null;
   } catch (e) { msg.className = "bad"; msg.textContent = action + ": " + e; return null; }
 }
-$("apply-faults").onclick = () => api("faults", { profile: $("profile").value });
-$("clear-faults").onclick = () => api("faults", { profile: null });
-$("preset").onchange = (e) => { if (PRESETS[e.target.value]) $("profile").value = PRESETS[e.target.value]; };
+$("apply-faults").onclick = async () => { if (await api("faults", { profile: $("profile").value })) profileEdited = false; };
+$("clear-faults").onclick = async () => { if (await api("faults", { profile: null })) profileEdited = false; };
+$("profile").oninput = () => { profileEdited = true; };
+$("preset").onchange = (e) => { if (PRESETS[e.target.value]) { $("profile").value = PRESETS[e.target.value]; profileEdited = true; } };
 document.querySelectorAll("[data-behaviour]").forEach(b => b.onclick = () => {
   const action = b.dataset.behaviour, body = { action };
   if (action === "stall-telemetry") body.duration_ms = Math.round(parseFloat($("stall-s").value || "3") * 1000);
