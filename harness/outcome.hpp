@@ -61,6 +61,9 @@ struct ScenarioOutcome {
   bool real_time = false;
   /// The command line that repeats this run exactly (seed included).
   std::string repro_command;
+  /// The NDJSON wire log of the run (every byte each way, before and
+  /// after the faults), when RunOptions::work_dir asked for one.
+  std::string wire_log;
 
   /// Passed: no error, every step ok, every expectation met.
   bool passed() const;

@@ -246,7 +246,13 @@ std::string run_page_html(const ReportEntry& entry) {
       "<h2>Trajectory</h2>\n<p><a href=\"trajectory.svg\"><img src=\"trajectory.svg\" "
       "alt=\"the arena and the path the car drove\"></a></p>\n";
   out += "<h2>Timeline</h2>\n<p><a href=\"timeline.ndjson\">timeline.ndjson</a> (" +
-         std::to_string(o.timeline.size()) + " records)</p>\n" + timeline_html(o.timeline);
+         std::to_string(o.timeline.size()) + " records)";
+  if (!o.wire_log.empty()) {
+    const std::string name = fs::path(o.wire_log).filename().string();
+    out +=
+        "; the wire log, every byte each way: <a href=\"" + esc(name) + "\">" + esc(name) + "</a>";
+  }
+  out += "</p>\n" + timeline_html(o.timeline);
   out += kFilterScript;
   out += "</body></html>\n";
   return out;

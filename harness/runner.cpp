@@ -286,6 +286,10 @@ bool ReferenceRun::build() {
   server.faults = scenario_.faults;
   server.seed = seed_;
   server.name = "car0";
+  if (!options_.work_dir.empty()) {
+    out_.wire_log = (std::filesystem::path(options_.work_dir) / "wire.ndjson").string();
+    server.wire_log_path = out_.wire_log;
+  }
   wire_ = std::make_shared<WireRecorder>(timeline_, car_->firmware().adapter());
   server.observers.push_back(wire_);
   server_ = std::make_unique<mocks::MockServer>(context_, car_->firmware(), std::move(server));

@@ -211,6 +211,11 @@ TEST(HilRunCli, WritesJunitAndTheReportFolder) {
   EXPECT_THAT(ndjson, StartsWith("{\"t_ms\":"));
   EXPECT_THAT(ndjson, HasSubstr("MV:STOP"));
   EXPECT_THAT(read(report / "run-pass" / "trajectory.svg"), HasSubstr("<svg"));
+  // The wire log: every frame each way, as the mock car's --log writes it.
+  const std::string wire = read(report / "run-pass" / "wire.ndjson");
+  EXPECT_THAT(wire, HasSubstr("\"link\":\"car0/link1\""));
+  EXPECT_THAT(wire, HasSubstr("MV:STOP"));
+  EXPECT_THAT(pass_page, HasSubstr("href=\"wire.ndjson\""));
   EXPECT_THAT(r.output, HasSubstr("report: " + (report / "index.html").string()));
 }
 
