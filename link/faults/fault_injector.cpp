@@ -122,6 +122,10 @@ struct FaultInjector::State {
 
   void install(FaultProfile p) {
     validate(p);
+    // A coalesce batch being gathered belongs to the old rules (it names
+    // them by index): it goes out now, under them.
+    if (batch && !broken) release_batch(last_now, "fault rules replaced");
+    batch.reset();
     profile = std::move(p);
     rule_state.assign(profile.rules.size(), RuleState{});
     // Time-triggered stalls not yet begun belong to the old rules.

@@ -430,6 +430,28 @@ TEST(FaultInjector, ProfileChangesWhileRunningKeepTheFrameCount) {
   ASSERT_EQ(injector->profile().rules.size(), 1U);
 }
 
+TEST(FaultInjector, ReplacingTheRulesReleasesABatchBeingGatheredUnderTheOldOnes) {
+  // The batch names its rule by index: the coalesce rule is the second of
+  // two, and the new profile has none, so reading it later would be past
+  // the end of the new rules.
+  std::vector<FaultEvent> events;
+  Coalesce c;
+  c.count = 3;
+  Trigger never;
+  never.probability = 0.0;
+  auto injector = make_injector("logi", profile_of({rule(Drop{}, never), rule(c)}), events);
+  auto gathered = drive(*injector, sp_writes(2, 1ms), false, Time{1ms});
+  EXPECT_TRUE(gathered.deliveries().empty()) << "two of three frames: still gathering";
+  injector->set_profile(profile_of({}));
+  auto after = drive(*injector, {{Duration(5ms), sp(7)}}, true);
+  EXPECT_EQ(after.delivered(), concat({sp(0), sp(1), sp(7)}));
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_EQ(events[0].kind, "coalesce");
+  EXPECT_NE(events[0].detail.find("2 frames in one write (fault rules replaced)"),
+            std::string::npos)
+      << events[0].detail;
+}
+
 TEST(FaultInjector, ProbabilityFollowsTheSeedAndRoughlyTheRate) {
   Trigger half;
   half.probability = 0.5;
