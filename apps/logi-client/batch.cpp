@@ -174,6 +174,34 @@ bool car_may_be_moving(const logi::LogiClientCore& core) {
   return s && (s->running || s->manual != proto::Direction::stop);
 }
 
+void stop_car_then(logi::LogiSession& session, link::Executor& executor, bool stop_car,
+                   const std::function<void(const std::string&)>& print,
+                   std::function<void()> done) {
+  if (!stop_car) {
+    done();
+    return;
+  }
+  print(stamp(executor.now()) + " emergency stop: MV:STOP" +
+        (session.core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
+  session.emergency_stop();
+  // The answers (or their timeouts), within a bound that keeps a program
+  // driven by hil run inside the 5 s it has to exit.
+  const logi::Time deadline = executor.now() + link::seconds(3);
+  auto poll = std::make_shared<std::function<void()>>();
+  *poll = [&session, &executor, deadline, done = std::move(done),
+           self = std::weak_ptr<std::function<void()>>(poll)] {
+    const auto& core = session.core();
+    const bool settled = core.in_flight() == 0 && core.queued() == 0;
+    if (settled || core.state() != ConnectionState::connected || executor.now() >= deadline) {
+      done();
+      return;
+    }
+    if (auto again = self.lock())
+      executor.call_after(link::milliseconds(10), [again] { (*again)(); });
+  };
+  (*poll)();
+}
+
 // ---- the run ----
 
 namespace {
@@ -249,27 +277,9 @@ class BatchRun {
     exit_code_ = code;
     runner_->cancel();  // no-op when the run already ended
     const bool connected = session_->core().state() == ConnectionState::connected;
-    if (stop_car && connected && car_may_be_moving(session_->core())) {
-      print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
-            (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
-      session_->emergency_stop();
-      // Wait for the car's answers (or their timeouts), within a bound.
-      stop_deadline_ = executor_.now() + link::seconds(3);
-      poll_stop();
-      return;
-    }
-    finish();
-  }
-
-  void poll_stop() {
-    const auto& core = session_->core();
-    const bool settled = core.in_flight() == 0 && core.queued() == 0;
-    if (settled || core.state() != ConnectionState::connected ||
-        executor_.now() >= stop_deadline_) {
-      finish();
-      return;
-    }
-    executor_.call_after(link::milliseconds(10), [this] { poll_stop(); });
+    stop_car_then(
+        *session_, executor_, stop_car && connected && car_may_be_moving(session_->core()),
+        [this](const std::string& line) { print(line); }, [this] { finish(); });
   }
 
   void finish() {
@@ -290,7 +300,6 @@ class BatchRun {
   BatchReporter reporter_;
   bool stopping_ = false;
   int exit_code_ = kExitOk;
-  logi::Time stop_deadline_{0};
 };
 
 }  // namespace

@@ -342,28 +342,9 @@ class StdinActionsRun {
                   executor_.now())));
     }
     const bool connected = session_->core().state() == ConnectionState::connected;
-    if (stop_car && connected && motion_.may_be_moving(session_->core())) {
-      print(stamp(executor_.now()) + " emergency stop: MV:STOP" +
-            (session_->core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
-      session_->emergency_stop();
-      // Wait for the car's answers (or their timeouts), within a bound
-      // that keeps the whole way out under hil's 5 s.
-      stop_deadline_ = executor_.now() + link::seconds(3);
-      poll_stop();
-      return;
-    }
-    finish();
-  }
-
-  void poll_stop() {
-    const auto& core = session_->core();
-    const bool settled = core.in_flight() == 0 && core.queued() == 0;
-    if (settled || core.state() != ConnectionState::connected ||
-        executor_.now() >= stop_deadline_) {
-      finish();
-      return;
-    }
-    executor_.call_after(link::milliseconds(10), [this] { poll_stop(); });
+    stop_car_then(
+        *session_, executor_, stop_car && connected && motion_.may_be_moving(session_->core()),
+        [this](const std::string& line) { print(line); }, [this] { finish(); });
   }
 
   void finish() {
@@ -400,7 +381,6 @@ class StdinActionsRun {
   bool input_ended_ = false;
   bool stopping_ = false;
   int exit_code_ = kExitOk;
-  logi::Time stop_deadline_{0};
 };
 
 }  // namespace
