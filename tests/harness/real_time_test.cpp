@@ -11,6 +11,7 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "tests/harness/runner_test_support.hpp"
 
 namespace hil::harness {
 namespace {
@@ -18,20 +19,10 @@ namespace {
 using link::milliseconds;
 using link::seconds;
 
-// A step as a scenario file would give it (line 0: built in code).
-Step step_of(std::string text, StepAction action) {
-  Step s;
-  s.text = std::move(text);
-  s.action = std::move(action);
-  return s;
-}
-
-Step action(const std::string& text) {
-  return step_of(text, ActionStep{text});
-}
-Step wait(Duration d) {
-  return step_of("wait", WaitStep{d});
-}
+using test::action;
+using test::of;
+using test::step_of;
+using test::wait;
 
 Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Step> steps) {
   Scenario s;
@@ -43,13 +34,6 @@ Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Ste
   s.settle = milliseconds(100);
   s.timeout = seconds(20);
   return s;
-}
-
-std::vector<Record> of(const ScenarioOutcome& o, Source source, const std::string& kind) {
-  std::vector<Record> out;
-  for (const auto& r : o.timeline.records())
-    if (r.source == source && r.kind == kind) out.push_back(r);
-  return out;
 }
 
 std::vector<std::string> lines_of(const ScenarioOutcome& o) {

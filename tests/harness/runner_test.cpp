@@ -13,6 +13,7 @@
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
 #include "sim/arena.hpp"
+#include "tests/harness/runner_test_support.hpp"
 
 namespace hil::harness {
 namespace {
@@ -20,20 +21,10 @@ namespace {
 using link::milliseconds;
 using link::seconds;
 
-// A step as a scenario file would give it (line 0: built in code).
-Step step_of(std::string text, StepAction action) {
-  Step s;
-  s.text = std::move(text);
-  s.action = std::move(action);
-  return s;
-}
-
-Step action(const std::string& text) {
-  return step_of(text, ActionStep{text});
-}
-Step wait(Duration d) {
-  return step_of("wait", WaitStep{d});
-}
+using test::action;
+using test::of;
+using test::step_of;
+using test::wait;
 Step wait_until(Matcher m, Duration timeout) {
   std::string text = "wait until " + m.text;
   return step_of(std::move(text), WaitUntilStep{std::move(m), timeout});
@@ -59,13 +50,6 @@ Scenario scenario(mocks::CarKind kind, std::vector<Step> steps) {
   s.seed = 7;
   s.steps = std::move(steps);
   return s;
-}
-
-std::vector<Record> of(const ScenarioOutcome& o, Source source, const std::string& kind) {
-  std::vector<Record> out;
-  for (const auto& r : o.timeline.records())
-    if (r.source == source && r.kind == kind) out.push_back(r);
-  return out;
 }
 
 std::vector<Record> wire(const ScenarioOutcome& o, const std::string& dir,
