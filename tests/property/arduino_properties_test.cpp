@@ -45,6 +45,7 @@
 #include "sim/differential.hpp"
 #include "sim/presets.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/property/random_faults.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -52,6 +53,7 @@ namespace {
 namespace proto = protocol::arduino;
 using link::milliseconds;
 using link::seconds;
+using hil::test::RandomFaults;
 
 // ---------------------------------------------------------------------------
 // The core against a scripted robot: one request, each frame it sends meets
@@ -252,64 +254,29 @@ RC_GTEST_PROP(ArduinoClientProperties,
 /// another valid one, which no client can tell.
 rc::Gen<link::FaultProfile> gen_faults() {
   return rc::gen::exec([] {
-    link::FaultProfile profile;
-    auto direction = [] {
-      return *rc::gen::element(link::DirectionFilter::both, link::DirectionFilter::to_car,
-                               link::DirectionFilter::to_client);
-    };
-    auto chance = [] { return *rc::gen::inRange(1, 31) / 100.0; };
-    auto add = [&](link::DirectionFilter d, link::Trigger trigger, link::FaultAction action) {
-      link::FaultRule rule;
-      rule.direction = d;
-      rule.trigger = std::move(trigger);
-      rule.action = std::move(action);
-      profile.rules.push_back(std::move(rule));
-    };
-    auto sometimes = [](double p) {
-      link::Trigger t;
-      t.probability = p;
-      return t;
-    };
-    auto at = [](Time t) {
-      link::Trigger trigger;
-      trigger.at = t;
-      return trigger;
-    };
-    if (*rc::gen::arbitrary<bool>()) add(direction(), sometimes(chance()), link::Drop{});
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
+    RandomFaults faults(30);
+    if (RandomFaults::coin()) faults.add_sometimes(link::Drop{});
+    if (RandomFaults::coin())
+      faults.add_sometimes(
           link::Corrupt{.target = link::CorruptTarget::random, .field = "", .bits = 1});
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
+    if (RandomFaults::coin())
+      faults.add_sometimes(
           link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1});
-    if (*rc::gen::arbitrary<bool>()) add(direction(), sometimes(chance()), link::Duplicate{1});
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
-          link::Delay{milliseconds(*rc::gen::inRange(0, 800)),
-                      milliseconds(*rc::gen::inRange(0, 800))});
-    if (*rc::gen::arbitrary<bool>()) {
+    if (RandomFaults::coin()) faults.add_sometimes(link::Duplicate{1});
+    if (RandomFaults::coin())
+      faults.add_sometimes(link::Delay{milliseconds(*rc::gen::inRange(0, 800)),
+                                       milliseconds(*rc::gen::inRange(0, 800))});
+    if (RandomFaults::coin()) {
       const auto piece = *rc::gen::inRange<std::size_t>(1, 9);
-      add(direction(), sometimes(chance()),
+      faults.add_sometimes(
           link::Fragment{{1, piece}, {Duration::zero(), milliseconds(*rc::gen::inRange(0, 30))}});
     }
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
-          link::Coalesce{2, milliseconds(*rc::gen::inRange(1, 200))});
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()), link::Garbage{{1, 1}, {'\r', '\n', '~', '#'}});
-    for (int i = *rc::gen::inRange(0, 3); i > 0; --i)
-      add(direction(), at(milliseconds(*rc::gen::inRange(0, 60'000))),
-          link::Stall{milliseconds(*rc::gen::inRange(100, 6000))});
-    for (int i = *rc::gen::inRange(0, 3); i > 0; --i) {
-      const Time when = milliseconds(*rc::gen::inRange(0, 60'000));
-      if (*rc::gen::arbitrary<bool>()) {
-        add(link::DirectionFilter::both, at(when), link::Reset{});
-      } else {
-        add(link::DirectionFilter::both, at(when), link::Disconnect{});
-      }
-    }
-    link::validate(profile);
-    return profile;
+    if (RandomFaults::coin())
+      faults.add_sometimes(link::Coalesce{2, milliseconds(*rc::gen::inRange(1, 200))});
+    if (RandomFaults::coin()) faults.add_sometimes(link::Garbage{{1, 1}, {'\r', '\n', '~', '#'}});
+    faults.add_stalls(6000);
+    faults.add_breaks();
+    return faults.take();
   });
 }
 

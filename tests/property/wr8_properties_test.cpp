@@ -50,69 +50,37 @@
 #include "protocol/wr8/codec.hpp"
 #include "sim/presets.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/property/random_faults.hpp"
 
 namespace hil::client::wr8 {
 namespace {
 
 using link::milliseconds;
 using link::seconds;
+using hil::test::RandomFaults;
 
 /// Faults that keep the oracle sound. WR8 packets carry no checksum, so a
 /// corrupted COI or code would be a different valid packet that no client
 /// can tell from the real one: corruption and byte drops are left out.
 rc::Gen<link::FaultProfile> gen_faults() {
   return rc::gen::exec([] {
-    link::FaultProfile profile;
-    auto direction = [] {
-      return *rc::gen::element(link::DirectionFilter::both, link::DirectionFilter::to_car,
-                               link::DirectionFilter::to_client);
-    };
-    auto chance = [] { return *rc::gen::inRange(1, 26) / 100.0; };
-    auto add = [&](link::DirectionFilter d, link::Trigger trigger, link::FaultAction action) {
-      link::FaultRule rule;
-      rule.direction = d;
-      rule.trigger = std::move(trigger);
-      rule.action = std::move(action);
-      profile.rules.push_back(std::move(rule));
-    };
-    auto sometimes = [](double p) {
-      link::Trigger t;
-      t.probability = p;
-      return t;
-    };
-    auto at = [](Time t) {
-      link::Trigger trigger;
-      trigger.at = t;
-      return trigger;
-    };
-    if (*rc::gen::arbitrary<bool>()) add(direction(), sometimes(chance()), link::Drop{});
-    if (*rc::gen::arbitrary<bool>()) add(direction(), sometimes(chance()), link::Duplicate{1});
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
-          link::Delay{milliseconds(*rc::gen::inRange(0, 400)),
-                      milliseconds(*rc::gen::inRange(0, 400))});
-    if (*rc::gen::arbitrary<bool>()) {
+    RandomFaults faults(25);
+    if (RandomFaults::coin()) faults.add_sometimes(link::Drop{});
+    if (RandomFaults::coin()) faults.add_sometimes(link::Duplicate{1});
+    if (RandomFaults::coin())
+      faults.add_sometimes(link::Delay{milliseconds(*rc::gen::inRange(0, 400)),
+                                       milliseconds(*rc::gen::inRange(0, 400))});
+    if (RandomFaults::coin()) {
       const auto piece = *rc::gen::inRange<std::size_t>(1, 9);
-      add(direction(), sometimes(chance()),
+      faults.add_sometimes(
           link::Fragment{{1, piece}, {Duration::zero(), milliseconds(*rc::gen::inRange(0, 30))}});
     }
-    if (*rc::gen::arbitrary<bool>())
-      add(direction(), sometimes(chance()),
-          link::Coalesce{*rc::gen::inRange<std::size_t>(2, 6),
-                         milliseconds(*rc::gen::inRange(1, 300))});
-    for (int i = *rc::gen::inRange(0, 3); i > 0; --i)
-      add(direction(), at(milliseconds(*rc::gen::inRange(0, 60'000))),
-          link::Stall{milliseconds(*rc::gen::inRange(100, 4000))});
-    for (int i = *rc::gen::inRange(0, 3); i > 0; --i) {
-      const Time when = milliseconds(*rc::gen::inRange(0, 60'000));
-      if (*rc::gen::arbitrary<bool>()) {
-        add(link::DirectionFilter::both, at(when), link::Reset{});
-      } else {
-        add(link::DirectionFilter::both, at(when), link::Disconnect{});
-      }
-    }
-    link::validate(profile);
-    return profile;
+    if (RandomFaults::coin())
+      faults.add_sometimes(link::Coalesce{*rc::gen::inRange<std::size_t>(2, 6),
+                                          milliseconds(*rc::gen::inRange(1, 300))});
+    faults.add_stalls(4000);
+    faults.add_breaks();
+    return faults.take();
   });
 }
 
