@@ -34,7 +34,8 @@ bool is_text_byte(std::uint8_t b) {
 nlohmann::ordered_json frames_json(const std::vector<WireFrame>& frames) {
   auto list = nlohmann::ordered_json::array();
   for (const auto& f : frames) {
-    list.push_back({{"kind", f.kind}, {"valid", f.valid}, {"text", f.text}});
+    list.push_back(
+        {{"kind", f.kind}, {"valid", f.valid}, {"text", masked_frame_text(f.kind, f.text)}});
   }
   return list;
 }
@@ -57,6 +58,15 @@ void put_bytes_into(Json& record, protocol::ByteView bytes) {
 }
 
 }  // namespace
+
+std::string masked_frame_text(std::string_view kind, std::string text) {
+  if (kind != "AUTH" || text.empty()) return text;
+  // 'Auth text="..." (profile string)': keep the verdict, hide the string.
+  const auto open = text.find("text=\"");
+  const auto close = text.rfind('"');
+  if (open == std::string::npos || close <= open + 5) return "Auth text=**********";
+  return text.substr(0, open) + "text=**********" + text.substr(close + 1);
+}
 
 void put_bytes(nlohmann::json& record, protocol::ByteView bytes) {
   put_bytes_into(record, bytes);

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -77,6 +78,12 @@ class WireLog final : public LinkObserver {
 /// exactly), else "hex" (spaced uppercase). Shared with reports.
 void put_bytes(nlohmann::json& record, protocol::ByteView bytes);
 void put_bytes(nlohmann::ordered_json& record, protocol::ByteView bytes);
+
+/// A decoded frame's text as a person may read it: the authentication
+/// string of a WR8 AUTH (kind "AUTH") replaced by asterisks, every other
+/// frame unchanged. The wire log's "frames" use it; the raw "text"/"hex"
+/// of the record still hold every byte (that is the capture).
+std::string masked_frame_text(std::string_view kind, std::string text);
 
 /// The bytes a record's "text" or "hex" field holds; empty when it has
 /// neither.
