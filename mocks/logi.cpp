@@ -35,6 +35,8 @@ const LogiConfig& checked(const LogiConfig& c) {
           "boot_speed_percent must be 0..100");
   require(c.stat_period > Duration::zero(), "stat_period must be positive");
   require(c.control_period > Duration::zero(), "control_period must be positive");
+  require(c.boot_offset >= Duration::zero() && c.boot_offset <= c.stat_period,
+          "boot_offset must be 0..stat_period");
   require(c.obstacle_stop_cm >= 0, "obstacle_stop_cm must be >= 0");
   require(c.obstacle_clear_hysteresis_cm >= 0, "obstacle_clear_hysteresis_cm must be >= 0");
   require(c.line_lost_timeout >= Duration::zero(), "line_lost_timeout must be >= 0");
@@ -389,7 +391,11 @@ bool LogiFirmware::active() const {
 }
 
 Time LogiFirmware::grid_after(Time now, Duration period) const {
-  return (now / period + 1) * period;
+  // Floor division: before the offset, the first grid point is the offset.
+  const Duration since = now - config_.boot_offset;
+  auto ticks = since / period;
+  if (since < Duration::zero() && since % period != Duration::zero()) --ticks;
+  return config_.boot_offset + (ticks + 1) * period;
 }
 
 void LogiFirmware::on_tick(Time now) {

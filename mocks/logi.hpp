@@ -30,6 +30,11 @@ struct LogiConfig {
   /// The control loop (line follower, obstacle lock, station check) runs at
   /// every multiple of this while the car has something to do.
   Duration control_period = link::milliseconds(10);
+  /// When the car was switched on: the STAT and control-loop grids are the
+  /// multiples of their periods counted from this time, not from zero. Cars
+  /// of a fleet switched on at different moments spread their telemetry and
+  /// control work instead of all waking at once. 0..stat_period.
+  Duration boot_offset = Duration::zero();
   /// The obstacle lock holds the car while the sonar reads below this.
   int obstacle_stop_cm = 20;
   /// ...and lets go when it reads at least obstacle_stop_cm + this again.

@@ -1,6 +1,7 @@
 // hil mock: standalone mock cars for the desk, in real time, until Ctrl-C.
 
 #include <sys/ioctl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <asio/io_context.hpp>
 #include <asio/posix/stream_descriptor.hpp>
@@ -10,9 +11,12 @@
 
 #include <fcntl.h>
 
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -49,6 +53,8 @@ struct MockArgs {
   std::string auth;
   std::optional<double> data_hz;
   bool quiet = false;
+  bool verbose = false;
+  std::string ports_file;
   bool no_status = false;
   bool commands = false;
   bool view = false;
@@ -56,6 +62,21 @@ struct MockArgs {
 };
 
 constexpr std::uint16_t kDefaultViewPort = 8080;
+
+// A fleet of TCP cars is what a fleet manager is tested against; one
+// io_context serves 1,000 LOGI cars in real time on 2 cores
+// (docs/performance.md), and each car holds two descriptors (its listener and
+// its client), so 10,000 cars stay within common hard limits of 20,000+ and
+// within the port range. Serial cars each hold a pty pair and a symlink in
+// /tmp, and the kernel's pty pool is shared with every terminal on the
+// machine, so they keep a smaller limit.
+constexpr std::size_t kMaxTcpCars = 10000;
+constexpr std::size_t kMaxSerialCars = 64;
+// Up to this many cars, one line each; beyond, the first, the last and a
+// summary (-v lists every car, --ports-file writes them to a file).
+constexpr std::size_t kCarsListed = 16;
+// Descriptors besides the cars': stdio, the status line, the view, a wire log.
+constexpr rlim_t kSpareDescriptors = 64;
 
 // "--view" alone, "--view 8081", "--view 0" (any free port).
 std::optional<std::uint16_t> parse_view_port(const std::string& text) {
@@ -83,6 +104,58 @@ std::string nth_path(const std::string& first, std::size_t index) {
     --digits;
   if (digits == first.size()) return first + "-" + std::to_string(index);
   return first.substr(0, digits) + std::to_string(std::stoull(first.substr(digits)) + index);
+}
+
+// Raises the soft limit on open descriptors to the hard one when the cars
+// need more than the soft limit allows (the usual soft limit, 1,024, is
+// about 500 TCP cars). Returns an error for the user when even the hard limit
+// is too low.
+std::optional<std::string> make_room_for_descriptors(std::size_t cars, bool serial) {
+  const rlim_t needed = static_cast<rlim_t>(cars) * 2 + kSpareDescriptors;
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0) return std::nullopt;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur >= needed) return std::nullopt;
+  if (limit.rlim_cur == RLIM_INFINITY) return std::nullopt;
+  if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < needed) {
+    return std::to_string(cars) + " cars need about " + std::to_string(needed) + " open files (" +
+           (serial ? "a pty pair" : "a listening socket and a client") +
+           " per car), but the hard limit is " + std::to_string(limit.rlim_max) +
+           " (ulimit -Hn); run fewer cars or raise the hard limit (limits.conf, systemd's "
+           "LimitNOFILE, or ulimit -Hn as root)";
+  }
+  const rlim_t old_soft = limit.rlim_cur;
+  limit.rlim_cur = limit.rlim_max;
+  if (::setrlimit(RLIMIT_NOFILE, &limit) != 0) {
+    return "cannot raise the open-file limit from " + std::to_string(old_soft) + " to " +
+           std::to_string(limit.rlim_max) + ": " + std::strerror(errno);
+  }
+  return std::nullopt;
+}
+
+// "tcp://127.0.0.1:9000" -> 9000; 0 when there is no port.
+unsigned port_of(const std::string& address) {
+  const auto colon = address.rfind(':');
+  if (colon == std::string::npos) return 0;
+  try {
+    return static_cast<unsigned>(std::stoul(address.substr(colon + 1)));
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
+// Writes "<name> <address>" per car, whole or not at all: a script waiting
+// for the file never reads half a list.
+bool write_ports_file(const std::string& path, const std::vector<std::string>& lines) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream out(partial, std::ios::trunc);
+    for (const auto& line : lines)
+      out << line << '\n';
+    if (!out.flush()) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(partial, path, ec);
+  return !ec;
 }
 
 link::Endpoint endpoint_for(const MockArgs& args, mocks::CarKind kind, std::size_t index) {
@@ -339,6 +412,23 @@ int run_mock(const MockArgs& args) {
     base.configs.wr8.data_period = std::chrono::duration_cast<link::Duration>(
         std::chrono::duration<double>(1.0 / *args.data_hz));
   }
+  const bool serial = std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(*kind, 0));
+  if (serial && args.count > kMaxSerialCars) {
+    std::cerr << "hil mock: --count for serial cars is at most " << kMaxSerialCars
+              << " (each holds a pty from the pool every terminal shares), got " << args.count
+              << '\n';
+    return 2;
+  }
+  if (!serial && args.port && *args.port != 0 && *args.port + args.count - 1 > 65535) {
+    std::cerr << "hil mock: --port " << *args.port << " with --count " << args.count
+              << " runs past port 65535 (car N listens on PORT+N); choose a lower --port or "
+                 "--port 0\n";
+    return 2;
+  }
+  if (const auto problem = make_room_for_descriptors(args.count, serial)) {
+    std::cerr << "hil mock: " << *problem << '\n';
+    return 1;
+  }
   const std::uint64_t seed = args.seed ? *args.seed : std::random_device{}();
   const auto view_port = parse_view_port(args.view_port);
   if (args.view && !view_port) {
@@ -354,11 +444,21 @@ int run_mock(const MockArgs& args) {
   const auto log = [&status](const std::string& line) { status.log(line); };
 
   std::vector<RunningCar> cars;
+  cars.reserve(args.count);
   std::vector<std::shared_ptr<view::WireWatch>> watches;
+  std::vector<std::string> listing;  // "<name> <address>" per car
+  const bool list_each = args.verbose || args.count <= kCarsListed;
   for (std::size_t i = 0; i < args.count; ++i) {
     mocks::CarOptions options = base;
     options.name = "car" + std::to_string(i);
     options.seed = mocks::car_seed(seed, i);
+    // Switched on one after another across a STAT period: a fleet's
+    // telemetry and control ticks spread out instead of all cars waking in
+    // the same instant, which would hold up every answer behind a burst of
+    // N cars' work (docs/performance.md, the fleet).
+    const auto& logi_config = options.configs.logi;
+    options.configs.logi.boot_offset = logi_config.stat_period * static_cast<std::int64_t>(i) /
+                                       static_cast<std::int64_t>(args.count);
     RunningCar running;
     try {
       running.car = std::make_unique<mocks::MockCar>(std::move(options));
@@ -391,9 +491,27 @@ int run_mock(const MockArgs& args) {
       std::cerr << '\n';
       return 1;
     }
-    std::cout << "hil mock " << args.car << ": " << running.car->name() << " "
-              << how_to_connect(listening, running.server->address()) << '\n';
+    listing.push_back(running.car->name() + " " + running.server->address());
+    if (list_each || i == 0 || i + 1 == args.count) {
+      if (!list_each && i + 1 == args.count) {
+        const unsigned second = port_of(cars.at(1).server->address());
+        const unsigned last_but_one = port_of(cars.back().server->address());
+        std::cout << "hil mock " << args.car << ": ... " << args.count - 2 << " more cars";
+        if (args.port && *args.port != 0)
+          std::cout << " on ports " << second << ".." << last_but_one << " (car N on " << *args.port
+                    << "+N)";
+        else
+          std::cout << " on free ports";
+        std::cout << "; -v lists each, --ports-file writes them to a file\n";
+      }
+      std::cout << "hil mock " << args.car << ": " << running.car->name() << " "
+                << how_to_connect(listening, running.server->address()) << '\n';
+    }
     cars.push_back(std::move(running));
+  }
+  if (!args.ports_file.empty() && !write_ports_file(args.ports_file, listing)) {
+    std::cerr << "hil mock: cannot write --ports-file " << args.ports_file << '\n';
+    return 1;
   }
   if (args.bind != "127.0.0.1" && args.bind != "localhost" && args.bind != "::1" &&
       !std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(*kind, 0))) {
@@ -498,12 +616,21 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
                   "Seed for sensor noise and faults (printed when chosen at random)");
   cmd->add_option("--log", args->wire_log,
                   "Write every byte of every connection to an NDJSON wire log");
-  cmd->add_option("--count", args->count, "Run N independent cars on consecutive ports or ptys")
-      ->check(CLI::Range(1, 64));
+  cmd->add_option("--count", args->count,
+                  "Run N independent cars on consecutive ports or ptys (TCP cars up to " +
+                      std::to_string(kMaxTcpCars) + ", serial cars up to " +
+                      std::to_string(kMaxSerialCars) + ")")
+      ->check(CLI::Range(std::size_t{1}, kMaxTcpCars));
+  cmd->add_option("--ports-file", args->ports_file,
+                  "Write one line per car, its name and where it listens, once every car "
+                  "listens (for scripts; with --port 0 the ports are not consecutive)");
   cmd->add_option("--auth", args->auth, "WR8: the 10-character authentication string");
   cmd->add_option("--data-hz", args->data_hz, "WR8: DATA packets per second (default 10)")
       ->check(CLI::Range(0.1, 1000.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No line per connection and fault");
+  cmd->add_flag("-v,--verbose", args->verbose,
+                "One line per car even with more than " + std::to_string(kCarsListed) +
+                    " cars (else the first, the last and a summary)");
   cmd->add_flag("--commands", args->commands,
                 "Read desk commands from stdin even when it is not a terminal (they are read "
                 "from a terminal anyway; type 'help')");
@@ -520,6 +647,7 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "Examples:\n"
       "  hil mock logi                                 # LOGI car on tcp://127.0.0.1:9000\n"
       "  hil mock wr8 --count 3 --port 9100            # three WR8 vehicles on 9100..9102\n"
+      "  hil mock logi --count 1000 -q                 # a fleet of LOGI cars on 9000..9999\n"
       "  hil mock arduino --pty /tmp/robot0            # open /tmp/robot0 at 9600 baud\n"
       "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil mock logi --view                          # and watch it on http://127.0.0.1:8080/\n"
