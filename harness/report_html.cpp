@@ -1,9 +1,12 @@
 // The report folder: per run an HTML page (verdict, steps, expectations with
-// evidence, the trajectory, the timeline as a filterable table), its NDJSON
+// evidence, a playback of the run on a time slider drawn by the live view's
+// own script, the trajectory, the timeline as a filterable table), its NDJSON
 // timeline and SVG trajectory, and an index page of every run. Self-contained:
 // no external scripts, fonts or styles, so it opens from a CI artifact.
 
 #include <cctype>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +15,9 @@
 #include <stdexcept>
 
 #include "harness/report.hpp"
+#include "sim/geometry.hpp"
 #include "sim/svg.hpp"
+#include "view/drawing.hpp"
 
 namespace hil::harness {
 namespace {
@@ -168,6 +173,231 @@ std::string timeline_html(const Timeline& timeline) {
   return out;
 }
 
+// What the playback carries at most: enough for minutes of run at full
+// detail; longer runs are thinned evenly (the NDJSON keeps everything).
+constexpr std::size_t kMostPlaybackSamples = 12000;  // per car
+constexpr std::size_t kMostPlaybackRecords = 20000;  // frames, faults, events each
+
+double ms_of(Duration d) {
+  return std::round(std::chrono::duration<double, std::milli>(d).count() * 10) / 10;
+}
+
+double rounded(double v, double step) {
+  return std::round(v / step) * step;
+}
+
+// The recorded run as the playback script reads it: the arena in the live
+// view's shape, each car's poses over time, and what crossed the wire.
+nlohmann::json playback_json(const ScenarioOutcome& o) {
+  using nlohmann::json;
+  json j;
+  j["arena"] = view::arena_json(o.arena);
+  j["run_ms"] = ms_of(o.run_time);
+  j["cars"] = json::array();
+  for (const auto& t : o.trajectories) {
+    json samples = json::array();
+    const std::size_t n = t.samples.size();
+    const std::size_t stride =
+        n > kMostPlaybackSamples ? (n + kMostPlaybackSamples - 1) / kMostPlaybackSamples : 1;
+    for (std::size_t i = 0; i < n; i += stride) {
+      const auto& s = t.samples[i];
+      samples.push_back({ms_of(s.time), rounded(s.pose.x_m, 1e-4), rounded(s.pose.y_m, 1e-4),
+                         rounded(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
+    }
+    if (n > 0 && (n - 1) % stride != 0) {
+      const auto& s = t.samples.back();
+      samples.push_back({ms_of(s.time), rounded(s.pose.x_m, 1e-4), rounded(s.pose.y_m, 1e-4),
+                         rounded(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
+    }
+    json marks = json::array();
+    for (const auto& m : t.marks) {
+      const char* kind = m.kind == sim::MarkKind::collision ? "collision"
+                         : m.kind == sim::MarkKind::stop    ? "stop"
+                         : m.kind == sim::MarkKind::station ? "station"
+                                                            : "note";
+      marks.push_back({ms_of(m.time), rounded(m.position_m.x_m, 1e-4),
+                       rounded(m.position_m.y_m, 1e-4), kind, m.label});
+    }
+    j["cars"].push_back({{"name", t.vehicle},
+                         {"footprint", {{"length", t.length_m}, {"width", t.width_m}}},
+                         {"samples", samples},
+                         {"marks", marks}});
+  }
+  json frames = json::array(), faults = json::array(), events = json::array(),
+       fault_state = json::array();
+  for (const auto& r : o.timeline.records()) {
+    const double at = ms_of(r.at);
+    if (r.source == Source::wire && r.kind == "frame") {
+      if (r.data.value("stage", "") != "delivered" || frames.size() >= kMostPlaybackRecords)
+        continue;
+      const std::string text =
+          r.data.contains("text") ? r.data.value("text", "") : r.data.value("hex", "");
+      frames.push_back({at, r.data.value("dir", ""), r.data.value("frame", ""), text,
+                        r.data.value("valid", true)});
+    } else if (r.source == Source::fault) {
+      if (faults.size() < kMostPlaybackRecords)
+        faults.push_back({at, r.data.value("dir", ""), r.kind, r.data.value("rule", ""),
+                          r.data.value("detail", "")});
+    } else if (r.source == Source::car && r.kind == "fault_state") {
+      fault_state.push_back({at, r.data.value("on", false)});
+    } else if ((r.source == Source::step && r.kind == "start") || r.source == Source::client ||
+               (r.source == Source::sim && r.kind != "sample")) {
+      if (events.size() < kMostPlaybackRecords)
+        events.push_back({at, std::string(to_string(r.source)), r.kind, describe_record(r)});
+    }
+  }
+  j["frames"] = std::move(frames);
+  j["faults"] = std::move(faults);
+  j["events"] = std::move(events);
+  j["fault_state"] = std::move(fault_state);
+  return j;
+}
+
+// JSON inside a <script> element: no '<' may reach the HTML parser, and a
+// JSON string may spell it \u003c.
+std::string script_json(const nlohmann::json& j) {
+  const std::string text = j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    if (c == '<')
+      out += "\\u003c";
+    else
+      out += c;
+  }
+  return out;
+}
+
+constexpr const char* kPlaybackStyle = R"(<style>
+#playback{display:grid;grid-template-columns:minmax(420px,1fr) 440px;gap:10px;align-items:start}
+#pb-canvas{width:100%;border:1px solid #ddd;background:#fff}
+#pb-controls{display:flex;gap:.5em;align-items:center;margin:.3em 0}
+#pb-slider{flex:1} #playback>div{min-width:0} #playback>div:last-child{overflow-x:auto}
+#playback .frames{font-family:ui-monospace,monospace;font-size:11px}
+#playback .frames td{border:none;padding:0 .4em 0 0;white-space:nowrap}
+#playback .invalid{color:#c62828} #playback h3{font-size:13px;margin:.6em 0 .2em}
+</style>
+)";
+
+// Plays the run back with the live view's drawing (hilFit, hilDrawArena,
+// hilDrawCar). The time can be set from the address: index.html#t=12.5.
+constexpr const char* kPlaybackScript = R"JS(<script>
+"use strict";
+(function () {
+  const data = JSON.parse(document.getElementById("pb-data").textContent);
+  const $ = (id) => document.getElementById(id);
+  const canvas = $("pb-canvas"), ctx = canvas.getContext("2d"), slider = $("pb-slider");
+  const esc = (s) => String(s).replace(/[&<>"]/g, c => ({"&":"&amp;","<":"&lt;",">":"&gt;",'"':"&quot;"}[c]));
+  // The index of the last row at or before t (rows sorted by row[0]).
+  function upTo(rows, t) {
+    let lo = 0, hi = rows.length;
+    while (lo < hi) { const mid = (lo + hi) >> 1; if (rows[mid][0] <= t) lo = mid + 1; else hi = mid; }
+    return lo - 1;
+  }
+  function poseAt(samples, t) {
+    const i = upTo(samples, t);
+    if (i < 0) { const s = samples[0]; return { x: s[1], y: s[2], heading_deg: s[3] }; }
+    const a = samples[i], b = samples[Math.min(i + 1, samples.length - 1)];
+    const f = b[0] > a[0] ? Math.min(1, (t - a[0]) / (b[0] - a[0])) : 0;
+    let dh = b[3] - a[3]; dh -= 360 * Math.round(dh / 360);
+    return { x: a[1] + f * (b[1] - a[1]), y: a[2] + f * (b[2] - a[2]), heading_deg: a[3] + f * dh };
+  }
+  function last(rows, t, n, keep) {
+    const out = [];
+    for (let i = upTo(rows, t); i >= 0 && out.length < n; --i) if (!keep || keep(rows[i])) out.push(rows[i]);
+    return out;
+  }
+  function show(t) {
+    t = Math.max(0, Math.min(data.run_ms, t));
+    hilFit(canvas, data.arena);
+    hilDrawArena(ctx, data.arena, null);
+    const fs = upTo(data.fault_state, t), inFault = fs >= 0 && data.fault_state[fs][1];
+    const poses = [];
+    data.cars.forEach((car, n) => {
+      if (!car.samples.length) return;
+      const k = upTo(car.samples, t), trail = car.samples.slice(0, k + 1).map(s => [s[1], s[2]]);
+      const pose = poseAt(car.samples, t);
+      trail.push([pose.x, pose.y]);
+      hilDrawCar(ctx, { pose, footprint: car.footprint, trail, in_fault: inFault,
+                        label: data.cars.length > 1 ? car.name : "" });
+      for (const m of car.marks) {
+        if (m[0] > t) continue;
+        ctx.fillStyle = m[3] === "collision" ? "#c62828" : m[3] === "station" ? "#a60" : "#555";
+        ctx.beginPath(); ctx.arc(hilPx(m[1]), hilPy(m[2]), 3, 0, 2 * Math.PI); ctx.fill();
+      }
+      poses.push(pose);
+    });
+    const d = $("pb-pose").dataset;
+    d.tMs = t.toFixed(1);
+    if (poses.length) { d.x = poses[0].x.toFixed(4); d.y = poses[0].y.toFixed(4); d.heading = poses[0].heading_deg.toFixed(2); }
+    d.framesToCar = upTo(data.frames, t) < 0 ? 0 : data.frames.slice(0, upTo(data.frames, t) + 1).filter(f => f[1] === "to_car").length;
+    d.faults = upTo(data.faults, t) + 1;
+    $("pb-time").textContent = (t / 1000).toFixed(2) + " / " + (data.run_ms / 1000).toFixed(2) + " s";
+    $("pb-pose").textContent = poses.length
+      ? "x " + d.x + " m, y " + d.y + " m, heading " + d.heading + "\u00b0" + (inFault ? " \u00b7 FAULT" : "") : "no chassis recorded";
+    const frameRows = (dir) => last(data.frames, t, 8, f => f[1] === dir).map(f =>
+      "<tr class='" + (f[4] ? "" : "invalid") + "'><td>" + (f[0] / 1000).toFixed(2) + "</td><td>" + esc(f[2]) +
+      "</td><td>" + esc(f[3]) + "</td></tr>").join("");
+    $("pb-to-car").innerHTML = frameRows("to_car");
+    $("pb-to-client").innerHTML = frameRows("to_client");
+    $("pb-faults").innerHTML = last(data.faults, t, 6).map(f => "<tr><td>" + (f[0] / 1000).toFixed(2) + "</td><td>" +
+      esc(f[1] + " " + f[2] + " [" + f[3] + "] " + f[4]) + "</td></tr>").join("") || "<tr><td>none yet</td></tr>";
+    $("pb-events").innerHTML = last(data.events, t, 8).map(e => "<tr><td>" + (e[0] / 1000).toFixed(2) + "</td><td>" +
+      esc(e[1]) + "</td><td>" + esc(e[3]) + "</td></tr>").join("");
+  }
+  let playing = false, lastTick = 0;
+  function tick(now) {
+    if (!playing) return;
+    const speed = parseFloat($("pb-speed").value) || 1;
+    const t = parseFloat(slider.value) + (lastTick ? (now - lastTick) * speed : 0);
+    lastTick = now;
+    slider.value = Math.min(data.run_ms, t);
+    show(parseFloat(slider.value));
+    if (t >= data.run_ms) { playing = false; $("pb-play").textContent = "play"; return; }
+    requestAnimationFrame(tick);
+  }
+  $("pb-play").onclick = () => {
+    playing = !playing; $("pb-play").textContent = playing ? "pause" : "play"; lastTick = 0;
+    if (playing) { if (parseFloat(slider.value) >= data.run_ms) slider.value = 0; requestAnimationFrame(tick); }
+  };
+  slider.max = data.run_ms;
+  slider.oninput = () => show(parseFloat(slider.value));
+  function fromAddress() {
+    const m = /t=([0-9.]+)/.exec(location.hash);
+    slider.value = m ? parseFloat(m[1]) * 1000 : data.run_ms;
+    show(parseFloat(slider.value));
+  }
+  window.addEventListener("hashchange", fromAddress);
+  fromAddress();
+})();
+</script>
+)JS";
+
+std::string playback_html(const ScenarioOutcome& o) {
+  std::string out = kPlaybackStyle;
+  out +=
+      "<p>The run replayed with the live view's drawing: drag the slider or press play "
+      "(the address can pick a time: <code>#t=2.5</code>).</p>\n"
+      "<div id=\"playback\"><div>\n"
+      "<canvas id=\"pb-canvas\" width=\"1000\" height=\"750\"></canvas>\n"
+      "<div id=\"pb-controls\"><button id=\"pb-play\">play</button>"
+      "<input type=\"range\" id=\"pb-slider\" min=\"0\" step=\"10\" value=\"0\">"
+      "<span id=\"pb-time\"></span><select id=\"pb-speed\" title=\"playback speed\">"
+      "<option value=\"0.25\">0.25x</option><option value=\"1\" selected>1x</option>"
+      "<option value=\"4\">4x</option><option value=\"16\">16x</option></select></div>\n"
+      "<div id=\"pb-pose\" class=\"mono\"></div></div>\n"
+      "<div><h3>client to car (last 8)</h3><table class=\"frames\" id=\"pb-to-car\"></table>\n"
+      "<h3>car to client (last 8)</h3><table class=\"frames\" id=\"pb-to-client\"></table>\n"
+      "<h3>faults injected</h3><table class=\"frames\" id=\"pb-faults\"></table>\n"
+      "<h3>steps, client, chassis</h3><table class=\"frames\" id=\"pb-events\"></table></div>\n"
+      "</div>\n<script>\n";
+  out += view::drawing_script();
+  out += "</script>\n<script id=\"pb-data\" type=\"application/json\">" +
+         script_json(playback_json(o)) + "</script>\n";
+  out += kPlaybackScript;
+  return out;
+}
+
 std::string page_head(const std::string& title) {
   return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + esc(title) +
          "</title>\n" + kStyle + "</head>\n";
@@ -240,6 +470,7 @@ std::string run_page_html(const ReportEntry& entry) {
   out += "</table>\n";
   if (!o.error.empty()) out += "<h2>Error</h2>\n<pre>" + esc(o.error) + "</pre>\n";
   if (!passed) out += "<h2>Failure</h2>\n<pre>" + esc(failure_text(o)) + "</pre>\n";
+  out += "<h2>Playback</h2>\n" + playback_html(o);
   out += "<h2>Steps</h2>\n" + steps_html(o);
   out += "<h2>Expectations</h2>\n" + expectations_html(o);
   out +=

@@ -1,5 +1,7 @@
 #include "view/live_model.hpp"
 
+#include "view/drawing.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -59,62 +61,11 @@ std::string string_field(const json& request, const char* name, std::string fall
   return it->get<std::string>();
 }
 
-json obstacle_json(const sim::Obstacle& o, std::size_t index, bool present) {
-  json j;
-  j["index"] = index;
-  j["present"] = present;
-  if (const auto* box = std::get_if<sim::BoxObstacle>(&o)) {
-    j["shape"] = "box";
-    j["name"] = box->name;
-    j["x"] = box->center_m.x_m;
-    j["y"] = box->center_m.y_m;
-    j["width"] = box->width_m;
-    j["height"] = box->height_m;
-    j["angle_deg"] = sim::rad_to_deg(box->angle_rad);
-  } else {
-    const auto& disc = std::get<sim::CircleObstacle>(o);
-    j["shape"] = "circle";
-    j["name"] = disc.name;
-    j["x"] = disc.center_m.x_m;
-    j["y"] = disc.center_m.y_m;
-    j["radius"] = disc.radius_m;
-  }
-  return j;
-}
-
 json arena_json(const sim::World& world) {
-  const auto& arena = world.arena();
-  json j;
-  j["name"] = arena.name;
-  j["width"] = arena.width_m;
-  j["height"] = arena.height_m;
-  j["walls"] = arena.walls;
-  j["wall_thickness"] = arena.wall_thickness_m;
-  j["obstacles"] = json::array();
-  for (std::size_t i = 0; i < arena.obstacles.size(); ++i) {
-    if (!world.obstacle_present(i)) continue;
-    j["obstacles"].push_back(obstacle_json(arena.obstacles[i], i, true));
-  }
-  j["tapes"] = json::array();
-  for (const auto& tape : arena.tapes) {
-    json points = json::array();
-    for (const auto& p : tape.points_m)
-      points.push_back({round_to(p.x_m, 1e-4), round_to(p.y_m, 1e-4)});
-    j["tapes"].push_back({{"name", tape.name},
-                          {"width", tape.width_m},
-                          {"closed", tape.closed},
-                          {"points", points}});
-  }
-  j["stations"] = json::array();
-  for (const auto& tag : arena.tags)
-    j["stations"].push_back({{"id", tag.id},
-                             {"x", tag.position_m.x_m},
-                             {"y", tag.position_m.y_m},
-                             {"radius", tag.radius_m}});
-  j["start"] = {{"x", arena.start.x_m},
-                {"y", arena.start.y_m},
-                {"heading_deg", sim::rad_to_deg(arena.start.heading_rad)}};
-  return j;
+  std::vector<bool> present(world.arena().obstacles.size());
+  for (std::size_t i = 0; i < present.size(); ++i)
+    present[i] = world.obstacle_present(i);
+  return view::arena_json(world.arena(), &present);
 }
 
 // The sonar's beam as the physics sees it (no noise, no sensor faults):

@@ -1,11 +1,15 @@
 #include "view/page.hpp"
 
+#include <string>
+
+#include "view/drawing.hpp"
+
 namespace hil::view {
 namespace {
 
 // One file, no external scripts or fonts: the page must work on a desk
 // with no network and behind nothing but `hil mock`.
-constexpr std::string_view kPage = R"HTML(<!doctype html>
+constexpr std::string_view kPageHead = R"HTML(<!doctype html>
 <html lang="en">
 <head>
 <meta charset="utf-8">
@@ -119,6 +123,11 @@ constexpr std::string_view kPage = R"HTML(<!doctype html>
   </div>
 </main>
 <script>
+)HTML";
+
+// The page's own script, after the shared drawing script.
+constexpr std::string_view kPageScript = R"HTML(</script>
+<script>
 "use strict";
 const $ = (id) => document.getElementById(id);
 const canvas = $("arena"), ctx = canvas.getContext("2d");
@@ -135,82 +144,8 @@ const PRESETS = {
 
 function esc(s) { return String(s).replace(/[&<>"]/g, c => ({"&":"&amp;","<":"&lt;",">":"&gt;",'"':"&quot;"}[c])); }
 
-// ---- drawing: arena metres to canvas pixels, y up ----
-let view = { scale: 200, ox: 20, oy: 20, h: 3 };
-function fit(arena) {
-  const margin = 20;
-  const sx = (canvas.width - 2 * margin) / arena.width, sy = (canvas.height - 2 * margin) / arena.height;
-  view = { scale: Math.min(sx, sy), ox: margin, oy: margin, h: arena.height };
-}
-const px = (x) => view.ox + x * view.scale;
-const py = (y) => view.oy + (view.h - y) * view.scale;
-function toArena(cx, cy) { return { x: (cx - view.ox) / view.scale, y: view.h - (cy - view.oy) / view.scale }; }
-
-function drawObstacle(o, fill) {
-  ctx.fillStyle = fill; ctx.strokeStyle = "#555"; ctx.lineWidth = 1;
-  if (o.shape === "circle") {
-    ctx.beginPath(); ctx.arc(px(o.x), py(o.y), o.radius * view.scale, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
-  } else {
-    ctx.save(); ctx.translate(px(o.x), py(o.y)); ctx.rotate(-o.angle_deg * Math.PI / 180);
-    const w = o.width * view.scale, h = o.height * view.scale;
-    ctx.fillRect(-w / 2, -h / 2, w, h); ctx.strokeRect(-w / 2, -h / 2, w, h); ctx.restore();
-  }
-  ctx.fillStyle = "#333"; ctx.font = "11px sans-serif"; ctx.textAlign = "center";
-  ctx.fillText(o.name + " #" + o.index, px(o.x), py(o.y) + 4);
-}
-
-function draw(car) {
-  const a = car.arena;
-  fit(a);
-  ctx.clearRect(0, 0, canvas.width, canvas.height);
-  ctx.fillStyle = "#fbfbf8"; ctx.fillRect(px(0), py(a.height), a.width * view.scale, a.height * view.scale);
-  // grid every half metre
-  ctx.strokeStyle = "#eee"; ctx.lineWidth = 1;
-  for (let x = 0; x <= a.width + 1e-9; x += 0.5) { ctx.beginPath(); ctx.moveTo(px(x), py(0)); ctx.lineTo(px(x), py(a.height)); ctx.stroke(); }
-  for (let y = 0; y <= a.height + 1e-9; y += 0.5) { ctx.beginPath(); ctx.moveTo(px(0), py(y)); ctx.lineTo(px(a.width), py(y)); ctx.stroke(); }
-  if (a.walls) { ctx.strokeStyle = "#444"; ctx.lineWidth = Math.max(3, a.wall_thickness * view.scale);
-    ctx.strokeRect(px(0) - ctx.lineWidth / 2, py(a.height) - ctx.lineWidth / 2, a.width * view.scale + ctx.lineWidth, a.height * view.scale + ctx.lineWidth); }
-  for (const t of a.tapes) {
-    ctx.strokeStyle = "#222"; ctx.lineWidth = Math.max(2, t.width * view.scale); ctx.lineJoin = "round";
-    ctx.beginPath(); t.points.forEach((p, i) => i ? ctx.lineTo(px(p[0]), py(p[1])) : ctx.moveTo(px(p[0]), py(p[1])));
-    if (t.closed) ctx.closePath(); ctx.stroke();
-  }
-  for (const s of a.stations) {
-    ctx.fillStyle = "rgba(230,160,20,.35)"; ctx.strokeStyle = "#c80";
-    ctx.beginPath(); ctx.arc(px(s.x), py(s.y), Math.max(5, s.radius * view.scale), 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
-    ctx.fillStyle = "#a60"; ctx.font = "bold 12px sans-serif"; ctx.textAlign = "left";
-    ctx.fillText("station " + s.id, px(s.x) + 10, py(s.y) - 10);
-  }
-  for (const o of a.obstacles) drawObstacle(o, picked === o.index ? "#f5d76e" : "#c9c4b8");
-  // trail
-  if (car.trail.length > 1) {
-    ctx.strokeStyle = "rgba(10,110,189,.55)"; ctx.lineWidth = 2;
-    ctx.beginPath(); car.trail.forEach((p, i) => i ? ctx.lineTo(px(p[0]), py(p[1])) : ctx.moveTo(px(p[0]), py(p[1]))); ctx.stroke();
-  }
-  // sonar beam
-  const s = car.sonar;
-  ctx.strokeStyle = "rgba(0,160,80,.35)"; ctx.lineWidth = 1;
-  for (const r of s.rays) { ctx.beginPath(); ctx.moveTo(px(s.x), py(s.y)); ctx.lineTo(px(r.x), py(r.y)); ctx.stroke(); }
-  if (s.echo) {
-    const ax = s.x + s.distance_m * Math.cos(s.axis_deg * Math.PI / 180), ay = s.y + s.distance_m * Math.sin(s.axis_deg * Math.PI / 180);
-    ctx.strokeStyle = "rgb(0,150,70)"; ctx.lineWidth = 2; ctx.beginPath(); ctx.moveTo(px(s.x), py(s.y)); ctx.lineTo(px(ax), py(ay)); ctx.stroke();
-    ctx.fillStyle = "rgb(0,150,70)"; ctx.beginPath(); ctx.arc(px(ax), py(ay), 4, 0, 2 * Math.PI); ctx.fill();
-  }
-  // the car
-  const p = car.pose, f = car.footprint;
-  ctx.save(); ctx.translate(px(p.x), py(p.y)); ctx.rotate(-p.heading_deg * Math.PI / 180);
-  const L = f.length * view.scale, W = f.width * view.scale, C = f.center_ahead * view.scale;
-  ctx.fillStyle = car.in_fault ? "rgba(192,57,43,.8)" : "rgba(10,110,189,.85)"; ctx.strokeStyle = "#033";
-  ctx.fillRect(C - L / 2, -W / 2, L, W); ctx.strokeRect(C - L / 2, -W / 2, L, W);
-  ctx.fillStyle = "#fff"; ctx.beginPath();  // heading arrow
-  ctx.moveTo(C + L / 2 - 2, 0); ctx.lineTo(C + L / 2 - L * 0.35, -W * 0.3); ctx.lineTo(C + L / 2 - L * 0.35, W * 0.3); ctx.closePath(); ctx.fill();
-  ctx.restore();
-  // line sensors
-  for (const h of car.line.sensors) {
-    ctx.fillStyle = h.on_tape ? "#e74c3c" : "#fff"; ctx.strokeStyle = "#000"; ctx.lineWidth = 1;
-    ctx.beginPath(); ctx.arc(px(h.x), py(h.y), 3.5, 0, 2 * Math.PI); ctx.fill(); ctx.stroke();
-  }
-}
+// ---- drawing: the shared script above (view/drawing.cpp) ----
+function draw(car) { hilDraw(ctx, car, picked); }
 
 // ---- panels ----
 function fmt(v, d) { return typeof v === "number" ? v.toFixed(d) : (v === null || v === undefined ? "-" : String(v)); }
@@ -314,7 +249,7 @@ function obstacleAt(car, p) {
 canvas.addEventListener("click", (ev) => {
   if (!state) return;
   const car = state.cars[carIndex], rect = canvas.getBoundingClientRect();
-  const p = toArena((ev.clientX - rect.left) * canvas.width / rect.width, (ev.clientY - rect.top) * canvas.height / rect.height);
+  const p = hilToArena((ev.clientX - rect.left) * canvas.width / rect.width, (ev.clientY - rect.top) * canvas.height / rect.height);
   const what = document.querySelector("input[name=click]:checked").value;
   if (what === "car") api("car", { x: p.x, y: p.y, heading_deg: parseFloat($("heading").value || "0") });
   else if (what === "parcel") api("obstacle", { op: "add", shape: "box", x: p.x, y: p.y, width: 0.3, height: 0.1, name: "parcel" });
@@ -342,7 +277,9 @@ connect();
 }  // namespace
 
 std::string_view live_view_page() {
-  return kPage;
+  static const std::string page =
+      std::string(kPageHead) + std::string(drawing_script()) + std::string(kPageScript);
+  return page;
 }
 
 }  // namespace hil::view

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "harness/report.hpp"
+#include "view/drawing.hpp"
 
 namespace hil::harness {
 namespace {
@@ -355,6 +356,27 @@ TEST(ReportFolder, FolderNamesAreSafeAndUnique) {
   EXPECT_EQ(entries[4].folder, "rejected-mode-2");
 }
 
+// The page with every <script> element taken out: what is left is markup
+// whose text must be escaped.
+std::string without_scripts(std::string page) {
+  for (auto open = page.find("<script"); open != std::string::npos; open = page.find("<script")) {
+    const auto close = page.find("</script>", open);
+    if (close == std::string::npos) break;
+    page.erase(open, close + 9 - open);
+  }
+  return page;
+}
+
+// The data the playback script reads from a run page.
+nlohmann::json playback_data(const std::string& page) {
+  const std::string open = "<script id=\"pb-data\" type=\"application/json\">";
+  const auto from = page.find(open);
+  if (from == std::string::npos) return nullptr;
+  const auto to = page.find("</script>", from);
+  return nlohmann::json::parse(page.substr(from + open.size(), to - from - open.size()), nullptr,
+                               false);
+}
+
 TEST(ReportFolder, EachRunGetsItsPageTimelineAndTrajectory) {
   const auto dir = std::filesystem::temp_directory_path() / "hil_report_test_dir";
   std::filesystem::remove_all(dir);
@@ -375,14 +397,76 @@ TEST(ReportFolder, EachRunGetsItsPageTimelineAndTrajectory) {
   EXPECT_THAT(page, HasSubstr("function filterTimeline"));
   // Nothing from outside the folder: it must open from a CI artifact.
   EXPECT_THAT(page, Not(HasSubstr("http")));
-  expect_well_escaped(
-      page.substr(page.find("<body>"), page.find("<script>") - page.find("<body>")));
+  expect_well_escaped(without_scripts(page.substr(page.find("<body>"))));
 
   EXPECT_THAT(read(run / "trajectory.svg"), HasSubstr("<svg"));
   const std::string ndjson = read(dir / "drive-forward" / "timeline.ndjson");
   EXPECT_EQ(ndjson, passing().timeline.to_ndjson());
   EXPECT_THAT(read(dir / "drive-forward" / "index.html"), HasSubstr("data-source=\"wire\""));
   std::filesystem::remove_all(dir);
+}
+
+TEST(ReportPlayback, RunPagesDrawWithTheLiveViewsScriptAndCarryTheRun) {
+  auto o = passing();
+  o.arena = sim::default_warehouse_arena();
+  sim::Trajectory t;
+  t.vehicle = "logi0";
+  t.length_m = 0.3;
+  t.width_m = 0.25;
+  for (int i = 0; i <= 100; ++i)
+    t.samples.push_back({milliseconds(i * 10), sim::Pose{1.0 + 0.001 * i, 0.5, 0.0}});
+  t.marks.push_back({milliseconds(600), {1.06, 0.5}, sim::MarkKind::station, "station 001"});
+  o.trajectories = {t};
+  o.timeline.add(frame(130, "to_car", "sent", "LOGI:MV:STOP:A1#"));
+  o.timeline.add(frame(140, "to_client", "delivered", "</script><b>", false));
+  o.timeline.add(milliseconds(150), Source::fault, "corrupt",
+                 {{"dir", "to_client"}, {"rule", "bad-cs"}, {"detail", "checksum"}});
+  o.timeline.add(milliseconds(160), Source::client, "notice", {{"text", "parse error"}});
+
+  const std::string page = run_page_html(entry(o));
+  // The same drawing as `hil mock --view`, inline: the page opens offline.
+  EXPECT_THAT(page, HasSubstr(std::string(view::drawing_script())));
+  EXPECT_THAT(page, HasSubstr("id=\"pb-slider\""));
+  // A frame's text cannot end the data's script element early.
+  EXPECT_THAT(page, Not(HasSubstr("</script><b>")));
+
+  const auto data = playback_data(page);
+  ASSERT_TRUE(data.is_object()) << "the playback data is not JSON";
+  EXPECT_DOUBLE_EQ(data["run_ms"].get<double>(), 12345.0);
+  EXPECT_EQ(data["arena"]["stations"].size(), o.arena.tags.size());
+  ASSERT_EQ(data["cars"].size(), 1U);
+  const auto& car = data["cars"][0];
+  EXPECT_EQ(car["name"], "logi0");
+  ASSERT_EQ(car["samples"].size(), 101U);
+  EXPECT_EQ(car["samples"][50], nlohmann::json({500.0, 1.05, 0.5, 0.0}));
+  EXPECT_EQ(car["marks"][0][3], "station");
+  // Frames as the receiver got them (after faults), not as they were sent.
+  ASSERT_EQ(data["frames"].size(), 2U);
+  EXPECT_EQ(data["frames"][0],
+            nlohmann::json({125.0, "to_car", "MV:STOP", "LOGI:SP:050:D7#", true}));
+  EXPECT_EQ(data["frames"][1][3], "</script><b>");
+  EXPECT_EQ(data["frames"][1][4], false);
+  ASSERT_EQ(data["faults"].size(), 1U);
+  EXPECT_EQ(data["faults"][0],
+            nlohmann::json({150.0, "to_client", "corrupt", "bad-cs", "checksum"}));
+  ASSERT_EQ(data["events"].size(), 1U);
+  EXPECT_EQ(data["events"][0][1], "client");
+}
+
+TEST(ReportPlayback, LongRunsAreThinnedButKeepTheirLastPose) {
+  auto o = passing();
+  sim::Trajectory t;
+  t.vehicle = "car";
+  for (int i = 0; i < 50001; ++i)
+    t.samples.push_back({milliseconds(i * 10), sim::Pose{0.00001 * i, 1.0, 90.0}});
+  o.trajectories = {t};
+  const auto data = playback_data(run_page_html(entry(o)));
+  ASSERT_TRUE(data.is_object());
+  const auto& samples = data["cars"][0]["samples"];
+  EXPECT_LE(samples.size(), 12001U);
+  EXPECT_GE(samples.size(), 10000U);
+  EXPECT_DOUBLE_EQ(samples.back()[0].get<double>(), 500000.0);
+  EXPECT_DOUBLE_EQ(samples.back()[1].get<double>(), 0.5);
 }
 
 TEST(ReportFolder, SaysWhichPathCannotBeWritten) {
