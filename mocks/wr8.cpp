@@ -73,11 +73,22 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
+std::string seconds_text(Duration d) {
+  return fixed(sim::to_seconds(d), 3) + " s";
+}
+
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("Wr8Config: " + what);
 }
 
 }  // namespace
+
+Duration wrong_auth_delay(const Wr8Config& config, std::uint64_t failures_in_a_row) {
+  Duration delay = config.wrong_auth_close_delay;
+  for (std::uint64_t n = 1; n < failures_in_a_row && delay < config.wrong_auth_max_delay; ++n)
+    delay *= 2;
+  return std::min(delay, config.wrong_auth_max_delay);
+}
 
 std::string_view to_string(Wr8Session session) {
   switch (session) {
@@ -100,6 +111,8 @@ Wr8Firmware::Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config con
   require(config_.control_period > Duration::zero(), "control_period must be positive");
   require(config_.wrong_auth_close_delay >= Duration::zero(),
           "wrong_auth_close_delay must not be negative");
+  require(config_.wrong_auth_max_delay >= config_.wrong_auth_close_delay,
+          "wrong_auth_max_delay must not be below wrong_auth_close_delay");
   require(config_.stall_timeout > Duration::zero(), "stall_timeout must be positive");
   require(config_.blink_duration >= Duration::zero(), "blink_duration must not be negative");
   require(config_.drive_max_speed_mps > 0, "drive_max_speed_mps must be positive");
@@ -176,6 +189,7 @@ std::string Wr8Firmware::summary() const {
   std::string s(wr8::to_string(state_code()));
   if (state_.session != Wr8Session::authenticated)
     s += " " + std::string(to_string(state_.session));
+  if (state_.auth_failures > 0) s += " AUTH FAILED " + std::to_string(state_.auth_failures);
   s += " ODO " + std::to_string(std::lround(vehicle_.odometry().distance_m * 100)) + "cm";
   s += " SP " + fixed(chassis_.speed_mps(), 2);
   s += " ANG " + fixed(chassis_.steering_rad() * kDegPerRad, 1);
@@ -193,6 +207,7 @@ std::string Wr8Firmware::summary() const {
 
 void Wr8Firmware::on_connect(Time /*now*/) {
   state_.session = Wr8Session::unauthenticated;
+  state_.dropped_this_connection = 0;
   state_.close_at.reset();
   state_.next_data.reset();
   decoder_ = wr8::Decoder(decoder_options(config_));
@@ -205,6 +220,12 @@ void Wr8Firmware::on_disconnect(Time /*now*/) {
   for (std::size_t n = 0; n < items_.size(); ++n)
     count_bad_frame();
   decoder_ = wr8::Decoder(decoder_options(config_));
+  if (state_.dropped_this_connection > 0) {
+    say("wr8: " + std::to_string(state_.dropped_this_connection) +
+        " packet(s) from this client dropped unanswered before a login (" +
+        std::to_string(state_.dropped_unauthenticated) + " in all)");
+  }
+  state_.dropped_this_connection = 0;
   // Nobody is left to watch the car: a safe firmware stops it.
   if (config_.stop_on_disconnect) {
     abort_tasks(false);
@@ -244,6 +265,7 @@ void Wr8Firmware::handle_item(Time now, const wr8::Item& item) {
   if (state_.session == Wr8Session::refused ||
       (state_.session == Wr8Session::unauthenticated && !is_auth)) {
     ++state_.dropped_unauthenticated;
+    ++state_.dropped_this_connection;
     return;
   }
   const std::string kind(wr8::to_string(wr8::code_of(message)));
@@ -315,15 +337,33 @@ void Wr8Firmware::handle_auth(Time now, const wr8::Auth& auth) {
   if (state_.session != Wr8Session::authenticated) {
     state_.session = Wr8Session::authenticated;
     state_.next_data = grid_after(now, config_.data_period);
+    if (state_.auth_failures_in_a_row > 0) {
+      say("wr8: login accepted after " + std::to_string(state_.auth_failures_in_a_row) +
+          " failed login(s) in a row");
+    }
+    state_.auth_failures_in_a_row = 0;
   }
   answer(wr8::AuthReply{config_.device_code, config_.device_id, state_code()});
 }
 
 void Wr8Firmware::refuse(Time now) {
   ++state_.auth_failures;
+  ++state_.auth_failures_in_a_row;
   state_.session = Wr8Session::refused;
   state_.next_data.reset();
-  if (!state_.close_at) state_.close_at = now + config_.wrong_auth_close_delay;
+  if (state_.close_at) return;  // a refusal already runs its delay
+  const Duration delay = wrong_auth_delay(config_, state_.auth_failures_in_a_row);
+  state_.close_at = now + delay;
+  // The string tried is never written anywhere a person reads: it may be
+  // the real one with a typo.
+  say("wr8: login refused (AUTH **********): failed login " +
+      std::to_string(state_.auth_failures_in_a_row) + " in a row, " +
+      std::to_string(state_.auth_failures) + " in all; closing the connection in " +
+      seconds_text(delay) + ", nothing answered until then");
+}
+
+void Wr8Firmware::say(const std::string& line) const {
+  if (config_.log) config_.log(line);
 }
 
 void Wr8Firmware::handle_task(Time now, const wr8::Task& task) {

@@ -4,6 +4,7 @@
 // (docs/mocks/wr8.md).
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -28,8 +29,11 @@ struct Wr8Config {
   std::uint8_t device_id = 1;    ///< in AUTH-REPLY
 
   /// After a wrong authentication string the connection is closed this much
-  /// later; nothing is answered in between.
+  /// later; nothing is answered in between. Each further failure in a row
+  /// (across connections, until a right login) doubles it, up to
+  /// wrong_auth_max_delay: guessing the string gets slower and slower.
   Duration wrong_auth_close_delay{link::seconds(1)};
+  Duration wrong_auth_max_delay{link::seconds(30)};
   /// DATA period once authenticated, on a grid of whole periods since the
   /// vehicle started (100 ms: 10 Hz).
   Duration data_period{link::milliseconds(100)};
@@ -71,6 +75,11 @@ struct Wr8Config {
   /// true: a client that goes away stops the car and ends every task (no
   /// answer). false: tasks run on to their end unwatched.
   bool stop_on_disconnect = true;
+
+  /// One line per authentication event for a person (a failed login with
+  /// its count, packets dropped before login); never holds the string that
+  /// was tried or the real one. May be empty.
+  std::function<void(const std::string&)> log;
 };
 
 /// Where the authentication of the current connection stands.
@@ -127,6 +136,10 @@ struct Wr8State {
 
   std::uint64_t dropped_unauthenticated = 0;  ///< packets dropped before AUTH or while refused
   std::uint64_t auth_failures = 0;
+  /// Failed logins since the last right one (sets the next close delay).
+  std::uint64_t auth_failures_in_a_row = 0;
+  /// Packets dropped before AUTH or while refused on this connection.
+  std::uint64_t dropped_this_connection = 0;
   std::uint64_t data_sent = 0;
   std::uint64_t tasks_completed = 0;
   std::uint64_t tasks_failed = 0;  ///< RESPONSE error for a task, whatever the reason
@@ -181,6 +194,7 @@ class Wr8Firmware final : public Firmware {
   void stop_motion();
   void abort_tasks(bool answer);
   bool control_needed() const;
+  void say(const std::string& line) const;
 
   /// Sends to an authenticated client only (nothing is answered otherwise).
   void answer(const Message& message);
@@ -194,5 +208,10 @@ class Wr8Firmware final : public Firmware {
   std::vector<protocol::wr8::Item> items_;
   Wr8State state_;
 };
+
+/// The close delay after the `failures_in_a_row`-th failed login in a row
+/// (1: the first): wrong_auth_close_delay doubled per earlier failure,
+/// capped at wrong_auth_max_delay.
+Duration wrong_auth_delay(const Wr8Config& config, std::uint64_t failures_in_a_row);
 
 }  // namespace hil::mocks

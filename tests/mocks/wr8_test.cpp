@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -1085,6 +1086,112 @@ TEST(Wr8Summary, ShowsStateReadingsAndRunningTasks) {
   EXPECT_NE(gui.fw().summary().find("RUN ODO"), std::string::npos) << gui.fw().summary();
   EXPECT_NE(gui.fw().summary().find("DRIVE"), std::string::npos);
   EXPECT_NE(gui.fw().summary().find("BLINK"), std::string::npos);
+}
+
+// ---------------------------------------------------------------- login security
+
+std::array<std::uint8_t, wr8::kAuthTextBytes> text_of(std::string_view s) {
+  std::array<std::uint8_t, wr8::kAuthTextBytes> text{};
+  std::copy(s.begin(), s.end(), text.begin());
+  return text;
+}
+
+TEST(Wr8AuthSecurity, FailedLoginsInARowDoubleTheCloseDelayAcrossConnectionsUpToTheCap) {
+  Wr8Config config;
+  config.wrong_auth_max_delay = seconds(3);
+  Gui gui(config);
+  const Bytes wrong = wr8::encode(wr8::Auth{text_of("NOT-IT-000")}, config.profile);
+  const Bytes right = wr8::encode(wr8::Auth{config.profile.auth_text}, config.profile);
+
+  // Failure 1 at 1 ms: closed exactly 1 s later.
+  gui.send_bytes(wrong);
+  gui.run_until(at_ms(1000));
+  EXPECT_FALSE(gui.client().closed.has_value());
+  gui.run_until(at_ms(1001));
+  EXPECT_TRUE(gui.client().closed.has_value());
+
+  // Each later failure in a row waits twice as long, also on a new
+  // connection (connect() takes 1 ms): 2 s, then 4 s capped at 3 s.
+  const std::int64_t expected_delay_ms[] = {2000, 3000, 3000};
+  for (const std::int64_t delay_ms : expected_delay_ms) {
+    auto client = gui.car().connect();
+    const Time sent = gui.car().now();
+    client->write(protocol::ByteView(wrong));
+    // Everything else on this connection meanwhile is ignored, the right
+    // string included: no answer, no DATA, no motion.
+    client->write(protocol::ByteView(right));
+    client->write(wr8::encode(wr8::Task{5, wr8::TaskCode::drive, {wr8::Word::from_i32(50)}}));
+    gui.car().run_until(sent + milliseconds(delay_ms) - milliseconds(1));
+    EXPECT_FALSE(client->closed.has_value()) << "delay " << delay_ms << " ms";
+    gui.car().run_until(sent + milliseconds(delay_ms));
+    EXPECT_TRUE(client->closed.has_value()) << "delay " << delay_ms << " ms";
+    EXPECT_TRUE(client->take().empty());
+  }
+  EXPECT_EQ(gui.state().auth_failures, 4u);
+  EXPECT_EQ(gui.state().auth_failures_in_a_row, 4u);
+  EXPECT_EQ(gui.state().dropped_unauthenticated, 6u);
+  EXPECT_EQ(gui.vehicle().odometry().distance_m, 0.0);
+
+  // A right login resets the run: the next failure waits 1 s again.
+  auto client = gui.car().connect();
+  client->write(protocol::ByteView(right));
+  gui.car().run_for(milliseconds(0));
+  EXPECT_EQ(client->take(), (Bytes{0x02, 0x08, 0x01, 0x02}));
+  EXPECT_EQ(gui.state().auth_failures_in_a_row, 0u);
+  const Time sent = gui.car().now();
+  client->write(protocol::ByteView(wrong));
+  gui.car().run_until(sent + milliseconds(999));
+  EXPECT_FALSE(client->closed.has_value());
+  gui.car().run_until(sent + seconds(1));
+  EXPECT_TRUE(client->closed.has_value());
+  EXPECT_EQ(gui.state().auth_failures, 5u);
+}
+
+TEST(Wr8AuthSecurity, TheDelayDoublesFromTheConfiguredOneAndTheCapMustNotBeBelowIt) {
+  Wr8Config config;
+  config.wrong_auth_close_delay = milliseconds(250);
+  config.wrong_auth_max_delay = seconds(30);
+  EXPECT_EQ(wrong_auth_delay(config, 1), milliseconds(250));
+  EXPECT_EQ(wrong_auth_delay(config, 2), milliseconds(500));
+  EXPECT_EQ(wrong_auth_delay(config, 7), milliseconds(16000));
+  EXPECT_EQ(wrong_auth_delay(config, 8), seconds(30));        // 32 s, capped
+  EXPECT_EQ(wrong_auth_delay(config, 1000000), seconds(30));  // no overflow
+  config.wrong_auth_max_delay = milliseconds(100);
+  EXPECT_THROW(Car(sim::wr8_vehicle(),
+                   [config](sim::World& w, sim::Vehicle& v) {
+                     return std::make_unique<Wr8Firmware>(w, v, config);
+                   }),
+               std::invalid_argument);
+}
+
+TEST(Wr8AuthSecurity, LogLinesCountFailedLoginsAndDroppedPacketsButNeverHoldAString) {
+  auto lines = std::make_shared<std::vector<std::string>>();
+  Wr8Config config;
+  config.log = [lines](const std::string& line) { lines->push_back(line); };
+  Gui gui(config);
+  gui.task(1, wr8::TaskCode::check);           // before any login: dropped
+  gui.send(wr8::Auth{text_of("HIL-WR8-02")});  // one character off the real one
+  gui.run_until(at_ms(1001));
+  ASSERT_TRUE(gui.client().closed.has_value());
+  gui.car().run_for(milliseconds(1));
+
+  auto client = gui.car().connect();
+  client->write(wr8::encode(wr8::Auth{config.profile.auth_text}, config.profile));
+  gui.car().run_for(milliseconds(0));
+
+  std::string all;
+  for (const auto& l : *lines)
+    all += l + "\n";
+  EXPECT_NE(all.find("login refused (AUTH **********): failed login 1 in a row, 1 in all; "
+                     "closing the connection in 1.000 s"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("1 packet(s) from this client dropped unanswered before a login"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("login accepted after 1 failed login(s) in a row"), std::string::npos) << all;
+  EXPECT_EQ(all.find("HIL-WR8-0"), std::string::npos) << all;  // neither the tried nor the real
+  EXPECT_NE(gui.fw().summary().find("AUTH FAILED 1"), std::string::npos);
 }
 
 }  // namespace
