@@ -46,9 +46,15 @@ LineReading line_reading_from(std::array<bool, 4> on) {
 }
 
 LineReading read_line_tracker(const LineTrackerDef& def, const Pose& pose, const Arena& arena) {
+  // The four points share one rotation: sin and cos once, not four times
+  // (the same arithmetic as Pose::to_arena, so the same points).
+  const double c = std::cos(pose.heading_rad);
+  const double s = std::sin(pose.heading_rad);
   std::array<bool, 4> on{};
-  for (std::size_t i = 0; i < 4; ++i)
-    on[i] = arena.on_tape(pose.to_arena({def.ahead_m, def.lateral_m[i]}));
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Vec2 v{def.ahead_m, def.lateral_m[i]};
+    on[i] = arena.on_tape(pose.position() + Vec2{c * v.x_m - s * v.y_m, s * v.x_m + c * v.y_m});
+  }
   return line_reading_from(on);
 }
 
