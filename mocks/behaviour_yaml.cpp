@@ -192,8 +192,12 @@ std::vector<Behaviour> parse_behaviours(const YAML::Node& node, const std::strin
              "unknown key '" + name + "' (a behaviours file takes: behaviours, description)");
       }
     }
-    list = node["behaviours"];
-    if (!list) fail(source_name, node.Mark(), "'behaviours' is missing");
+    // A const lookup, and reset() rather than operator=: assigning to a
+    // YAML::Node that shares `node` rewrites the caller's document (and a
+    // missing key then leaves `node` invalid, so Mark() throws).
+    const YAML::Node found = static_cast<const YAML::Node&>(node)["behaviours"];
+    if (!found) fail(source_name, node.Mark(), "'behaviours' is missing");
+    list.reset(found);
   }
   if (list.IsNull()) return {};
   if (!list.IsSequence()) fail(source_name, list.Mark(), "'behaviours' must be a list");

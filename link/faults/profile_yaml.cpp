@@ -450,9 +450,13 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
                  "' (a fault profile has 'rules' and an optional 'description')");
       }
     }
-    rules = node["rules"];
-    if (!rules) fail(source_name, node.Mark(), "a fault profile needs 'rules: [...]'");
-    if (rules.IsNull()) return {};
+    // A const lookup, and reset() rather than operator=: assigning to a
+    // YAML::Node that shares `node` rewrites the caller's document (and a
+    // missing key then leaves `node` invalid, so Mark() throws).
+    const YAML::Node found = static_cast<const YAML::Node&>(node)["rules"];
+    if (!found) fail(source_name, node.Mark(), "a fault profile needs 'rules: [...]'");
+    if (found.IsNull()) return {};
+    rules.reset(found);
   }
   if (!rules.IsSequence()) fail(source_name, rules.Mark(), "'rules' must be a list of rules");
   FaultProfile profile;

@@ -1,6 +1,7 @@
 // Scripted behaviours from YAML: every action, and errors that say where.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 
@@ -66,6 +67,18 @@ void expect_error(const std::string& yaml, const std::string& message) {
   } catch (const BehaviourError& e) {
     EXPECT_EQ(std::string(e.what()), message);
   }
+}
+
+// Found by the behaviour fuzz target: a map without 'behaviours' escaped as
+// YAML::InvalidNode instead of a BehaviourError, and loading rewrote the node
+// it was given.
+TEST(BehaviourYaml, AMapWithoutBehavioursIsRefusedAndTheNodeIsLeftAlone) {
+  expect_error("description: only words\n", "b.yaml:1:1: 'behaviours' is missing");
+  YAML::Node scenario = YAML::Load("behaviours:\n  behaviours:\n    - do: fault\n");
+  YAML::Node node = scenario["behaviours"];
+  ASSERT_EQ(parse_behaviours(node, "scenario.yaml").size(), 1u);
+  EXPECT_TRUE(node.IsMap());
+  EXPECT_TRUE(scenario["behaviours"]["behaviours"].IsSequence());
 }
 
 TEST(BehaviourYaml, ErrorsNameTheFileLineColumnAndWhatWasExpected) {

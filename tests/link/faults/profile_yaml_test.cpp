@@ -131,6 +131,19 @@ TEST(FaultProfileYaml, EmbeddedInAScenarioNode) {
   EXPECT_EQ(p.rules[0].trigger.first, 1U);
 }
 
+// Found by the fault_profile fuzz target: a map without 'rules' escaped as
+// YAML::InvalidNode instead of a FaultProfileError, and loading rewrote the
+// node it was given.
+TEST(FaultProfileYaml, AMapWithoutRulesIsRefusedAndTheNodeIsLeftAlone) {
+  EXPECT_EQ(error_of("description: only words\n"),
+            "faults.yaml:1:1: a fault profile needs 'rules: [...]'");
+  YAML::Node scenario = YAML::Load("faults:\n  rules:\n    - kind: drop\n");
+  YAML::Node faults = scenario["faults"];
+  ASSERT_EQ(parse_fault_profile(faults, "scenario.yaml").rules.size(), 1U);
+  EXPECT_TRUE(faults.IsMap());
+  EXPECT_TRUE(scenario["faults"]["rules"].IsSequence());
+}
+
 TEST(FaultProfileYaml, ErrorsNameFileLineColumnAndWhatWasExpected) {
   EXPECT_EQ(error_of("rules:\n  - kind: drop\n  - kind: fragment\n    sizes: [5, 2]\n"),
             "faults.yaml:4:12: rule 2 (fragment): 'sizes' must be [min, max] with 1 <= min <= max, "

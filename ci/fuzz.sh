@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# The long fuzzing run: builds the libFuzzer targets (fuzz preset: clang,
+# ASan + UBSan) and runs each in turn, keeping its corpus between runs.
+#
+#   ci/fuzz.sh [options] [MINUTES_PER_TARGET] [TARGET...]
+#
+#   MINUTES_PER_TARGET  default 3; TARGET is a name from tests/fuzz/ without
+#                       "_fuzz" (logi, scenario, wr8_firmware, ...); default all.
+#   --seconds=N         run each target N seconds instead (the CI smoke run).
+#   --work=DIR          where corpora, logs and crash artifacts live
+#                       (default build-fuzz/fuzz-work; kept between runs).
+#   --merge             afterwards, add the inputs that reach new coverage to
+#                       the checked-in seeds in tests/fuzz/corpus/<target>/.
+#   --no-build          use the targets already in build-fuzz.
+#
+# Each target starts from tests/fuzz/corpus/<target>/ plus what earlier runs
+# found. A crash, leak, timeout or out-of-memory input is saved as
+# DIR/artifacts/<target>-<kind>-<sha1> and fails the run; replay one with
+# build-fuzz/tests/fuzz/<target>_fuzz DIR/artifacts/<file>. The last line is
+# "fuzz: N target(s) passed, M failed".
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+seconds=""
+minutes=3
+work=build-fuzz/fuzz-work
+merge=0
+build=1
+targets=()
+for arg in "$@"; do
+  case "$arg" in
+    --seconds=*) seconds="${arg#*=}" ;;
+    --work=*) work="${arg#*=}" ;;
+    --merge) merge=1 ;;
+    --no-build) build=0 ;;
+    -h | --help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -*) echo "ci/fuzz.sh: unknown option $arg" >&2; exit 2 ;;
+    *)
+      if [[ "$arg" =~ ^[0-9]+([.][0-9]+)?$ ]] && [ ${#targets[@]} -eq 0 ] && [ -z "${minutes_given:-}" ]; then
+        minutes="$arg"; minutes_given=1
+      else
+        targets+=("$arg")
+      fi ;;
+  esac
+done
+[ -n "$seconds" ] || seconds=$(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')
+
+if [ "$build" = 1 ]; then
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz
+fi
+
+if [ ${#targets[@]} -eq 0 ]; then
+  for fuzzer in build-fuzz/tests/fuzz/*_fuzz; do
+    [ -x "$fuzzer" ] && targets+=("$(basename "$fuzzer" _fuzz)")
+  done
+fi
+[ ${#targets[@]} -gt 0 ] || { echo "ci/fuzz.sh: no fuzz targets were built" >&2; exit 1; }
+
+mkdir -p "$work/corpus" "$work/logs" "$work/artifacts"
+summary="$work/summary.txt"
+printf '%-18s %12s %9s %8s %8s %8s  %s\n' target runs execs/s cov ft corpus result >"$summary"
+passed=0
+failed=0
+for name in "${targets[@]}"; do
+  fuzzer="build-fuzz/tests/fuzz/${name}_fuzz"
+  if [ ! -x "$fuzzer" ]; then
+    echo "ci/fuzz.sh: no target $name (looked for $fuzzer)" >&2
+    failed=$((failed + 1))
+    printf '%-18s %12s %9s %8s %8s %8s  %s\n' "$name" - - - - - "not built" >>"$summary"
+    continue
+  fi
+  corpus="$work/corpus/$name"
+  log="$work/logs/$name.log"
+  mkdir -p "$corpus"
+  # Seeds are copied in, so the source tree is only written with --merge.
+  if [ -d "tests/fuzz/corpus/$name" ]; then cp -n tests/fuzz/corpus/"$name"/* "$corpus"/ 2>/dev/null || true; fi
+  echo "-- $name: ${seconds}s"
+  result=ok
+  # -timeout: one input taking 10 s is a hang; -rss_limit_mb: a leak-like
+  # growth is a finding, not a machine brought to its knees.
+  if ! "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$work/artifacts/$name-" "$corpus" >"$log" 2>&1; then
+    result="FAILED"
+    artifact=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
+    [ -z "$artifact" ] || result="FAILED: $artifact"
+    failed=$((failed + 1))
+    echo "FAILED: $name (last lines of $log follow)"
+    tail -40 "$log"
+  else
+    passed=$((passed + 1))
+  fi
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
+  cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
+  ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
+  files=$(find "$corpus" -type f | wc -l)
+  printf '%-18s %12s %9s %8s %8s %8s  %s\n' "$name" "${runs:--}" "${speed:--}" "${cov:--}" \
+    "${ft:--}" "$files" "$result" >>"$summary"
+  if [ "$merge" = 1 ] && [ "$result" = ok ]; then
+    mkdir -p "tests/fuzz/corpus/$name"
+    # -merge=1 adds to the first folder only inputs that reach new features.
+    "$fuzzer" -merge=1 -timeout=10 "tests/fuzz/corpus/$name" "$corpus" >>"$log" 2>&1
+  fi
+done
+
+echo
+cat "$summary"
+echo "fuzz: $passed target(s) passed, $failed failed"
+[ "$failed" -eq 0 ]
