@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Runs the decoder, proxy, simulation, mock-car and random-session
-# benchmarks on a RelWithDebInfo build and rewrites their sections of
-# docs/performance.md with the results.
-# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [session]
+# Runs the decoder, proxy, simulation, mock-car, random-session and
+# whole-stack benchmarks and times the scenario suite on a RelWithDebInfo
+# build, and rewrites their sections of docs/performance.md with the results.
+# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [session] [stack] [suite]
 #   With no section named, runs them all. Each section is rewritten only when
 #   its benchmark ran to the end, so one section can be refreshed alone
 #   (bench/run.sh mock). Run on an otherwise idle machine.
@@ -12,12 +12,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 sections=("$@")
-[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock session)
+[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock session stack suite)
 for section in "${sections[@]}"; do
   case $section in
-    decoder | proxy | sim | mock | session) ;;
+    decoder | proxy | sim | mock | session | stack | suite) ;;
     *)
-      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, session)" >&2
+      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, session, stack, suite)" >&2
       exit 2
       ;;
   esac
@@ -72,7 +72,8 @@ run_proxy() {
   "$build"/bench/proxy_bench --frames 20000 --mib 128 --protocol logi --markdown "$work/proxy.md"
   {
     echo
-    echo "Measured $(today) with \`bench/run.sh\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way):"
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh proxy\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way, wall time):"
     echo
     cat "$work/proxy.md"
   } >"$work/proxy.section"
@@ -124,7 +125,47 @@ run_session() {
   splice session-bench "$work/session.section"
 }
 
+run_stack() {
+  cmake --build "$build" --target scenario_bench
+  "$build"/bench/scenario_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --benchmark_enable_random_interleaving=true --hil_markdown="$work/stack.md"
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh stack\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
+    echo
+    sed "s|$PWD/||" "$work/stack.md"
+    echo
+  } >"$work/stack.section"
+  splice stack-bench "$work/stack.section"
+}
+
+run_suite() {
+  cmake --build "$build" --target hil
+  # A failing scenario still leaves a suite time; the table says how many
+  # passed, and the failure is printed above it.
+  bench/suite_time.sh --hil "$build"/apps/hil/hil --jobs 2 --markdown "$work/suite.md" ||
+    echo "bench/run.sh: a scenario failed; the suite section says how many passed" >&2
+  [ -s "$work/suite.md" ] || exit 1
+  {
+    echo
+    echo "Measured $(today) on $(machine),"
+    echo "with \`bench/run.sh suite\` (\`hil run -j 2\`, wall time of one run of the library):"
+    echo
+    cat "$work/suite.md"
+    echo
+  } >"$work/suite.section"
+  splice suite-bench "$work/suite.section"
+}
+
+# Load average when the figures were taken: CPU times and in-run ratios are
+# what stays fair on a shared machine, but the page says how busy it was.
+load_note() {
+  echo "Load average at the end of the run: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) core(s)."
+}
+
 for section in "${sections[@]}"; do
   "run_$section"
 done
+load_note
 echo "updated $doc"
