@@ -373,6 +373,7 @@ bool ReferenceRun::make_client(const link::Endpoint& endpoint) {
   }
   o.environment = values;
   if (exec != nullptr) o.startup_timeout = exec->startup_timeout;
+  if (options_.on_client_command) options_.on_client_command(o.command);
   client_ = make_exec_session(context_, std::move(o), timeline_);
   return true;
 }

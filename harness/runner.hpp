@@ -5,6 +5,7 @@
 // records the timeline, and checks the expectations.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -29,6 +30,10 @@ struct RunOptions {
   /// harness/expect.hpp); nullopt: 0 in virtual time, kRealTimeSlack in
   /// real time.
   std::optional<Duration> time_slack;
+  /// Called with the exact shell command line of an external client, its
+  /// placeholders filled in, just before it is started (hil run prints it:
+  /// a scenario never starts a program a person cannot see).
+  std::function<void(const std::string&)> on_client_command;
   /// Period of the simulation samples in the timeline.
   Duration sample_period{std::chrono::milliseconds(100)};
 };

@@ -199,8 +199,11 @@ const Keys kQuantifierKeys = {"never", "count", "at_least", "at_most", "times", 
 
 class Loader {
  public:
-  Loader(std::string file, const std::map<std::string, std::string>& overrides)
-      : file_(std::move(file)), overrides_(overrides) {
+  Loader(std::string file, const std::map<std::string, std::string>& overrides,
+         const LoadOptions& options)
+      : file_(std::move(file)),
+        overrides_(overrides),
+        allow_outside_paths_(options.allow_outside_paths) {
     dir_ = fs::path(file_).parent_path();
   }
 
@@ -411,16 +414,39 @@ class Loader {
     return value * scale;
   }
 
-  /// A file named relative to the scenario's folder; it must exist.
+  /// A file named relative to the scenario's folder; it must exist and,
+  /// unless allowed, stay inside the scenario's root.
   std::string existing_file(const YAML::Node& n, const std::string& what) const {
     const std::string name = scalar(n, "the " + what);
     if (name.empty()) fail(n, "the " + what + " name must not be empty");
-    const fs::path path = fs::path(name).is_absolute() ? fs::path(name) : dir_ / name;
+    const bool absolute = fs::path(name).is_absolute();
+    const fs::path path = absolute ? fs::path(name) : dir_ / name;
+    const auto outside = [&](const std::string& why) {
+      fail(n, what + " '" + name + "' " + why + ": a scenario may only name files inside " +
+                  scenario_root(file_) +
+                  " (its folder's parent); pass --allow-outside-paths to hil run to allow it");
+    };
+    if (!allow_outside_paths_ && absolute) outside("is an absolute path");
+    // Checked by name first, so a ../ escape is refused whether or not the
+    // file exists (no probing of the disk from a scenario).
+    const fs::path root(scenario_root(file_));
+    if (!allow_outside_paths_ && !inside(fs::absolute(path).lexically_normal(), root))
+      outside("is outside the scenario's root");
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) {
       fail(n, what + " '" + name + "' does not exist (looked for " + path.string() + ")");
     }
+    // A symlink inside the root may point out of it: compare where it
+    // really leads with where the root really is.
+    const fs::path target = fs::weakly_canonical(path, ec);
+    if (!allow_outside_paths_ && !inside(target, fs::weakly_canonical(root, ec)))
+      outside("leads outside the scenario's root (to " + target.string() + ")");
     return path.lexically_normal().string();
+  }
+
+  static bool inside(const fs::path& resolved, const fs::path& root) {
+    const fs::path relative = resolved.lexically_relative(root);
+    return !relative.empty() && *relative.begin() != ".." && !relative.is_absolute();
   }
 
   // ---------------------------------------------------------- variables
@@ -1724,6 +1750,7 @@ class Loader {
   std::string file_;
   fs::path dir_;
   std::map<std::string, std::string> overrides_;
+  bool allow_outside_paths_ = false;
   std::map<std::string, std::string> variables_;
   std::set<std::pair<int, int>> substituted_;
   Keys step_texts_;
@@ -1732,19 +1759,28 @@ class Loader {
 
 }  // namespace
 
-Scenario parse_scenario_text(std::string_view yaml, const std::string& file_name,
-                             const std::map<std::string, std::string>& overrides) {
-  return Loader(file_name, overrides).load(yaml);
+std::string scenario_root(const std::string& scenario_file) {
+  return fs::absolute(fs::path(scenario_file))
+      .lexically_normal()
+      .parent_path()
+      .parent_path()
+      .string();
 }
 
-Scenario load_scenario(const std::string& path,
-                       const std::map<std::string, std::string>& overrides) {
+Scenario parse_scenario_text(std::string_view yaml, const std::string& file_name,
+                             const std::map<std::string, std::string>& overrides,
+                             const LoadOptions& options) {
+  return Loader(file_name, overrides, options).load(yaml);
+}
+
+Scenario load_scenario(const std::string& path, const std::map<std::string, std::string>& overrides,
+                       const LoadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ScenarioError(path, 0, 0, "cannot read the scenario file");
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw ScenarioError(path, 0, 0, "cannot read the scenario file");
-  return parse_scenario_text(text.str(), path, overrides);
+  return parse_scenario_text(text.str(), path, overrides, options);
 }
 
 }  // namespace hil::harness

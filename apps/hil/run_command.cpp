@@ -17,6 +17,8 @@
 #include <thread>
 
 #include "apps/hil/cli_common.hpp"
+#include "harness/atomic_file.hpp"
+#include "harness/exec_client.hpp"
 #include "harness/report.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
@@ -44,6 +46,7 @@ struct RunArgs {
   int jobs = 0;
   bool list = false;
   bool verbose = false;
+  bool allow_outside_paths = false;
 };
 
 // A scenario file is a YAML map with top-level `car:` and `steps:`. Read as
@@ -84,6 +87,7 @@ std::string repro_command(const RunArgs& args, const std::string& file,
   for (const auto& s : args.sets)
     out += " --set " + shell_quote(s);
   if (args.client_exec) out += " --client-exec " + shell_quote(*args.client_exec);
+  if (args.allow_outside_paths) out += " --allow-outside-paths";
   if (!args.slack.empty()) out += " --slack " + shell_quote(args.slack);
   return out;
 }
@@ -145,6 +149,14 @@ std::optional<std::vector<std::string>> find_files(const RunArgs& args) {
   return std::vector<std::string>(files.begin(), files.end());
 }
 
+// The command an external client of this scenario runs, as written (the
+// placeholders are filled in per run); nullopt for a reference client.
+std::optional<std::string> client_command(const RunArgs& args, const Scenario& scenario) {
+  if (args.client_exec) return *args.client_exec;
+  if (const auto* exec = std::get_if<harness::ExecClient>(&scenario.client)) return exec->command;
+  return std::nullopt;
+}
+
 ScenarioOutcome load_failure(const Planned& p, const RunArgs& args) {
   ScenarioOutcome o;
   o.file = p.file;
@@ -176,7 +188,8 @@ int run_scenarios(const RunArgs& args) {
   for (const auto& file : *files) {
     Planned p{file, std::nullopt, {}};
     try {
-      p.scenario = harness::load_scenario(file, overrides);
+      p.scenario =
+          harness::load_scenario(file, overrides, harness::LoadOptions{args.allow_outside_paths});
     } catch (const harness::ScenarioError& e) {
       p.error = e.what();
     } catch (const std::exception& e) {
@@ -203,6 +216,9 @@ int run_scenarios(const RunArgs& args) {
         std::cout << p.file << "  " << p.scenario->name;
         if (!p.scenario->tags.empty()) std::cout << "  [" << joined(p.scenario->tags) << ']';
         std::cout << '\n';
+        // Every program a run would start, before anything is started.
+        if (const auto command = client_command(args, *p.scenario))
+          std::cout << "  client exec: " << *command << '\n';
       } else {
         all_load = false;
         std::cout << p.file << "  does not load: " << p.error << '\n';
@@ -246,6 +262,7 @@ int run_scenarios(const RunArgs& args) {
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   std::mutex progress;
+  std::set<std::string> shown_commands;  // files whose client command was printed
   const auto worker = [&] {
     for (std::size_t k = next++; k < tasks.size(); k = next++) {
       const auto& p = plan[tasks[k].plan_index];
@@ -254,6 +271,14 @@ int run_scenarios(const RunArgs& args) {
         harness::RunOptions options;
         options.seed = tasks[k].seed;
         options.client_exec = args.client_exec;
+        // A scenario may start one program, its declared client: print the
+        // exact command line before it starts (once per scenario file).
+        options.on_client_command = [&, file = p.file](const std::string& command) {
+          const std::lock_guard lock(progress);
+          if (!shown_commands.insert(file).second) return;
+          std::cerr << "hil run: " << file << ": client exec: /bin/sh -c "
+                    << harness::shell_quote(command) << '\n';
+        };
         if (!args.slack.empty()) options.time_slack = link::parse_duration(args.slack);
         if (!args.report_dir.empty()) {
           const fs::path folder = fs::path(args.report_dir) / entry.folder;
@@ -304,11 +329,12 @@ int run_scenarios(const RunArgs& args) {
   for (const auto& s : harness::summarize(entries))
     if (s.verdict != harness::Verdict::pass) status = 1;
   if (!args.junit.empty()) {
-    std::ofstream out(args.junit, std::ios::binary | std::ios::trunc);
-    if (out) out << harness::junit_xml(entries);
-    out.close();
-    if (!out) {
-      std::cerr << "hil run: cannot write " << args.junit << '\n';
+    // Atomically: a CI job that reads the file never sees half of it, and a
+    // run stopped while writing leaves the previous file whole.
+    try {
+      harness::write_file_atomically(args.junit, harness::junit_xml(entries));
+    } catch (const std::exception& e) {
+      std::cerr << "hil run: " << e.what() << '\n';
       status = 1;
     }
   }
@@ -372,7 +398,12 @@ void register_run(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("-j,--jobs", args->jobs, "Runs at a time (default: the number of cores)")
       ->type_name("N")
       ->check(CLI::Range(1, 1024));
-  cmd->add_flag("--list", args->list, "Print the scenarios that would run, with their tags");
+  cmd->add_flag("--list", args->list,
+                "Print the scenarios that would run, with their tags and the command line of "
+                "any external client");
+  cmd->add_flag("--allow-outside-paths", args->allow_outside_paths,
+                "Let scenarios name files outside their root (the parent of the scenario's "
+                "folder): absolute paths, ../ past it, symlinks out of it");
   cmd->add_flag("-v,--verbose", args->verbose,
                 "Show each run as it finishes and the YAML files that are not scenarios");
   cmd->footer(
