@@ -1,0 +1,171 @@
+// hil's security defaults as a user meets them: every listener binds
+// 127.0.0.1 unless told otherwise and says so when it does not; hil run
+// shows every program a scenario starts, keeps scenario paths inside the
+// scenario's library and writes its JUnit file whole.
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <string>
+
+#include "tests/apps/hil_cli_support.hpp"
+
+namespace hil::test {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------- listeners
+
+TEST(DefaultBind, MockTcpCarsListenOnLoopbackOnlyAndSayNothingAboutTheNetwork) {
+  for (const std::string car : {"logi", "wr8"}) {
+    HilProcess mock({"mock", car, "--port", "0", "--no-status"});
+    ASSERT_TRUE(mock.started());
+    const auto line = mock.wait_for_line("connect to tcp://");
+    ASSERT_TRUE(line) << car << ": " << mock.output();
+    EXPECT_THAT(*line, HasSubstr("connect to tcp://127.0.0.1:")) << car;
+    ASSERT_TRUE(mock.wait_for_line("Ctrl-C stops")) << mock.output();
+    EXPECT_THAT(mock.output(), Not(HasSubstr("reachable from other machines"))) << car;
+    mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+  }
+}
+
+TEST(DefaultBind, AMockBoundToEveryInterfaceWarnsNamingTheAddress) {
+  HilProcess mock({"mock", "logi", "--port", "0", "--bind", "0.0.0.0", "--no-status"});
+  ASSERT_TRUE(mock.started());
+  const auto line = mock.wait_for_line("reachable from other machines");
+  ASSERT_TRUE(line) << mock.output();
+  EXPECT_THAT(*line, HasSubstr("0.0.0.0"));
+  mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+}
+
+TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
+  HilProcess mock({"mock", "logi", "--port", "0", "--view", "0", "--no-status"});
+  ASSERT_TRUE(mock.started());
+  const auto line = mock.wait_for_line("view: ");
+  ASSERT_TRUE(line) << mock.output();
+  EXPECT_THAT(*line, HasSubstr("view: http://127.0.0.1:"));
+  // The page answers there (and the server is up before Ctrl-C comes).
+  std::smatch port;
+  ASSERT_TRUE(std::regex_search(*line, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(std::stoi(port[1])));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const std::string request = "GET / HTTP/1.0\r\n\r\n";
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(::write(fd, request.data(), request.size()), static_cast<ssize_t>(request.size()));
+  char reply[16] = {};
+  EXPECT_GT(::read(fd, reply, sizeof reply - 1), 0);
+  EXPECT_THAT(std::string(reply), HasSubstr("HTTP/1."));
+  ::close(fd);
+  mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+}
+
+TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
+  {
+    HilProcess proxy({"proxy", "--listen", "tcp://127.0.0.1:0", "--upstream", "tcp://127.0.0.1:9"});
+    ASSERT_TRUE(proxy.started());
+    const auto line = proxy.wait_for_line("clients connect to");
+    ASSERT_TRUE(line) << proxy.output();
+    EXPECT_THAT(*line, HasSubstr("clients connect to tcp://127.0.0.1:"));
+    EXPECT_THAT(proxy.output(), Not(HasSubstr("reachable from other machines")));
+    proxy.interrupt();  // right after start-up: may beat the Ctrl-C handler
+  }
+  HilProcess proxy({"proxy", "--listen", "tcp://0.0.0.0:0", "--upstream", "tcp://127.0.0.1:9"});
+  ASSERT_TRUE(proxy.started());
+  const auto line = proxy.wait_for_line("reachable from other machines");
+  ASSERT_TRUE(line) << proxy.output();
+  EXPECT_THAT(*line, HasSubstr("0.0.0.0"));
+  proxy.interrupt();  // right after start-up: may beat the Ctrl-C handler
+}
+
+// ---------------------------------------------------------------- hil run
+
+/// A scratch scenario library: <tmp>/lib/logi/<name>.yaml and friends.
+class ScratchLibrary : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    tmp_ =
+        fs::temp_directory_path() / ("hil-sec-" + std::to_string(::getpid()) + "-" + info->name());
+    fs::remove_all(tmp_);
+    fs::create_directories(tmp_ / "lib" / "logi");
+  }
+  void TearDown() override { fs::remove_all(tmp_); }
+  static std::string read(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  fs::path tmp_;
+};
+
+const std::string kPass = std::string(HIL_SOURCE_DIR) + "/tests/harness/data/run/pass.yaml";
+
+TEST_F(ScratchLibrary, AnExecClientsExactCommandLineIsShownBeforeItRuns) {
+  const auto run = run_hil("run " + kPass + " --client-exec 'true --port {port} --host {host}'");
+  // 'true' is not a client, so the run fails; what matters is the line.
+  EXPECT_THAT(run.output, HasSubstr("pass.yaml: client exec: /bin/sh -c 'true --port "));
+  EXPECT_THAT(run.output, HasSubstr(" --host '\\''127.0.0.1'\\'''\n"));
+  // --list shows it too, as written, without running anything.
+  const auto list = run_hil("run " + kPass + " --list --client-exec 'true {port}'");
+  EXPECT_EQ(list.exit_code, 0);
+  EXPECT_THAT(list.output, HasSubstr("  client exec: true {port}\n"));
+  // A scenario with its own client starts no program and shows none.
+  const auto plain = run_hil("run " + kPass + " --list");
+  EXPECT_THAT(plain.output, Not(HasSubstr("client exec")));
+}
+
+TEST_F(ScratchLibrary, PathsOutsideTheLibraryAreRefusedUnlessAllowed) {
+  std::ofstream(tmp_ / "outside.yaml") << "rules:\n  - kind: drop\n    first: 1\n";
+  const fs::path scenario = tmp_ / "lib" / "logi" / "s.yaml";
+  std::ofstream(scenario) << "name: s\ncar: logi\nfaults: ../../outside.yaml\nsteps: [connect]\n";
+  const auto refused = run_hil("run " + scenario.string() + " --list");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_THAT(refused.output,
+              HasSubstr(scenario.string() +
+                        ":3:9: fault profile file '../../outside.yaml' is outside the scenario's "
+                        "root"));
+  EXPECT_THAT(refused.output, HasSubstr("--allow-outside-paths"));
+  const auto allowed = run_hil("run " + scenario.string() + " --list --allow-outside-paths");
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.output;
+  EXPECT_THAT(allowed.output, HasSubstr(scenario.string() + "  s"));
+}
+
+TEST_F(ScratchLibrary, TheJunitFileIsWrittenWholeWithNothingLeftBeside) {
+  const fs::path junit = tmp_ / "hil.xml";
+  std::ofstream(junit) << "an older report";
+  const auto run = run_hil("run " + kPass + " --junit " + junit.string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  const std::string xml = read(junit);
+  EXPECT_EQ(xml.rfind("<?xml", 0), 0u) << xml;
+  EXPECT_THAT(xml, HasSubstr("</testsuite>"));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(tmp_))
+    ++files;
+  EXPECT_EQ(files, 2u);  // hil.xml and lib/: no temporary file left over
+
+  const auto unwritable =
+      run_hil("run " + kPass + " --junit " + (tmp_ / "no/such/hil.xml").string());
+  EXPECT_EQ(unwritable.exit_code, 1);
+  EXPECT_THAT(unwritable.output,
+              HasSubstr("hil run: cannot write " + (tmp_ / "no/such/hil.xml").string()));
+}
+
+}  // namespace
+}  // namespace hil::test
