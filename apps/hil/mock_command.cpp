@@ -438,6 +438,9 @@ int run_mock(const MockArgs& args) {
   }
 
   asio::io_context io;
+  // Caught from here on: a Ctrl-C while a big fleet starts is held until the
+  // cars run and then stops them cleanly, instead of killing the process.
+  asio::signal_set signals(io, SIGINT, SIGTERM);
   link::AsioExecutor executor(io);
   link::TransportContext context{executor, &io};
   StatusLine status(!args.no_status && ::isatty(STDOUT_FILENO) != 0);
@@ -567,7 +570,6 @@ int run_mock(const MockArgs& args) {
   };
   if (status.enabled()) redraw();
 
-  asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](const std::error_code& ec, int) {
     if (ec) return;
     status.end();

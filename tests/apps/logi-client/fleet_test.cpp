@@ -70,6 +70,8 @@ TEST(HilMockFleet, VerboseListsEveryCar) {
     EXPECT_TRUE(contains(mock.output(), "car" + std::to_string(i) + " connect to tcp://"))
         << i << "\n"
         << mock.output();
+  // Ctrl-C as soon as the cars are listed still stops them cleanly.
+  EXPECT_EQ(mock.interrupt(30s), 0) << mock.output();
 }
 
 TEST(HilMockFleet, CountsItCannotServeAreRefusedWithTheReason) {
