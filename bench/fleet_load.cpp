@@ -76,6 +76,9 @@ double percentile(std::vector<double> v, double p) {
 
 struct ProcSample {
   double cpu_s = 0;  // user + sys
+  // Time the process's threads were runnable but waited for a core (the
+  // machine's load as the mock felt it).
+  double run_delay_s = 0;
   double rss_kib = 0;
   std::size_t fds = 0;
 };
@@ -96,6 +99,13 @@ ProcSample sample(pid_t pid) {
       const double ticks = static_cast<double>(::sysconf(_SC_CLK_TCK));
       s.cpu_s = (std::stod(f[11]) + std::stod(f[12])) / ticks;  // utime, stime
     }
+  }
+  for (auto it = std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task");
+       it != std::filesystem::directory_iterator(); ++it) {
+    std::ifstream schedstat(it->path() / "schedstat");
+    double on_cpu_ns = 0;
+    double waiting_ns = 0;
+    if (schedstat >> on_cpu_ns >> waiting_ns) s.run_delay_s += waiting_ns / 1e9;
   }
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   std::string line;
@@ -483,7 +493,8 @@ struct Result {
   std::string failure;  // the mock did not start or the clients could not connect
   Measurements m;
   double stat_expected = 0;
-  double cpu_cores = 0;  // mock CPU over the window, in cores
+  double cpu_cores = 0;        // mock CPU over the window, in cores
+  double waited_fraction = 0;  // of the window, the mock runnable but not running
   double rss_kib = 0;
   double baseline_rss_kib = 0;
   std::size_t fds = 0;
@@ -604,6 +615,7 @@ Result run_fleet(const Options& o, std::size_t count) {
     const ProcSample after = sample(mock.pid());
     const double s = ms_between(window.start, window.end) / 1000;
     r.cpu_cores = (after.cpu_s - before.cpu_s) / s;
+    r.waited_fraction = (after.run_delay_s - before.run_delay_s) / s;
     r.driver_cpu_cores = (driver_cpu_s() - driver_before) / s;
     r.rss_kib = after.rss_kib;
     r.fds = after.fds;
@@ -630,12 +642,13 @@ std::string fixed(double v, int digits) {
 std::string table(const std::vector<Result>& results, double rate_hz) {
   std::ostringstream out;
   out << "| cars | STAT jitter p50 / p99 / max | STATs read | feedback p50 / p99 | echo p50 / p99 "
-         "| mock CPU (cores) | CPU per car | RSS per car | mock fds | loadavg (before -> after) "
+         "| mock CPU (cores) | mock waited for a core | CPU per car | RSS per car | mock fds | "
+         "loadavg (before -> after) "
          "| breaks |\n"
-      << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
+      << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n";
   for (const auto& r : results) {
     if (!r.failure.empty()) {
-      out << "| " << r.count << " | | | | | | | | | " << r.load_before << " | " << r.failure
+      out << "| " << r.count << " | | | | | | | | | | " << r.load_before << " | " << r.failure
           << " |\n";
       continue;
     }
@@ -648,6 +661,7 @@ std::string table(const std::vector<Result>& results, double rate_hz) {
         << fixed(r.stat_expected, 0) << " | " << fixed(r.fb_p50(), 2) << " / "
         << fixed(r.fb_p99(), 2) << " ms | " << fixed(r.echo_p50(), 3) << " / "
         << fixed(r.echo_p99(), 3) << " ms | " << fixed(r.cpu_cores, 2) << " | "
+        << fixed(r.waited_fraction * 100, 0) << " % | "
         << fixed(r.cpu_cores / static_cast<double>(r.count) * 1e6, 0) << " µs/s | "
         << fixed(r.kib_per_car(), 0) << " KiB | " << r.fds << " | " << r.load_before << " -> "
         << r.load_after << " | " << (breaks.empty() ? "none" : breaks) << " |\n";
