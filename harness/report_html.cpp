@@ -9,11 +9,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <stdexcept>
 
+#include "harness/atomic_file.hpp"
 #include "harness/report.hpp"
 #include "sim/geometry.hpp"
 #include "sim/svg.hpp"
@@ -58,11 +58,10 @@ std::string ndjson(const Timeline& timeline) {
   return out;
 }
 
+// Whole files only: a CI job that uploads the folder while a later run is
+// still being written, or a crash, never leaves a half page behind.
 void write_file(const fs::path& path, const std::string& content) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (out) out << content;
-  out.close();
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  write_file_atomically(path.string(), content);
 }
 
 constexpr const char* kStyle = R"(<style>
