@@ -2,6 +2,7 @@
 // One end of a bidirectional byte stream: a TCP connection, a pty, or an
 // in-memory pipe. Everything above the transports talks to this interface.
 
+#include <cstddef>
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,6 +14,12 @@ namespace hil::link {
 
 using protocol::Bytes;
 using protocol::ByteView;
+
+/// The send backlog hil's mock cars and proxy allow each peer (bytes
+/// written but not yet taken by the operating system): see
+/// BytePipe::set_send_limit. Every frame of every protocol is under 300
+/// bytes, so a peer that reads at all never comes near it.
+inline constexpr std::size_t kMaxSendBacklogBytes = std::size_t{1} << 20;
 
 enum class CloseMode : std::uint8_t {
   graceful,  ///< flush what is queued, then close (TCP: FIN)
@@ -38,6 +45,11 @@ class BytePipe {
   virtual void write(ByteView bytes) = 0;
   virtual void close(CloseMode mode = CloseMode::graceful) = 0;
   virtual bool is_open() const = 0;
+  /// Caps the send backlog at `bytes` (0: no cap, the default): a write
+  /// that would queue more aborts the pipe and on_close gets
+  /// std::errc::no_buffer_space, so a peer that never reads costs at most
+  /// this much memory. In-memory pipes have no backlog and ignore it.
+  virtual void set_send_limit(std::size_t /*bytes*/) {}
   /// Bytes written but not yet handed to the operating system / the peer.
   virtual std::size_t queued_bytes() const = 0;
   /// For logs: "tcp 127.0.0.1:9000 <- 127.0.0.1:53422", "mem car0", ...

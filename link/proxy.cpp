@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
+#include <system_error>
 
 #include "link/capture/pcap.hpp"
 #include "link/capture/wire_log.hpp"
@@ -19,11 +21,30 @@ class TerminalObserver final : public LinkObserver {
     log_(id_ + " " + format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " +
          std::string(to_string(e.direction)) + "): " + e.detail);
   }
+  void on_sent(Time /*at*/, Direction d, protocol::ByteView bytes) override {
+    (d == Direction::to_car ? to_car_ : to_client_) += bytes.size();
+  }
+  void on_open(Time /*at*/, const std::string& client, const std::string& car) override {
+    client_ = client;
+    car_ = car;
+  }
   void on_close(Time at, const LinkClose& close) override {
-    log_(id_ + " " + format_ms(at) + " closed: " + close.reason);
+    if (close.reason.find(std::make_error_code(std::errc::no_buffer_space).message()) !=
+        std::string::npos) {
+      const bool client = close.by == LinkClose::By::client;
+      log_(id_ + " " + format_ms(at) + " " + (client ? "client" : "car") +
+           " dropped: it stopped reading and " + std::to_string(kMaxSendBacklogBytes) +
+           " bytes waited for it (" + (client ? client_ : car_) + ")");
+    }
+    log_(id_ + " " + format_ms(at) + " closed: " + close.reason + " (" + std::to_string(to_car_) +
+         " bytes to the car, " + std::to_string(to_client_) + " to the client)");
   }
 
  private:
+  std::string client_;
+  std::string car_;
+  std::uint64_t to_car_ = 0;
+  std::uint64_t to_client_ = 0;
   std::string id_;
   std::function<void(const std::string&)> log_;
 };
@@ -99,6 +120,9 @@ void Proxy::on_accept(BytePipePtr client) {
 
 void Proxy::join(BytePipePtr client, BytePipePtr car, std::size_t number) {
   const std::string id = "link" + std::to_string(number);
+  // A side that never reads must not grow the proxy without end.
+  client->set_send_limit(kMaxSendBacklogBytes);
+  car->set_send_limit(kMaxSendBacklogBytes);
   LinkOptions link_options;
   link_options.protocol = options_.protocol;
   link_options.to_car = for_direction(options_.faults, Direction::to_car);

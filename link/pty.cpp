@@ -172,6 +172,10 @@ void make_raw(int fd, unsigned baud) {
   ::tcsetattr(fd, TCSANOW, &t);
 }
 
+/// Client bytes that may wait for pacing before the pty is left unread:
+/// 4 s of input at 9600 baud.
+constexpr std::size_t kMaxPacedInputBytes = 4096;
+
 /// Reads whatever is waiting without blocking and forgets it.
 void discard_input(int fd) {
   std::array<char, 4096> scratch{};
@@ -211,6 +215,14 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
 
   void write(ByteView bytes) override {
     if (state_ != State::open || bytes.empty()) return;
+    if (send_limit_ != 0 && tx_.queued() + os_queued_ + bytes.size() > send_limit_) {
+      // The client stopped reading: end its session rather than grow.
+      post_close(std::make_error_code(std::errc::no_buffer_space));
+      state_ = State::closed;
+      rx_.clear();
+      end_session(false);
+      return;
+    }
     tx_.push(bytes);
   }
 
@@ -230,6 +242,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   }
 
   bool is_open() const override { return state_ == State::open; }
+  void set_send_limit(std::size_t bytes) override { send_limit_ = bytes; }
   std::size_t queued_bytes() const override { return tx_.queued() + os_queued_; }
   std::string describe() const override { return description_; }
 
@@ -259,6 +272,20 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
         [self = shared_from_this()](std::error_code ec, std::size_t n) { self->on_read(ec, n); });
   }
 
+  /// A serial line delivers at most `baud` bits a second however fast the
+  /// client writes: once a few seconds of input wait to be paced in, the
+  /// pty is left unread (the client's writes block, as on a real port)
+  /// until they have gone through, so a fast writer cannot grow memory.
+  void read_when_room() {
+    if (rx_.queued() <= kMaxPacedInputBytes) {
+      read();
+      return;
+    }
+    rx_.when_drained([self = shared_from_this()] {
+      if (self->state_ == State::open && !self->reading_) self->read();
+    });
+  }
+
   void on_read(std::error_code ec, std::size_t n) {
     reading_ = false;
     ec = portable_error(ec);
@@ -266,7 +293,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
     if (n > 0 && state_ == State::open) received(ByteView(buffer_.data(), n));
     if (state_ == State::closed || ec == std::errc::operation_canceled) return;
     if (!ec) {
-      if (!reading_) read();
+      if (!reading_) read_when_room();
       return;
     }
     if (state_ == State::flushing) {
@@ -388,8 +415,9 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   std::array<std::uint8_t, 4096> buffer_{};
   std::deque<Bytes> os_queue_;
   std::size_t os_queued_ = 0;
-  SerialPacer tx_;  // device -> client
-  SerialPacer rx_;  // client -> device
+  std::size_t send_limit_ = 0;  // 0: no cap
+  SerialPacer tx_;              // device -> client
+  SerialPacer rx_;              // client -> device
 };
 
 /// Points `link` at `target`, replacing an old symlink atomically (rename)

@@ -42,6 +42,8 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     std::error_code ignored;
     // Frames are small and latency matters more than packet count.
     socket_.set_option(tcp::no_delay(true), ignored);
+    // read() reads only once the socket is readable, and must never block.
+    socket_.non_blocking(true, ignored);
   }
 
   void start(Handlers handlers) override {
@@ -51,6 +53,14 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
 
   void write(ByteView bytes) override {
     if (state_ != State::open || bytes.empty()) return;
+    if (send_limit_ != 0 && queued_ + bytes.size() > send_limit_) {
+      // The peer stopped reading: dropping it bounds what it can cost.
+      abort(true);
+      asio::post(socket_.get_executor(), [self = shared_from_this()] {
+        self->notify_close(std::make_error_code(std::errc::no_buffer_space));
+      });
+      return;
+    }
     queue_.emplace_back(bytes.begin(), bytes.end());
     queued_ += bytes.size();
     if (!writing_) write_queued();
@@ -68,6 +78,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   }
 
   bool is_open() const override { return state_ == State::open; }
+  void set_send_limit(std::size_t bytes) override { send_limit_ = bytes; }
   std::size_t queued_bytes() const override { return queued_; }
   std::string describe() const override { return description_; }
 
@@ -93,11 +104,32 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     if (!writing_) shut_down_send();
   }
 
+  /// Waits until the socket is readable and only then reads, into one
+  /// buffer per thread: an idle connection holds no read buffer, so a
+  /// thousand open connections cost a few hundred KiB, not 64 MiB.
   void read() {
     reading_ = true;
-    socket_.async_read_some(
-        asio::buffer(read_buffer_),
-        [self = shared_from_this()](std::error_code ec, std::size_t n) { self->on_read(ec, n); });
+    socket_.async_wait(tcp::socket::wait_read, [self = shared_from_this()](std::error_code ec) {
+      if (ec) {
+        self->on_read(ec, 0);
+        return;
+      }
+      std::error_code read_ec;
+      const std::size_t n = self->socket_.read_some(asio::buffer(read_buffer()), read_ec);
+      if (read_ec == asio::error::would_block || read_ec == asio::error::try_again) {
+        self->reading_ = false;
+        if (self->state_ != State::closed) self->read();
+        return;
+      }
+      self->on_read(read_ec, n);
+    });
+  }
+
+  /// Handlers never run nested inside another pipe's read, so one buffer
+  /// per thread is never in use twice.
+  static std::array<std::uint8_t, 64 * 1024>& read_buffer() {
+    static thread_local std::array<std::uint8_t, 64 * 1024> buffer{};
+    return buffer;
   }
 
   void on_read(std::error_code ec, std::size_t n) {
@@ -113,7 +145,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
       }
       return;
     }
-    if (n > 0 && handlers_.on_data) handlers_.on_data(ByteView(read_buffer_.data(), n));
+    if (n > 0 && handlers_.on_data) handlers_.on_data(ByteView(read_buffer().data(), n));
     if (state_ != State::open) {
       // on_data closed the pipe; close() keeps the drain going if needed.
       return;
@@ -200,11 +232,11 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   bool writing_ = false;
   bool peer_done_ = false;
   bool close_notified_ = false;
-  std::array<std::uint8_t, 64 * 1024> read_buffer_{};
   // A deque keeps each queued buffer in place while an async_write uses it.
   std::deque<Bytes> queue_;
   std::size_t in_flight_ = 0;  // queue_ entries the current async_write covers
   std::size_t queued_ = 0;
+  std::size_t send_limit_ = 0;  // 0: no cap
 };
 
 tcp::endpoint resolve_for_listen(asio::io_context& io, const TcpEndpoint& endpoint,

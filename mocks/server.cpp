@@ -1,5 +1,9 @@
 #include "mocks/server.hpp"
 
+#include <optional>
+#include <string>
+#include <system_error>
+
 #include "link/capture/wire_log.hpp"
 #include "link/mem_pipe.hpp"
 
@@ -20,6 +24,33 @@ class FaultLogger final : public link::LinkObserver {
   std::string id_;
   std::function<void(const std::string&)> log_;
 };
+
+// Remembers why a client's link closed, and the firmware's counters then,
+// for the session's "client gone" line (a next client may already be
+// talking to the firmware when that line is written).
+class CloseReason final : public link::LinkObserver {
+ public:
+  explicit CloseReason(const Firmware& firmware) : firmware_(firmware) {}
+  void on_close(Time /*at*/, const link::LinkClose& close) override {
+    reason_ = close.reason;
+    stats_ = firmware_.stats();
+  }
+  const std::string& reason() const { return reason_; }
+  FirmwareStats stats() const { return stats_ ? *stats_ : firmware_.stats(); }
+
+ private:
+  const Firmware& firmware_;
+  std::string reason_;
+  std::optional<FirmwareStats> stats_;
+};
+
+// What one session did to the firmware's counters, for its last log line.
+std::string session_counts(const FirmwareStats& now, const FirmwareStats& at_start) {
+  return std::to_string(now.bytes_in - at_start.bytes_in) + " bytes in, " +
+         std::to_string(now.frames_in - at_start.frames_in) + " frames in, " +
+         std::to_string(now.bad_frames - at_start.bad_frames) + " bad frames, " +
+         std::to_string(now.frames_out - at_start.frames_out) + " frames out";
+}
 
 }  // namespace
 
@@ -128,7 +159,14 @@ void MockServer::on_accept(link::BytePipePtr client) {
       say(id + " cannot write the wire log " + options_.wire_log_path + ": " + ec.message());
   }
 
-  say(id + " client connected: " + client->describe());
+  // A client that never reads must not grow the process without end.
+  client->set_send_limit(link::kMaxSendBacklogBytes);
+  auto close_reason = std::make_shared<CloseReason>(firmware_);
+  link_options.observers.push_back(close_reason);
+  const std::string peer = client->describe();
+  const FirmwareStats at_start = firmware_.stats();
+
+  say(id + " client connected: " + peer);
   auto [car_end, firmware_end] = link::make_mem_pipe(context_.executor, id);
   firmware_end_ = firmware_end;
   std::weak_ptr<bool> alive = alive_;
@@ -139,15 +177,29 @@ void MockServer::on_accept(link::BytePipePtr client) {
         firmware_.receive(context_.executor.now(), bytes);
         flush();
       },
-      [this, alive, weak_end, id](std::error_code ec) {
+      [this, alive, weak_end, id, close_reason, peer, at_start](std::error_code ec) {
         if (const auto a = alive.lock(); !a || !*a) return;
-        if (weak_end.lock() != firmware_end_) return;  // an older session
-        firmware_end_.reset();
-        firmware_.disconnect(context_.executor.now());
-        say(id + " client gone" +
-            (ec == link::end_of_stream() || ec == link::closed_here() ? std::string()
-                                                                      : ": " + ec.message()));
-        flush();
+        // A next client may have connected before this session's end got
+        // here: the firmware is theirs now, but this session is still told.
+        const bool current = weak_end.lock() == firmware_end_;
+        if (current) {
+          firmware_end_.reset();
+          firmware_.disconnect(context_.executor.now());
+        }
+        const std::string& why = close_reason->reason();
+        if (why.find(std::make_error_code(std::errc::no_buffer_space).message()) !=
+            std::string::npos) {
+          say(id + " client dropped: it stopped reading and " +
+              std::to_string(link::kMaxSendBacklogBytes) + " bytes waited for it (" + peer + ")");
+        }
+        std::string detail;
+        if (!why.empty() && why != "client closed")
+          detail = ": " + why;
+        else if (ec != link::end_of_stream() && ec != link::closed_here())
+          detail = ": " + ec.message();
+        say(id + " client gone" + detail + " (" + session_counts(close_reason->stats(), at_start) +
+            ")");
+        if (current) flush();
       }});
   link_ = link::Link::create(context_.executor, std::move(client), std::move(car_end),
                              std::move(link_options));
