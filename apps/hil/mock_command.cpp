@@ -450,7 +450,9 @@ int run_mock(const MockArgs& args) {
   cars.reserve(args.count);
   std::vector<std::shared_ptr<view::WireWatch>> watches;
   std::vector<std::string> listing;  // "<name> <address>" per car
-  const bool list_each = args.verbose || args.count <= kCarsListed;
+  // Serial cars are at most kMaxSerialCars, and their paths are what a
+  // user opens, so each is listed.
+  const bool list_each = args.verbose || args.count <= kCarsListed || serial;
   for (std::size_t i = 0; i < args.count; ++i) {
     mocks::CarOptions options = base;
     options.name = "car" + std::to_string(i);
