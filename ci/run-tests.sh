@@ -2,8 +2,10 @@
 # Sets up this machine (Debian 12) and runs every test hil has:
 #   1. the default RelWithDebInfo build and its CTest suite,
 #   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer,
-#   3. a short smoke run of every libFuzzer target (ci/fuzz-smoke.sh).
-# Set HIL_SKIP_ASAN=1 or HIL_SKIP_FUZZ=1 to leave a stage out locally.
+#   3. the same suite built with ThreadSanitizer,
+#   4. a short smoke run of every libFuzzer target (ci/fuzz-smoke.sh).
+# Set HIL_SKIP_ASAN=1, HIL_SKIP_TSAN=1 or HIL_SKIP_FUZZ=1 to leave a stage
+# out locally.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,6 +29,14 @@ if [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
   cmake --build --preset asan
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --preset asan | tee "$log"
+  passed=$((passed + $(ran)))
+fi
+
+if [ "${HIL_SKIP_TSAN:-0}" != 1 ]; then
+  echo "== ThreadSanitizer build and tests"
+  cmake --preset tsan
+  cmake --build --preset tsan
+  ctest --preset tsan | tee "$log"
   passed=$((passed + $(ran)))
 fi
 
