@@ -31,9 +31,11 @@ struct Wr8Config {
   /// After a wrong authentication string the connection is closed this much
   /// later; nothing is answered in between. Each further failure in a row
   /// (across connections, until a right login) doubles it, up to
-  /// wrong_auth_max_delay: guessing the string gets slower and slower.
+  /// wrong_auth_max_delay: with a cap above the delay (e.g. 30 s), guessing
+  /// the string gets slower and slower. The default cap equals the delay
+  /// (a constant 1 s, as the shipped scenarios and clients expect).
   Duration wrong_auth_close_delay{link::seconds(1)};
-  Duration wrong_auth_max_delay{link::seconds(30)};
+  Duration wrong_auth_max_delay{link::seconds(1)};
   /// DATA period once authenticated, on a grid of whole periods since the
   /// vehicle started (100 ms: 10 Hz).
   Duration data_period{link::milliseconds(100)};
