@@ -45,17 +45,57 @@ LineReading line_reading_from(std::array<bool, 4> on) {
   return reading;
 }
 
+namespace {
+
+// Arena::on_tape for the line tracker's four points at once, with the same
+// answer for each: a segment whose box (grown by half the tape's width)
+// misses the box round all four points misses each of them, so it is
+// skipped with one test instead of four; the per-point test is Tape::covers'.
+std::array<bool, 4> on_tape(const Arena& arena, const std::array<Vec2, 4>& points) {
+  std::array<bool, 4> on{};
+  Vec2 lo = points[0];
+  Vec2 hi = points[0];
+  for (const Vec2& p : points) {
+    lo = {std::min(lo.x_m, p.x_m), std::min(lo.y_m, p.y_m)};
+    hi = {std::max(hi.x_m, p.x_m), std::max(hi.y_m, p.y_m)};
+  }
+  for (const Tape& tape : arena.tapes) {
+    const double half = tape.width_m / 2;
+    const double half2 = half * half;
+    const auto visit = [&](Vec2 a, Vec2 b) {
+      const double min_x = std::min(a.x_m, b.x_m) - half;
+      const double max_x = std::max(a.x_m, b.x_m) + half;
+      const double min_y = std::min(a.y_m, b.y_m) - half;
+      const double max_y = std::max(a.y_m, b.y_m) + half;
+      if (hi.x_m < min_x || lo.x_m > max_x || hi.y_m < min_y || lo.y_m > max_y) return;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const Vec2 p = points[i];
+        if (on[i] || p.x_m < min_x || p.x_m > max_x || p.y_m < min_y || p.y_m > max_y) continue;
+        on[i] = distance_squared_to_segment(p, a, b) <= half2;
+      }
+    };
+    const auto& pts = tape.points_m;
+    if (pts.size() == 1) visit(pts[0], pts[0]);
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i)
+      visit(pts[i], pts[i + 1]);
+    if (tape.closed && pts.size() > 2) visit(pts.back(), pts.front());
+  }
+  return on;
+}
+
+}  // namespace
+
 LineReading read_line_tracker(const LineTrackerDef& def, const Pose& pose, const Arena& arena) {
   // The four points share one rotation: sin and cos once, not four times
   // (the same arithmetic as Pose::to_arena, so the same points).
   const double c = std::cos(pose.heading_rad);
   const double s = std::sin(pose.heading_rad);
-  std::array<bool, 4> on{};
+  std::array<Vec2, 4> points{};
   for (std::size_t i = 0; i < 4; ++i) {
     const Vec2 v{def.ahead_m, def.lateral_m[i]};
-    on[i] = arena.on_tape(pose.position() + Vec2{c * v.x_m - s * v.y_m, s * v.x_m + c * v.y_m});
+    points[i] = pose.position() + Vec2{c * v.x_m - s * v.y_m, s * v.x_m + c * v.y_m};
   }
-  return line_reading_from(on);
+  return line_reading_from(on_tape(arena, points));
 }
 
 namespace {
