@@ -552,7 +552,7 @@ std::string check_bad_checksum(const Rig& rig) {
     const auto* p = std::get_if<ParseErrorEvent>(&e);
     if (p == nullptr || p->error.kind != protocol::ErrorKind::bad_checksum) continue;
     const std::string raw = text_of(p->error.raw);
-    const bool logged = std::any_of(log.begin(), log.end(), [&](const LogEntry& l) {
+    const bool logged = std::any_of(log.begin(), log.end(), [&, t = t](const LogEntry& l) {
       return l.at == t && l.kind == LogKind::parse_error && l.raw == raw;
     });
     if (!logged)

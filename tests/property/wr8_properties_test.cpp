@@ -280,7 +280,7 @@ void check_coi_correlation(const Wr8Rig& rig) {
     Open& o = it->second;
     RC_ASSERT(r->kind == o.sent.kind);
     RC_ASSERT(r->task == o.sent.task);
-    auto delivered = [&](proto::ResponseCode code) {
+    auto delivered = [&, t = t](proto::ResponseCode code) {
       return seen_at(rig, t, false, [&](const proto::Message& m) {
         return m == proto::Message{proto::Response{r->coi, code}};
       });
@@ -402,7 +402,7 @@ void check_reconnects(const Wr8Rig& rig) {
   for (const auto& [t, f] : rig.of<LoginFailedEvent>()) {
     if (f.reason == "AUTH-REPLY timeout") {
       RC_ASSERT(authenticating_since.has_value());
-      const auto since = [&] {
+      const auto since = [&, t = t] {
         std::optional<Time> s;
         for (const auto& [when, c] : changes) {
           if (when > t) break;
