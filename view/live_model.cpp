@@ -10,6 +10,7 @@
 #include <exception>
 #include <variant>
 
+#include "link/capture/wire_log.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/behaviour_yaml.hpp"
 #include "sim/geometry.hpp"
@@ -163,7 +164,10 @@ void WireWatch::on_delivered(link::Time at, link::Direction d, protocol::ByteVie
     splitter->feed(bytes, scratch_);
     for (auto& f : scratch_) {
       ++seen_[static_cast<int>(d)];
-      kept.push_back(Frame{at, f.valid, std::move(f.kind), std::move(f.text), hex_of(f.raw)});
+      // The page is open to anyone on the machine: a login string is never
+      // kept, only the hex a debugger needs.
+      std::string text = link::masked_frame_text(f.kind, std::move(f.text));
+      kept.push_back(Frame{at, f.valid, std::move(f.kind), std::move(text), hex_of(f.raw)});
     }
   }
   while (kept.size() > kFramesKept)

@@ -12,6 +12,7 @@
 #include "link/executor.hpp"
 #include "link/transport.hpp"
 #include "protocol/logi/codec.hpp"
+#include "protocol/wr8/codec.hpp"
 
 namespace hil::view {
 namespace {
@@ -23,7 +24,7 @@ namespace logi = protocol::logi;
 // the model the view would build.
 class Desk {
  public:
-  Desk() {
+  explicit Desk(mocks::CarOptions car = {}) : car_(std::move(car)) {
     mocks::ServerOptions options;
     options.listen = link::MemEndpoint{"car"};
     options.observers.push_back(watch_);
@@ -43,8 +44,8 @@ class Desk {
         });
     run_for(link::milliseconds(1));
   }
-  void send(const logi::Message& m) {
-    const auto bytes = logi::encode(m);
+  void send(const logi::Message& m) { send_bytes(logi::encode(m)); }
+  void send_bytes(const protocol::Bytes& bytes) {
     client_->write(bytes);
     run_for(link::milliseconds(20));
   }
@@ -70,7 +71,7 @@ class Desk {
  private:
   link::VirtualExecutor executor_;
   link::TransportContext context_{executor_};
-  mocks::MockCar car_{mocks::CarOptions{}};
+  mocks::MockCar car_;
   std::shared_ptr<WireWatch> watch_ = std::make_shared<WireWatch>(car_.firmware().adapter());
   std::unique_ptr<mocks::MockServer> server_;
   std::unique_ptr<LiveModel> model_;
@@ -128,6 +129,29 @@ TEST(LiveModel, LastFramesEachWayAreDecoded) {
   EXPECT_TRUE(feedback) << to_client;
   EXPECT_TRUE(status) << to_client;
   EXPECT_NE(car["mode"].get<std::string>().find("SP 50"), std::string::npos) << car["mode"];
+}
+
+TEST(LiveModel, AWr8LoginStringNeverReachesThePage) {
+  mocks::CarOptions options;
+  options.kind = mocks::CarKind::wr8;
+  const auto profile = options.configs.wr8.profile;
+  Desk desk(std::move(options));
+  desk.connect();
+  namespace wr8 = protocol::wr8;
+  const auto login = wr8::encode(wr8::Auth{profile.auth_text}, profile);
+  desk.send_bytes(login);
+  desk.run_for(link::milliseconds(300));
+  const json car = desk.snapshot();
+  const json& to_car = car["frames"]["to_car"];
+  ASSERT_EQ(to_car.size(), 1U) << to_car;
+  EXPECT_EQ(to_car[0]["kind"], "AUTH");
+  const std::string secret(profile.auth_text.begin(), profile.auth_text.end());
+  EXPECT_EQ(car.dump().find(secret), std::string::npos) << car["frames"];
+  EXPECT_NE(to_car[0]["text"].get<std::string>().find("**********"), std::string::npos) << to_car;
+  // The hex stays, for whoever debugs the link byte by byte.
+  EXPECT_FALSE(to_car[0]["hex"].get<std::string>().empty());
+  // Logged in: the car answers and streams DATA.
+  EXPECT_GT(car["frames"]["to_client"].size(), 1U) << car["frames"];
 }
 
 TEST(LiveModel, PoseAndTrailFollowADrivenCar) {
