@@ -88,6 +88,12 @@ TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
     const auto r = client({"--script", (examples / name).string()});
     EXPECT_EQ(r.exit_code, 0) << name << "\n" << r.output;
     EXPECT_FALSE(contains(r.output, "NACK")) << r.output;
+    // A pty shows its owner a client's close only until the next open: if
+    // the next client opened the port before the mock ran again (a loaded
+    // machine), both would be one session and the board would not reset.
+    // A real port resets on every open; here the next run waits until the
+    // mock has seen this one leave.
+    ASSERT_TRUE(mock->process().wait_for_line("client gone", 20s)) << mock->output();
   }
   const auto r = client({"STATUS"});
   EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=140 ")) << "a fresh boot: " << r.output;
