@@ -390,6 +390,10 @@ int run_mock(const MockArgs& args) {
   const auto kind = mocks::parse_car_kind(args.car);
   mocks::CarOptions base;
   base.kind = *kind;
+  // A mock on a shared machine is a target for guessing the login: each
+  // failure in a row doubles the refusal delay up to 30 s. Scenarios keep
+  // the library's constant 1 s, which their timings rely on.
+  base.configs.wr8.wrong_auth_max_delay = link::seconds(30);
   link::FaultProfile faults;
   std::vector<mocks::Behaviour> behaviours;
   try {
@@ -464,6 +468,11 @@ int run_mock(const MockArgs& args) {
     const auto& logi_config = options.configs.logi;
     options.configs.logi.boot_offset = logi_config.stat_period * static_cast<std::int64_t>(i) /
                                        static_cast<std::int64_t>(args.count);
+    if (!args.quiet) {
+      options.configs.wr8.log = [log, name = options.name](const std::string& l) {
+        log(name + ": " + l);
+      };
+    }
     RunningCar running;
     try {
       running.car = std::make_unique<mocks::MockCar>(std::move(options));
@@ -520,7 +529,7 @@ int run_mock(const MockArgs& args) {
   }
   if (args.bind != "127.0.0.1" && args.bind != "localhost" && args.bind != "::1" &&
       !std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(*kind, 0))) {
-    std::cout << "note: listening on " << args.bind << ", reachable from other machines\n";
+    std::cerr << "warning: listening on " << args.bind << ", reachable from other machines\n";
   }
   std::cout << "world " << (args.world.empty() ? "built-in warehouse" : args.world) << ", "
             << faults.rules.size() << " fault rule(s), " << behaviours.size()
@@ -628,10 +637,13 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--ports-file", args->ports_file,
                   "Write one line per car, its name and where it listens, once every car "
                   "listens (for scripts; with --port 0 the ports are not consecutive)");
-  cmd->add_option("--auth", args->auth, "WR8: the 10-character authentication string");
+  cmd->add_option("--auth", args->auth,
+                  "WR8: the 10-character authentication string (a wrong one is refused "
+                  "after 1 s, doubling per failure in a row up to 30 s; failures are logged "
+                  "without the string)");
   cmd->add_option("--data-hz", args->data_hz, "WR8: DATA packets per second (default 10)")
       ->check(CLI::Range(0.1, 1000.0));
-  cmd->add_flag("-q,--quiet", args->quiet, "No line per connection and fault");
+  cmd->add_flag("-q,--quiet", args->quiet, "No line per connection, fault and WR8 login failure");
   cmd->add_flag("-v,--verbose", args->verbose,
                 "One line per car even with more than " + std::to_string(kCarsListed) +
                     " cars (else the first, the last and a summary)");

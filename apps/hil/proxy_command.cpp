@@ -75,6 +75,9 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       link::AsioExecutor executor(io);
       link::TransportContext context{executor, &io};
       link::Proxy proxy(context, options);
+      // Caught before the start-up lines: a Ctrl-C right after them stops
+      // cleanly instead of killing the process.
+      asio::signal_set signals(io, SIGINT, SIGTERM);
       try {
         proxy.start();
       } catch (const std::exception& e) {
@@ -84,13 +87,12 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       if (const auto* tcp = std::get_if<link::TcpEndpoint>(&options.listen);
           tcp != nullptr && tcp->host != "127.0.0.1" && tcp->host != "localhost" &&
           tcp->host != "::1") {
-        std::cout << "note: listening on " << tcp->host << ", reachable from other machines\n";
+        std::cerr << "warning: listening on " << tcp->host << ", reachable from other machines\n";
       }
       std::cout << "hil proxy: clients connect to " << proxy.address() << ", car at "
                 << link::to_uri(options.upstream) << ", protocol " << args->protocol << ", "
                 << options.faults.rules.size() << " fault rule(s), seed " << options.seed
                 << " (replay with --seed " << options.seed << ")" << std::endl;
-      asio::signal_set signals(io, SIGINT, SIGTERM);
       signals.async_wait([&](const std::error_code& ec, int) {
         if (ec) return;
         std::cout << "hil proxy: stopping (" << proxy.links_opened() << " link(s) served, "

@@ -6,6 +6,7 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -40,7 +41,8 @@ TEST(DefaultBind, MockTcpCarsListenOnLoopbackOnlyAndSayNothingAboutTheNetwork) {
     EXPECT_THAT(*line, HasSubstr("connect to tcp://127.0.0.1:")) << car;
     ASSERT_TRUE(mock.wait_for_line("Ctrl-C stops")) << mock.output();
     EXPECT_THAT(mock.output(), Not(HasSubstr("reachable from other machines"))) << car;
-    mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+    // Ctrl-C right after start-up is caught like any later one.
+    EXPECT_EQ(mock.interrupt(), 0) << car << ": " << mock.output();
   }
 }
 
@@ -49,8 +51,16 @@ TEST(DefaultBind, AMockBoundToEveryInterfaceWarnsNamingTheAddress) {
   ASSERT_TRUE(mock.started());
   const auto line = mock.wait_for_line("reachable from other machines");
   ASSERT_TRUE(line) << mock.output();
-  EXPECT_THAT(*line, HasSubstr("0.0.0.0"));
-  mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+  EXPECT_THAT(*line, HasSubstr("warning: listening on 0.0.0.0"));
+  EXPECT_EQ(mock.interrupt(), 0) << mock.output();
+  // On stderr, where warnings are looked for: stdout alone does not carry it.
+  const std::string hil = HIL_BINARY;
+  HilProcess stdout_only(
+      "/bin/sh",
+      {"-c", "exec '" + hil + "' mock logi --port 0 --bind 0.0.0.0 --no-status 2>/dev/null"});
+  ASSERT_TRUE(stdout_only.wait_for_line("Ctrl-C stops")) << stdout_only.output();
+  EXPECT_THAT(stdout_only.output(), Not(HasSubstr("reachable from other machines")));
+  EXPECT_EQ(stdout_only.interrupt(), 0) << stdout_only.output();
 }
 
 TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
@@ -85,14 +95,79 @@ TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
     ASSERT_TRUE(line) << proxy.output();
     EXPECT_THAT(*line, HasSubstr("clients connect to tcp://127.0.0.1:"));
     EXPECT_THAT(proxy.output(), Not(HasSubstr("reachable from other machines")));
-    proxy.interrupt();  // right after start-up: may beat the Ctrl-C handler
+    // Ctrl-C right after start-up is caught like any later one.
+    EXPECT_EQ(proxy.interrupt(), 0) << proxy.output();
   }
   HilProcess proxy({"proxy", "--listen", "tcp://0.0.0.0:0", "--upstream", "tcp://127.0.0.1:9"});
   ASSERT_TRUE(proxy.started());
   const auto line = proxy.wait_for_line("reachable from other machines");
   ASSERT_TRUE(line) << proxy.output();
-  EXPECT_THAT(*line, HasSubstr("0.0.0.0"));
-  proxy.interrupt();  // right after start-up: may beat the Ctrl-C handler
+  EXPECT_THAT(*line, HasSubstr("warning: listening on 0.0.0.0"));
+  EXPECT_EQ(proxy.interrupt(), 0) << proxy.output();
+}
+
+// ---------------------------------------------------------------- WR8 login
+
+/// A TCP connection to 127.0.0.1:`port` (-1 if refused).
+int connect_loopback(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+/// Sends one AUTH with a wrong string and reads until the car hangs up.
+void fail_a_login(int port) {
+  const int fd = connect_loopback(port);
+  ASSERT_GE(fd, 0);
+  const std::string wrong_login = std::string("\x01") + "WRONG-AUTH";
+  ASSERT_EQ(::write(fd, wrong_login.data(), wrong_login.size()),
+            static_cast<ssize_t>(wrong_login.size()));
+  timeval limit{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &limit, sizeof limit);
+  char reply[64];
+  // Nothing is answered before the refusal: the first read sees the close.
+  EXPECT_EQ(::read(fd, reply, sizeof reply), 0);
+  ::close(fd);
+}
+
+TEST(Wr8Login, HilMockLogsFailedLoginsByCarWithoutTheStringAndSlowsEachRetry) {
+  HilProcess mock({"mock", "wr8", "--port", "0", "--no-status"});
+  const auto listed = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(listed) << mock.output();
+  std::smatch port;
+  ASSERT_TRUE(std::regex_search(*listed, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
+  fail_a_login(std::stoi(port[1]));
+  const auto first = mock.wait_for_line("login refused");
+  ASSERT_TRUE(first) << mock.output();
+  EXPECT_THAT(*first, HasSubstr("car0: wr8: login refused (AUTH **********)"));
+  EXPECT_THAT(*first, HasSubstr("closing the connection in 1.000 s"));
+  // A guesser's next try waits twice as long (the library keeps 1 s).
+  fail_a_login(std::stoi(port[1]));
+  const auto second = mock.wait_for_line("login refused");
+  ASSERT_TRUE(second) << mock.output();
+  EXPECT_THAT(*second, HasSubstr("failed login 2 in a row"));
+  EXPECT_THAT(*second, HasSubstr("closing the connection in 2.000 s"));
+  EXPECT_EQ(mock.interrupt(), 0);
+  EXPECT_THAT(mock.output(), Not(HasSubstr("WRONG-AUTH")));
+  EXPECT_THAT(mock.output(), Not(HasSubstr("HIL-WR8-01")));
+}
+
+TEST(Wr8Login, QuietMockSaysNothingAboutLogins) {
+  HilProcess mock({"mock", "wr8", "--port", "0", "--no-status", "-q"});
+  const auto listed = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(listed) << mock.output();
+  std::smatch port;
+  ASSERT_TRUE(std::regex_search(*listed, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
+  fail_a_login(std::stoi(port[1]));
+  EXPECT_EQ(mock.interrupt(), 0);
+  EXPECT_THAT(mock.output(), Not(HasSubstr("login refused")));
 }
 
 // ---------------------------------------------------------------- hil run
