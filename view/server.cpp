@@ -26,6 +26,7 @@ struct LiveViewServer::Shared {
   std::uint64_t version = 0;
   bool stopping = false;
   std::atomic<int> viewers{0};
+  std::atomic<bool> listen_returned{false};
   httplib::Server http;
   std::thread thread;
 };
@@ -150,7 +151,10 @@ void LiveViewServer::start() {
   }
   running_ = true;
   refresh();
-  shared->thread = std::thread([shared] { shared->http.listen_after_bind(); });
+  shared->thread = std::thread([shared] {
+    shared->http.listen_after_bind();
+    shared->listen_returned = true;
+  });
 }
 
 void LiveViewServer::refresh() {
@@ -179,6 +183,11 @@ void LiveViewServer::stop() {
     shared_->stopping = true;
   }
   shared_->changed.notify_all();
+  // httplib's stop() does nothing before its accept loop runs, and the loop
+  // would then wait for a connection for ever: a Ctrl-C right after start-up
+  // must find the loop running (or already ended) before stopping it.
+  while (!shared_->http.is_running() && !shared_->listen_returned)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   shared_->http.stop();
   if (shared_->thread.joinable()) shared_->thread.join();
 }

@@ -3,11 +3,16 @@
 // the car, its world and its link.
 
 #include "view/live_model.hpp"
+#include "view/server.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <future>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "link/executor.hpp"
 #include "link/transport.hpp"
@@ -67,6 +72,8 @@ class Desk {
   std::string take_received() { return std::exchange(received_, {}); }
   bool closed() const { return closed_; }
   mocks::MockCar& car() { return car_; }
+  link::Executor& executor() { return executor_; }
+  LiveModel& model() { return *model_; }
 
  private:
   link::VirtualExecutor executor_;
@@ -152,6 +159,30 @@ TEST(LiveModel, AWr8LoginStringNeverReachesThePage) {
   EXPECT_FALSE(to_car[0]["hex"].get<std::string>().empty());
   // Logged in: the car answers and streams DATA.
   EXPECT_GT(car["frames"]["to_client"].size(), 1U) << car["frames"];
+}
+
+TEST(LiveViewServer, StopsAtOnceWhenStoppedRightAfterStarting) {
+  // hil mock stops the page server as soon as a Ctrl-C arrives, which may
+  // be before the server's thread has begun to accept connections.
+  Desk desk;
+  asio::io_context io;
+  std::promise<void> done;
+  auto stopped = done.get_future();
+  std::thread([&] {
+    for (int i = 0; i < 100; ++i) {
+      ViewOptions options;
+      options.port = 0;
+      LiveViewServer server(io, desk.executor(), desk.model(), options);
+      server.start();
+      server.stop();
+    }
+    done.set_value();
+  }).detach();
+  if (stopped.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+    // The server thread will never end: the process cannot be left cleanly.
+    std::fputs("LiveViewServer.stop() right after start() did not return in 20 s\n", stderr);
+    std::_Exit(1);
+  }
 }
 
 TEST(LiveModel, PoseAndTrailFollowADrivenCar) {
