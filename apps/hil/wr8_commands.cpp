@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/hil/cli_common.hpp"
+#include "link/capture/wire_log.hpp"
 #include "protocol/wr8/codec.hpp"
 
 namespace hil::apps {
@@ -360,9 +361,16 @@ void register_wr8(CommandSet& commands) {
         return 1;
       }
       const wr8::Profile profile = options.profile;
-      return print_items<wr8::Message>(
-          wr8::Decoder(std::move(options)), bytes, true, dec_args->input,
-          [profile](const wr8::Message& m) { return wr8::describe(m, profile); });
+      return print_items<wr8::Message>(wr8::Decoder(std::move(options)), bytes, true,
+                                       dec_args->input, [profile](const wr8::Message& m) {
+                                         // A capture may hold the real login: the hex above shows
+                                         // the bytes, the decoded line only whether they match the
+                                         // profile.
+                                         const std::string text = wr8::describe(m, profile);
+                                         return std::holds_alternative<wr8::Auth>(m)
+                                                    ? link::masked_frame_text("AUTH", text)
+                                                    : text;
+                                       });
     };
   });
 }

@@ -170,6 +170,13 @@ TEST(Wr8Login, QuietMockSaysNothingAboutLogins) {
   EXPECT_THAT(mock.output(), Not(HasSubstr("login refused")));
 }
 
+TEST(Wr8Login, HilDecodeShowsTheBytesOfAnAuthButNotItsText) {
+  const auto decoded = run_hil("decode wr8 01 48 49 4C 2D 57 52 38 2D 30 31");
+  EXPECT_EQ(decoded.exit_code, 0) << decoded.output;
+  EXPECT_THAT(decoded.output, HasSubstr("Auth text=********** (profile string)"));
+  EXPECT_THAT(decoded.output, Not(HasSubstr("HIL-WR8-01")));
+}
+
 // ---------------------------------------------------------------- hil run
 
 /// A scratch scenario library: <tmp>/lib/logi/<name>.yaml and friends.
