@@ -30,6 +30,7 @@
 #include <variant>
 #include <vector>
 
+#include "bench/bare_box2d.hpp"
 #include "bench/hil_flags.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
@@ -90,53 +91,8 @@ void bare_box2d(benchmark::State& state) {
   for (auto _ : state) {
     // On the heap: b2World carries Box2D's 100 KiB stack allocator.
     const auto world = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
-    b2BodyDef ground_def;
-    b2Body* ground = world->CreateBody(&ground_def);
-    auto add_box = [&](double cx, double cy, double hw, double hh, double angle) {
-      b2PolygonShape shape;
-      shape.SetAsBox(static_cast<float>(hw), static_cast<float>(hh),
-                     b2Vec2(static_cast<float>(cx), static_cast<float>(cy)),
-                     static_cast<float>(angle));
-      b2FixtureDef fixture;
-      fixture.shape = &shape;
-      fixture.friction = 0.3f;
-      ground->CreateFixture(&fixture);
-    };
-    const double t = arena.wall_thickness_m;
-    const double w = arena.width_m;
-    const double h = arena.height_m;
-    add_box(w / 2, -t / 2, w / 2 + t, t / 2, 0);
-    add_box(w / 2, h + t / 2, w / 2 + t, t / 2, 0);
-    add_box(-t / 2, h / 2, t / 2, h / 2 + t, 0);
-    add_box(w + t / 2, h / 2, t / 2, h / 2 + t, 0);
-    for (const auto& obstacle : arena.obstacles) {
-      if (const auto* box = std::get_if<hil::sim::BoxObstacle>(&obstacle)) {
-        add_box(box->center_m.x_m, box->center_m.y_m, box->width_m / 2, box->height_m / 2,
-                box->angle_rad);
-      } else {
-        const auto& circle = std::get<hil::sim::CircleObstacle>(obstacle);
-        b2CircleShape shape;
-        shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
-                      static_cast<float>(circle.center_m.y_m));
-        shape.m_radius = static_cast<float>(circle.radius_m);
-        b2FixtureDef fixture;
-        fixture.shape = &shape;
-        fixture.friction = 0.3f;
-        ground->CreateFixture(&fixture);
-      }
-    }
-    b2BodyDef body_def;
-    body_def.type = b2_dynamicBody;
-    body_def.position.Set(0.7f, 0.7f);
-    body_def.allowSleep = false;
-    b2Body* body = world->CreateBody(&body_def);
-    b2PolygonShape shape;
-    shape.SetAsBox(static_cast<float>(car.length_m / 2), static_cast<float>(car.width_m / 2));
-    b2FixtureDef fixture;
-    fixture.shape = &shape;
-    fixture.density = static_cast<float>(car.mass_kg / (car.length_m * car.width_m));
-    fixture.friction = 0.3f;
-    body->CreateFixture(&fixture);
+    hil::bench::add_bare_arena(*world, arena);
+    b2Body* body = hil::bench::add_bare_car(*world, car, hil::sim::Pose{0.7, 0.7, 0.0});
     for (std::int64_t i = 0; i < steps; ++i) {
       const double angle = body->GetAngle();
       body->SetLinearVelocity(b2Vec2(static_cast<float>(kSpeed_mps * std::cos(angle)),
