@@ -57,19 +57,6 @@ class Fd {
   int fd_;
 };
 
-int tcp_connect(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
 int port_in(const std::string& line) {
   std::smatch m;
   if (!std::regex_search(line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) return -1;
@@ -82,7 +69,7 @@ TEST(HilMock, LogiCarAnswersOverTcpAndStopsCleanlyOnCtrlC) {
   const auto line = mock.wait_for_line("connect to tcp://");
   ASSERT_TRUE(line) << mock.output();
   EXPECT_NE(mock.output().find("seed 7 (replay with --seed 7)"), std::string::npos);
-  Fd client(tcp_connect(port_in(*line)));
+  Fd client(connect_loopback(port_in(*line)));
   ASSERT_TRUE(client.ok());
   client.send("LOGI:SP:050:D7#");
   EXPECT_TRUE(client.read_until("FB:SP:1")) << client.received;
@@ -103,13 +90,13 @@ TEST(HilMock, CountRunsIndependentCarsAndASecondClientIsTurnedAway) {
   const auto second = mock.wait_for_line("car1 connect to");
   ASSERT_TRUE(first && second) << mock.output();
   ASSERT_NE(port_in(*first), port_in(*second));
-  Fd a(tcp_connect(port_in(*first)));
-  Fd b(tcp_connect(port_in(*second)));
+  Fd a(connect_loopback(port_in(*first)));
+  Fd b(connect_loopback(port_in(*second)));
   a.send("LOGI:MD:MAN:0C#");
   b.send("LOGI:MD:MAN:0C#");
   EXPECT_TRUE(a.read_until("FB:MD:1"));
   EXPECT_TRUE(b.read_until("FB:MD:1"));
-  Fd extra(tcp_connect(port_in(*first)));
+  Fd extra(connect_loopback(port_in(*first)));
   ASSERT_TRUE(extra.ok());
   EXPECT_FALSE(extra.read_until("LOGI", 3s));  // closed by the car with no byte
   EXPECT_TRUE(extra.received.empty());
@@ -138,7 +125,7 @@ TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
   HilProcess mock({"mock", "wr8", "--port", "0", "--auth", "0123456789"});
   const auto line = mock.wait_for_line("connect to tcp://");
   ASSERT_TRUE(line) << mock.output();
-  Fd client(tcp_connect(port_in(*line)));
+  Fd client(connect_loopback(port_in(*line)));
   client.send(std::string("\x01") + "0123456789");
   ASSERT_TRUE(client.read_until(std::string("\x02", 1))) << client.received.size();
   EXPECT_EQ(mock.interrupt(), 0);
@@ -149,7 +136,7 @@ TEST(HilMock, DeskCommandsDropAParcelThatLocksTheCarAndTakeItAway) {
   const auto line = mock.wait_for_line("connect to tcp://");
   ASSERT_TRUE(line) << mock.output();
   ASSERT_TRUE(mock.wait_for_line("type 'help' for desk commands"));
-  Fd client(tcp_connect(port_in(*line)));
+  Fd client(connect_loopback(port_in(*line)));
   client.send("LOGI:MD:MAN:0C#LOGI:MV:FWD:23#");
   ASSERT_TRUE(client.read_until("FB:MV:1")) << client.received;
   ASSERT_TRUE(mock.write_stdin("obstacle 10\n"));

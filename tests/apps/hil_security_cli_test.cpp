@@ -108,20 +108,6 @@ TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
 
 // ---------------------------------------------------------------- WR8 login
 
-/// A TCP connection to 127.0.0.1:`port` (-1 if refused).
-int connect_loopback(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
 /// Sends one AUTH with a wrong string and reads until the car hangs up.
 void fail_a_login(int port) {
   const int fd = connect_loopback(port);
