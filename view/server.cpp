@@ -61,7 +61,11 @@ std::string LiveViewServer::url() const {
 }
 
 void LiveViewServer::start() {
-  auto shared = shared_;
+  auto shared_owner = shared_;
+  // The handlers live in shared->http, so they hold a plain pointer: a
+  // shared_ptr in them would keep Shared (and them) alive for ever. They run
+  // only inside listen_after_bind, on the thread below, which owns Shared.
+  Shared* const shared = shared_owner.get();
   auto& http = shared->http;
   http.new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
   http.set_keep_alive_timeout(2);
@@ -151,9 +155,9 @@ void LiveViewServer::start() {
   }
   running_ = true;
   refresh();
-  shared->thread = std::thread([shared] {
-    shared->http.listen_after_bind();
-    shared->listen_returned = true;
+  shared->thread = std::thread([shared_owner] {
+    shared_owner->http.listen_after_bind();
+    shared_owner->listen_returned = true;
   });
 }
 

@@ -60,6 +60,22 @@ inline constexpr bool kSanitizerBuild = false;
 inline constexpr bool kSanitizerBuild = false;
 #endif
 
+/// True in an AddressSanitizer build: freed blocks wait in ASan's quarantine
+/// (256 MiB by default) instead of going back to the allocator, so resident
+/// memory after an abuse says nothing about leaks or unbounded queues there
+/// (ASan's own leak check does, at exit).
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizerBuild = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSanitizerBuild = true;
+#else
+inline constexpr bool kAddressSanitizerBuild = false;
+#endif
+#else
+inline constexpr bool kAddressSanitizerBuild = false;
+#endif
+
 /// Raises this process's open-file soft limit to the hard limit (for a
 /// thousand sockets at once); processes started earlier keep theirs.
 inline void raise_file_limit() {

@@ -300,7 +300,11 @@ class Abuse : public ::testing::TestWithParam<Car> {
     }
     std::cout << "[ figures  ] " << car().name << " " << what << ": VmRSS " << rss_before_kib_
               << " KiB before, " << rss_after_kib << " KiB after\n";
-    EXPECT_LE(rss_after_kib, rss_before_kib_ + kRssBoundKib) << what;
+    // The memory bound holds in the default and TSan builds; under ASan the
+    // quarantine keeps freed blocks resident (kAddressSanitizerBuild).
+    if (!kAddressSanitizerBuild) {
+      EXPECT_LE(rss_after_kib, rss_before_kib_ + kRssBoundKib) << what;
+    }
   }
 
   std::unique_ptr<Target> target_;
@@ -384,7 +388,9 @@ TEST_P(Abuse, FramesAtAndPastTheLengthLimit) {
     // Leka's 128-byte buffer takes one full frame per loop pass.
     if (car().name == "leka") std::this_thread::sleep_for(50ms);
   }
-  if (valid_after) ASSERT_TRUE(c.send(car().valid(9)));
+  if (valid_after) {
+    ASSERT_TRUE(c.send(car().valid(9)));
+  }
   const auto count_answers = [&] {
     int n = 0;
     for (std::size_t at = c.received.find(car().answer); at != std::string::npos;
