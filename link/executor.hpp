@@ -5,9 +5,9 @@
 
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "link/time.hpp"
 
@@ -49,14 +49,42 @@ class VirtualExecutor final : public Executor {
   std::size_t run_until_idle(std::size_t max_tasks = 10'000'000);
 
   std::optional<Time> next_due() const;
-  std::size_t pending() const { return queue_.size(); }
+  std::size_t pending() const { return live_; }
 
  private:
-  // Key: (time, sequence) so equal times keep scheduling order.
-  std::map<std::pair<Time, TimerId>, Task> queue_;
-  std::map<TimerId, Time> due_;  // for cancel
+  // A binary min-heap of (time, sequence) entries, so equal times keep
+  // scheduling order, over a table of task slots reused through a free
+  // list: scheduling and running a task allocate nothing of their own
+  // (the Task may). A TimerId is the slot and its generation; cancelling
+  // empties the slot at once and leaves the heap entry to be skipped when
+  // it comes up, or dropped when such stale entries outnumber live ones.
+  struct Entry {
+    Time at;
+    std::uint64_t seq;
+    std::uint32_t slot;
+    std::uint32_t generation;
+  };
+  struct Slot {
+    Task task;
+    std::uint32_t generation = 1;
+    bool pending = false;
+  };
+  static bool later(const Entry& a, const Entry& b) {
+    return a.at != b.at ? a.at > b.at : a.seq > b.seq;
+  }
+  bool stale(const Entry& e) const {
+    const Slot& s = slots_[e.slot];
+    return !s.pending || s.generation != e.generation;
+  }
+  void drop_stale_top() const;
+  void release(std::uint32_t slot);
+
+  mutable std::vector<Entry> heap_;
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> free_;
+  std::size_t live_ = 0;
   Time now_{0};
-  TimerId next_id_ = 1;
+  std::uint64_t next_seq_ = 0;
 };
 
 }  // namespace hil::link
