@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdint>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -113,16 +114,31 @@ void RunTimeline::add(Source source, std::string kind, nlohmann::json data) {
 
 void RunTimeline::add_at(Time at, Source source, std::string kind, nlohmann::json data) {
   if (closed_) return;
+  if (dispatching_) {
+    // The record a listener holds lives in the timeline's vector, which
+    // this would move; and the order of records would no longer be the
+    // order things happened in.
+    throw std::logic_error("a timeline listener added a '" + kind +
+                           "' record itself; it must post that work instead");
+  }
   timeline_.add(at, source, std::move(kind), std::move(data));
   if (listeners_.empty()) return;
-  // A copy of the record and of the listener list: listeners may come and go
-  // while they run, and the timeline may grow.
-  const Record record = timeline_.records().back();
-  std::vector<std::pair<ListenerId, std::shared_ptr<Listener>>> now(listeners_.begin(),
-                                                                    listeners_.end());
-  for (const auto& [id, listener] : now) {
-    if (listeners_.count(id) != 0) (*listener)(record);
+  // Listeners may come and go while they run: each one listening when the
+  // record came is told, unless it has gone by its turn.
+  const Record& record = timeline_.records().back();
+  snapshot_.assign(listeners_.begin(), listeners_.end());
+  dispatching_ = true;
+  try {
+    for (const auto& [id, listener] : snapshot_) {
+      if (listeners_.count(id) != 0) (*listener)(record);
+    }
+  } catch (...) {
+    dispatching_ = false;
+    snapshot_.clear();
+    throw;
   }
+  dispatching_ = false;
+  snapshot_.clear();
 }
 
 RunTimeline::ListenerId RunTimeline::listen(Listener listener) {

@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "harness/timeline.hpp"
 #include "link/link.hpp"
@@ -46,8 +48,9 @@ class RunTimeline {
               nlohmann::json data = nlohmann::json::object());
 
   /// Listeners see each record after it is in the timeline. They may add
-  /// and remove listeners, but should not add records themselves (post
-  /// the work instead), so records keep the order things happened in.
+  /// and remove listeners, but must not add records themselves (post the
+  /// work instead), so records keep the order things happened in; a record
+  /// added from a listener throws std::logic_error.
   ListenerId listen(Listener listener);
   void unlisten(ListenerId id);
 
@@ -62,8 +65,11 @@ class RunTimeline {
   const link::Clock& clock_;
   Timeline timeline_;
   std::map<ListenerId, std::shared_ptr<Listener>> listeners_;
+  // The listeners of the record being told, kept to reuse its storage.
+  std::vector<std::pair<ListenerId, std::shared_ptr<Listener>>> snapshot_;
   ListenerId next_id_ = 1;
   bool closed_ = false;
+  bool dispatching_ = false;
 };
 
 /// Watches a link and writes what crosses it to the timeline: one wire

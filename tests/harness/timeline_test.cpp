@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "harness/timeline.hpp"
 #include "harness/timeline_recorder.hpp"
@@ -93,6 +95,44 @@ std::vector<Record> frames_of(const std::string& protocol, link::Direction dir,
 
 protocol::Bytes text_bytes(const std::string& text) {
   return protocol::to_bytes(text);
+}
+
+TEST(RunTimelineListeners, EachListenerSeesEachRecordOnceAndMayLeaveOrJoinWhileTold) {
+  StillClock clock;
+  RunTimeline timeline(clock);
+  std::vector<std::string> seen;
+  RunTimeline::ListenerId second = 0;
+  RunTimeline::ListenerId joined = 0;
+  const auto first = timeline.listen([&](const Record& r) {
+    seen.push_back("first " + r.kind);
+    // The first record makes the second listener leave before its turn and a
+    // third one join, which hears only the records after it.
+    if (r.kind == "a") {
+      timeline.unlisten(second);
+      joined = timeline.listen([&](const Record& r2) { seen.push_back("joined " + r2.kind); });
+    }
+  });
+  second = timeline.listen([&](const Record& r) { seen.push_back("second " + r.kind); });
+  timeline.add(Source::step, "a");
+  timeline.add(Source::step, "b");
+  EXPECT_EQ(seen, (std::vector<std::string>{"first a", "first b", "joined b"}));
+  EXPECT_EQ(timeline.timeline().size(), 2u);
+  timeline.unlisten(first);
+  timeline.unlisten(joined);
+}
+
+TEST(RunTimelineListeners, AListenerThatAddsARecordItselfIsRefusedAndTheTimelineGoesOn) {
+  StillClock clock;
+  RunTimeline timeline(clock);
+  const auto id = timeline.listen([&](const Record& r) {
+    if (r.kind == "a") timeline.add(Source::step, "echo");
+  });
+  EXPECT_THROW(timeline.add(Source::step, "a"), std::logic_error);
+  timeline.unlisten(id);
+  timeline.add(Source::step, "b");
+  ASSERT_EQ(timeline.timeline().size(), 2u);
+  EXPECT_EQ(timeline.timeline().records()[0].kind, "a");
+  EXPECT_EQ(timeline.timeline().records()[1].kind, "b");
 }
 
 TEST(WireRecorderFields, EachProtocolsDecodedFieldsAreInTheFrameRecord) {
