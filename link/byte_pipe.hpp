@@ -52,6 +52,21 @@ class BytePipe {
   virtual void set_send_limit(std::size_t /*bytes*/) {}
   /// Bytes written but not yet handed to the operating system / the peer.
   virtual std::size_t queued_bytes() const = 0;
+  /// Flow control for a relay (a link between two pipes): pause_reading()
+  /// stops taking bytes from the peer, so the operating system's buffers
+  /// fill and the peer's sends slow down as they would on a direct
+  /// connection, until resume_reading(). While paused the end of the
+  /// stream is seen only once reading resumes. Pipes that take nothing
+  /// from an operating system (in-memory ones) ignore both.
+  virtual void pause_reading() {}
+  virtual void resume_reading() {}
+  /// Calls `callback` once, on the pipe's executor, when queued_bytes()
+  /// has fallen to `bytes` or below; a later call replaces a waiting one,
+  /// and a closed pipe never calls it. Pipes without a backlog of their
+  /// own call it at once.
+  virtual void when_drained_to(std::size_t /*bytes*/, std::function<void()> callback) {
+    if (callback) callback();
+  }
   /// For logs: "tcp 127.0.0.1:9000 <- 127.0.0.1:53422", "mem car0", ...
   virtual std::string describe() const = 0;
 };

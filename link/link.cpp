@@ -121,6 +121,7 @@ void Link::pump(Direction d) {
       return;
     }
   }
+  hold_back_if_full(d);
   if (draining_[index(d)] && !injectors_[index(d)]->next_due()) {
     shut(LinkClose{side_of(d), CloseMode::graceful, side_name(d) + " closed"});
     return;
@@ -144,6 +145,24 @@ void Link::schedule(Direction d) {
       self->timers_[index(d)] = 0;
       self->pump(d);
     }
+  });
+}
+
+void Link::hold_back_if_full(Direction d) {
+  BytePipe& receiver = *pipes_[index(d)];
+  if (held_back_[index(d)] || receiver.queued_bytes() <= kLinkHighWaterBytes) return;
+  // pipes_ is indexed by the direction a pipe receives: the sender of d's
+  // bytes is the other pipe.
+  const Direction other = d == Direction::to_car ? Direction::to_client : Direction::to_car;
+  held_back_[index(d)] = true;
+  ++stats_.holds[index(d)];
+  pipes_[index(other)]->pause_reading();
+  std::weak_ptr<Link> weak = weak_from_this();
+  receiver.when_drained_to(kLinkLowWaterBytes, [weak, d, other] {
+    const auto self = weak.lock();
+    if (!self || !self->held_back_[index(d)]) return;
+    self->held_back_[index(d)] = false;
+    if (self->open_) self->pipes_[index(other)]->resume_reading();
   });
 }
 

@@ -58,7 +58,17 @@ struct LinkStats {
   std::uint64_t bytes_sent[2] = {0, 0};       ///< indexed by Direction
   std::uint64_t bytes_delivered[2] = {0, 0};  ///< indexed by Direction
   std::uint64_t faults = 0;
+  std::uint64_t holds[2] = {0, 0};  ///< times the sender was held back (flow control)
 };
+
+/// Flow control between a link's two pipes: once the pipe a direction
+/// writes to holds more than kLinkHighWaterBytes not yet taken by its peer,
+/// the link stops reading the pipe that sends in that direction, and reads
+/// it again when the backlog is down to kLinkLowWaterBytes. A fast sender
+/// is then slowed to its receiver's pace, as on a direct connection,
+/// instead of growing a queue until the send limit drops the receiver.
+inline constexpr std::size_t kLinkHighWaterBytes = std::size_t{256} << 10;
+inline constexpr std::size_t kLinkLowWaterBytes = std::size_t{64} << 10;
 
 class Link : public std::enable_shared_from_this<Link> {
  public:
@@ -82,6 +92,7 @@ class Link : public std::enable_shared_from_this<Link> {
   void on_side_closed(Direction from, std::error_code ec);
   void pump(Direction d);
   void schedule(Direction d);
+  void hold_back_if_full(Direction d);
   void shut(LinkClose close);
 
   Executor& executor_;
@@ -89,7 +100,8 @@ class Link : public std::enable_shared_from_this<Link> {
   std::unique_ptr<FaultInjector> injectors_[2];
   Executor::TimerId timers_[2] = {0, 0};
   Time timer_due_[2] = {Time{-1}, Time{-1}};
-  bool draining_[2] = {false, false};  // the sender of that direction has closed
+  bool draining_[2] = {false, false};   // the sender of that direction has closed
+  bool held_back_[2] = {false, false};  // that direction's sender is not being read
   std::vector<std::shared_ptr<LinkObserver>> observers_;
   LinkStats stats_;
   bool open_ = false;

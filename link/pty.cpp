@@ -9,6 +9,7 @@
 #include <array>
 #include <cerrno>
 #include <climits>
+#include <functional>
 #include <system_error>
 #include <utility>
 
@@ -246,6 +247,22 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   std::size_t queued_bytes() const override { return tx_.queued() + os_queued_; }
   std::string describe() const override { return description_; }
 
+  void pause_reading() override { paused_ = true; }
+  void resume_reading() override {
+    if (!paused_) return;
+    paused_ = false;
+    if (state_ == State::open && !reading_) read_when_room();
+  }
+  void when_drained_to(std::size_t bytes, std::function<void()> callback) override {
+    if (state_ == State::closed || !callback) return;
+    if (queued_bytes() <= bytes) {
+      executor_.post(std::move(callback));
+      return;
+    }
+    drain_to_ = bytes;
+    on_drained_ = std::move(callback);
+  }
+
   std::uint64_t bytes_lost() const { return lost_; }
 
   /// The owner is going away: end now without waiting for anything.
@@ -277,12 +294,13 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   /// pty is left unread (the client's writes block, as on a real port)
   /// until they have gone through, so a fast writer cannot grow memory.
   void read_when_room() {
+    if (paused_) return;  // resume_reading() reads again
     if (rx_.queued() <= kMaxPacedInputBytes) {
       read();
       return;
     }
     rx_.when_drained([self = shared_from_this()] {
-      if (self->state_ == State::open && !self->reading_) self->read();
+      if (self->state_ == State::open && !self->reading_ && !self->paused_) self->read();
     });
   }
 
@@ -358,6 +376,8 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
     }
     os_queued_ -= os_queue_.front().size();
     os_queue_.pop_front();
+    if (on_drained_ && queued_bytes() <= drain_to_) std::exchange(on_drained_, nullptr)();
+    if (state_ != State::open && state_ != State::flushing) return;
     if (!os_queue_.empty()) {
       write_os();
     } else {
@@ -373,6 +393,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
 
   /// Stops using the descriptor and hands it back to the owner.
   void end_session(bool client_gone) {
+    on_drained_ = nullptr;
     tx_.clear();
     // Safe while a write is pending: cancel() runs on this thread, so no
     // more of that buffer is written once it returns.
@@ -411,13 +432,16 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   bool reading_ = false;
   bool writing_ = false;
   bool close_notified_ = false;
+  bool paused_ = false;  // pause_reading(): the pty is left unread
   std::uint64_t lost_ = 0;
   std::array<std::uint8_t, 4096> buffer_{};
   std::deque<Bytes> os_queue_;
   std::size_t os_queued_ = 0;
   std::size_t send_limit_ = 0;  // 0: no cap
-  SerialPacer tx_;              // device -> client
-  SerialPacer rx_;              // client -> device
+  std::size_t drain_to_ = 0;    // when_drained_to(): the level, and whom to tell
+  std::function<void()> on_drained_;
+  SerialPacer tx_;  // device -> client
+  SerialPacer rx_;  // client -> device
 };
 
 /// Points `link` at `target`, replacing an old symlink atomically (rename)

@@ -3,6 +3,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -82,6 +83,22 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   std::size_t queued_bytes() const override { return queued_; }
   std::string describe() const override { return description_; }
 
+  void pause_reading() override { paused_ = true; }
+  void resume_reading() override {
+    if (!paused_) return;
+    paused_ = false;
+    if (state_ == State::open && !reading_) read();
+  }
+  void when_drained_to(std::size_t bytes, std::function<void()> callback) override {
+    if (state_ == State::closed || !callback) return;
+    if (queued_ <= bytes) {
+      asio::post(socket_.get_executor(), std::move(callback));
+      return;
+    }
+    drain_to_ = bytes;
+    on_drained_ = std::move(callback);
+  }
+
  private:
   enum class State : std::uint8_t {
     open,
@@ -112,6 +129,12 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     socket_.async_wait(tcp::socket::wait_read, [self = shared_from_this()](std::error_code ec) {
       if (ec) {
         self->on_read(ec, 0);
+        return;
+      }
+      if (self->paused_ && self->state_ == State::open) {
+        // Readable, but the relay is holding this peer back: leave the
+        // bytes in the kernel until resume_reading().
+        self->reading_ = false;
         return;
       }
       std::error_code read_ec;
@@ -188,6 +211,8 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
       queued_ -= queue_.front().size();
       queue_.pop_front();
     }
+    if (on_drained_ && queued_ <= drain_to_) std::exchange(on_drained_, nullptr)();
+    if (state_ == State::closed) return;
     if (!queue_.empty()) {
       write_queued();
     } else if (state_ == State::flushing) {
@@ -211,6 +236,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     state_ = State::closed;
     queue_.clear();
     queued_ = 0;
+    on_drained_ = nullptr;
   }
 
   void notify_close(std::error_code ec) {
@@ -232,11 +258,14 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   bool writing_ = false;
   bool peer_done_ = false;
   bool close_notified_ = false;
+  bool paused_ = false;  // pause_reading(): readable input stays in the kernel
   // A deque keeps each queued buffer in place while an async_write uses it.
   std::deque<Bytes> queue_;
   std::size_t in_flight_ = 0;  // queue_ entries the current async_write covers
   std::size_t queued_ = 0;
   std::size_t send_limit_ = 0;  // 0: no cap
+  std::size_t drain_to_ = 0;    // when_drained_to(): the level, and whom to tell
+  std::function<void()> on_drained_;
 };
 
 tcp::endpoint resolve_for_listen(asio::io_context& io, const TcpEndpoint& endpoint,

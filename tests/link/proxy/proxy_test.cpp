@@ -7,6 +7,8 @@
 #include <asio/io_context.hpp>
 #include <filesystem>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "link/asio_executor.hpp"
 #include "link/capture/wire_log.hpp"
@@ -106,6 +108,52 @@ TEST_F(ProxyTest, TcpToTcpCarriesBothDirections) {
   EXPECT_EQ(client.received, "LOGI:SP:050:D7#LOGI:MV:FWD:23#");
   EXPECT_EQ(proxy.links_opened(), 1u);
   EXPECT_EQ(proxy.open_links(), 1u);
+}
+
+// A client that writes far faster than the car reads: the proxy holds the
+// client back (it stops reading it) instead of queueing for the car until
+// the send limit drops the car, and every byte arrives, in order.
+TEST_F(ProxyTest, AFastClientIsHeldBackForASlowCarAndNothingIsLostOrDropped) {
+  // The car reads nothing for half a second, then everything.
+  std::unique_ptr<Listener> car = listen(ctx, parse_endpoint("tcp://127.0.0.1:0"));
+  BytePipePtr car_pipe;
+  std::string at_car;
+  car->start([&](BytePipePtr p) {
+    car_pipe = p;
+    p->pause_reading();
+    p->start({[&](ByteView b) { at_car.append(b.begin(), b.end()); }, [](std::error_code) {}});
+  });
+  ProxyOptions o;
+  o.listen = parse_endpoint("tcp://127.0.0.1:0");
+  o.upstream = parse_endpoint(car->address());
+  o.protocol = protocol_adapter("raw");
+  std::vector<std::string> log;
+  o.log = [&](const std::string& line) { log.push_back(line); };
+  Proxy proxy(ctx, o);
+  proxy.start();
+
+  // 64 MiB: more than the kernel's socket buffers on both sides of the
+  // proxy take, and 64 times the send limit that would drop the car.
+  std::string sent(64 << 20, '\0');
+  for (std::size_t i = 0; i < sent.size(); ++i)
+    sent[i] = static_cast<char>(i % 251);
+  Client client;
+  client.connect_to(ctx, proxy.address());
+  ASSERT_TRUE(run_until([&] { return client.connected && car_pipe != nullptr; }));
+  client.pipe->write(to_bytes(sent));
+  settle(std::chrono::milliseconds(500));
+  EXPECT_TRUE(at_car.empty());
+  EXPECT_EQ(proxy.open_links(), 1u);
+  EXPECT_FALSE(client.closed.has_value());
+
+  car_pipe->resume_reading();
+  ASSERT_TRUE(run_until([&] { return at_car.size() >= sent.size(); }))
+      << at_car.size() << " of " << sent.size() << " bytes reached the car";
+  EXPECT_TRUE(at_car == sent) << "the bytes arrived changed or out of order";
+  EXPECT_EQ(proxy.open_links(), 1u);
+  EXPECT_FALSE(client.closed.has_value());
+  for (const auto& line : log)
+    EXPECT_EQ(line.find("dropped"), std::string::npos) << line;
 }
 
 TEST_F(ProxyTest, FaultRulesActOnFramesOfTheNamedKind) {

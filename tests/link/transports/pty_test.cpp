@@ -138,6 +138,56 @@ TEST_F(PtyTest, BytesFlowBothWaysThroughTheSymlink) {
   EXPECT_NE(device.sessions[0]->describe().find(path), std::string::npos);
 }
 
+// Flow control for a relay: a paused session leaves what the client writes
+// in the pty until it resumes, and then delivers all of it, in order.
+TEST_F(PtyTest, APausedSessionLeavesTheClientsBytesUnreadUntilResumed) {
+  Device device(io, ex, path);
+  Client client(io, ex, path);
+  client.write("first\n");
+  ASSERT_TRUE(test::run_until(io, [&] { return device.text() == "first\n"; })) << device.text();
+  ASSERT_EQ(device.sessions.size(), 1u);
+  device.sessions[0]->pause_reading();
+  // A read already waiting may still take one piece; after that, nothing.
+  client.write("second\n");
+  test::run_for(io, std::chrono::milliseconds(100));
+  const std::size_t taken = device.data.size();
+  client.write("third\n");
+  test::run_for(io, std::chrono::milliseconds(300));
+  EXPECT_EQ(device.data.size(), taken) << device.text();
+  device.sessions[0]->resume_reading();
+  ASSERT_TRUE(test::run_until(io, [&] { return device.text() == "first\nsecond\nthird\n"; }))
+      << device.text();
+}
+
+// when_drained_to tells once the paced backlog has gone down to the level.
+TEST_F(PtyTest, WhenDrainedToTellsOnceTheBacklogIsDown) {
+  PtyOptions options;
+  options.baud = 9600;  // about 1 ms a byte
+  Device device(io, ex, path, options);
+  Client client(io, ex, path);
+  ASSERT_TRUE(test::run_until(io, [&] { return device.sessions.size() == 1; }));
+  BytePipe& session = *device.sessions[0];
+  session.write(Bytes(300, 'x'));
+  EXPECT_GT(session.queued_bytes(), 100u);
+  int told = 0;
+  std::size_t backlog_when_told = 0;
+  const Time asked = ex.now();
+  session.when_drained_to(100, [&] {
+    ++told;
+    backlog_when_told = session.queued_bytes();
+  });
+  ASSERT_TRUE(test::run_until(io, [&] { return told > 0; }));
+  EXPECT_LE(backlog_when_told, 100u);
+  // About 200 bytes at 1.04 ms each had to go first.
+  EXPECT_GE(ex.now() - asked, milliseconds(150));
+  ASSERT_TRUE(test::run_until(io, [&] { return client.data.size() == 300; }));
+  EXPECT_EQ(told, 1);
+  // Already down to the level: told at once (posted, not inside the call).
+  session.when_drained_to(0, [&] { ++told; });
+  EXPECT_EQ(told, 1);
+  ASSERT_TRUE(test::run_until(io, [&] { return told == 2; }));
+}
+
 TEST_F(PtyTest, ClientOpenIsNoticedWithinAFewPollPeriods) {
   Device device(io, ex, path);
   Time accepted{-1};
