@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <stdexcept>
 #include <utility>
+#include <variant>
+
+#include "link/capture/wire_log.hpp"
 
 namespace hil::client::wr8 {
 
@@ -65,6 +68,22 @@ proto::DecoderOptions decoder_options(const proto::Profile& profile) {
 
 bool is_final(RequestState s) {
   return s != RequestState::sent && s != RequestState::started;
+}
+
+// What the log shows of a packet the client sends. Logs end up in bug
+// reports, so an AUTH never shows its string: its type byte stays, each
+// byte of the string reads "**", and the text is masked as the mock's wire
+// log masks it.
+LogEntry tx_entry(Time now, const proto::Message& message, protocol::ByteView bytes,
+                  const proto::Profile& profile) {
+  std::string description = proto::describe(message, profile);
+  if (!std::holds_alternative<proto::Auth>(message) || bytes.empty())
+    return {now, LogKind::tx, protocol::to_hex(bytes), std::move(description)};
+  std::string raw = protocol::to_hex(bytes.first(1));
+  for (std::size_t i = 1; i < bytes.size(); ++i)
+    raw += " **";
+  return {now, LogKind::tx, std::move(raw),
+          link::masked_frame_text("AUTH", std::move(description))};
 }
 
 }  // namespace
@@ -304,7 +323,7 @@ double Wr8ClientCore::value_of(const proto::DataValue& v) const {
 
 void Wr8ClientCore::send(Time now, const proto::Message& message) {
   protocol::Bytes bytes = proto::encode(message, config_.profile);
-  log_->add({now, LogKind::tx, protocol::to_hex(bytes), proto::describe(message, config_.profile)});
+  log_->add(tx_entry(now, message, bytes, config_.profile));
   actions_.push_back(SendBytes{std::move(bytes)});
 }
 
@@ -330,7 +349,7 @@ SubmitResult Wr8ClientCore::send_request(Time now, RequestKind kind, proto::Task
   } catch (const std::invalid_argument&) {
     return {0, Refusal::bad_request};
   }
-  log_->add({now, LogKind::tx, protocol::to_hex(bytes), proto::describe(m, config_.profile)});
+  log_->add(tx_entry(now, m, bytes, config_.profile));
   actions_.push_back(SendBytes{std::move(bytes)});
   next_coi_ = static_cast<std::uint8_t>(*coi + 1);
   pending_[*coi] = Pending{kind, task, false, now + config_.answer_timeout};

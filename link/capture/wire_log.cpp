@@ -61,6 +61,10 @@ void put_bytes_into(Json& record, protocol::ByteView bytes) {
 
 std::string masked_frame_text(std::string_view kind, std::string text) {
   if (kind != "AUTH" || text.empty()) return text;
+  // Already masked (a log read back and written again): as it is.
+  if (text.find("text=**********") != std::string::npos &&
+      text.find("text=\"") == std::string::npos)
+    return text;
   // 'Auth text="..." (profile string)': keep the verdict, hide the string.
   const auto open = text.find("text=\"");
   const auto close = text.rfind('"');

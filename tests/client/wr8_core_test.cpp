@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -303,15 +304,41 @@ TEST(Wr8ClientCore, ALostConnectionCancelsOpenRequests) {
 
 TEST(Wr8ClientCore, TheLogExportsTxAndRxAsHexInTextCsvAndNdjson) {
   auto core = logged_in();
+  ASSERT_TRUE(core.drive(milliseconds(10), 100));
+  const auto out = sent(core.take_actions());
+  ASSERT_EQ(out.size(), 1u);
+  const std::string task = protocol::to_hex(out[0]);
   const std::string text = core.log()->export_text();
-  EXPECT_NE(text.find("TX   01 48 49 4C 2D 57 52 38 2D 30 31"), std::string::npos) << text;
+  EXPECT_NE(text.find("TX   " + task), std::string::npos) << text;
   EXPECT_NE(text.find("RX   02 08 01 02"), std::string::npos) << text;
   const std::string csv = core.log()->export_csv();
   EXPECT_EQ(csv.rfind("time_ms,kind,raw,description\r\n", 0), 0u);
-  EXPECT_NE(csv.find("0.000,TX,\"01 48 49"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("10.000,TX,\"" + task + "\""), std::string::npos) << csv;
   const std::string nd = core.log()->export_ndjson();
   EXPECT_NE(nd.find("\"kind\":\"RX\""), std::string::npos) << nd;
   EXPECT_NE(nd.find("\"raw\":\"02 08 01 02\""), std::string::npos) << nd;
+}
+
+TEST(Wr8ClientCore, TheLogNeverShowsTheAuthenticationString) {
+  // The string in text and in hex ("HIL-WR8-01" is 48 49 4C 2D 57 52 38 2D 30 31),
+  // in every export; what was sent on the wire is the whole string.
+  ClientConfig config;
+  const std::string secret = "SECRET-042";
+  ASSERT_EQ(secret.size(), config.profile.auth_text.size());
+  std::copy(secret.begin(), secret.end(), config.profile.auth_text.begin());
+  auto core = logged_in(config);
+  const std::string hex = "53 45 43 52 45 54 2D 30 34 32";
+  for (const std::string& out :
+       {core.log()->export_text(), core.log()->export_csv(), core.log()->export_ndjson()}) {
+    EXPECT_EQ(out.find(secret), std::string::npos) << out;
+    EXPECT_EQ(out.find(hex), std::string::npos) << out;
+  }
+  const auto log = core.log()->snapshot();
+  const auto auth =
+      std::find_if(log.begin(), log.end(), [](const LogEntry& e) { return e.kind == LogKind::tx; });
+  ASSERT_NE(auth, log.end());
+  EXPECT_EQ(auth->raw, "01 ** ** ** ** ** ** ** ** ** **");
+  EXPECT_EQ(auth->description, "Auth text=********** (profile string)");
 }
 
 }  // namespace

@@ -49,6 +49,10 @@ TEST(WireLogSecrets, OnlyAuthTextsAreMasked) {
             "Auth text=********** (profile string)");
   EXPECT_EQ(masked_frame_text("AUTH", "odd text"), "Auth text=**********");
   EXPECT_EQ(masked_frame_text("AUTH", ""), "");
+  // Masking what is masked changes nothing.
+  EXPECT_EQ(masked_frame_text("AUTH", "Auth text=********** (profile string)"),
+            "Auth text=********** (profile string)");
+  EXPECT_EQ(masked_frame_text("AUTH", "Auth text=**********"), "Auth text=**********");
 }
 
 }  // namespace
