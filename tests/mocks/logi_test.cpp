@@ -198,6 +198,37 @@ TEST(LogiFirmware, StatComesEvery500MsOnTheGridWhileConnected) {
   EXPECT_EQ(b.decode_errors(), 0u);
 }
 
+TEST(LogiFirmware, ABootOffsetShiftsTheStatAndControlGridsByItself) {
+  // A car switched on 137 ms in: STAT at 137 + k * 500 ms, and the control
+  // loop, while it has work, at 137 + k * 10 ms; nothing at the zero grid.
+  LogiConfig config;
+  config.boot_offset = link::milliseconds(137);
+  Bench b(config);  // connected at 0
+  b.run_until(at_ms(137) - link::Duration(1));
+  EXPECT_TRUE(b.stats().empty());
+  b.run_until(at_ms(2000));
+  const auto stats = b.stats();
+  ASSERT_EQ(stats.size(), 4u);
+  for (std::size_t i = 0; i < stats.size(); ++i)
+    EXPECT_EQ(stats[i].first, at_ms(137 + 500 * static_cast<int>(i)));
+  // Driving, the control loop wakes on its own grid, offset alike.
+  ASSERT_EQ(b.ask("MD:MAN"), "FB:MD:1");
+  ASSERT_EQ(b.ask("MV:FWD"), "FB:MV:1");
+  const auto wake = b.fw().next_wakeup();
+  ASSERT_TRUE(wake.has_value());
+  EXPECT_EQ((*wake - at_ms(137)) % link::milliseconds(10), link::Duration::zero())
+      << link::to_ms(*wake) << " ms";
+  EXPECT_EQ(b.decode_errors(), 0u);
+}
+
+TEST(LogiFirmware, ABootOffsetOutsideOneStatPeriodIsRefused) {
+  LogiConfig config;
+  config.boot_offset = link::milliseconds(501);
+  EXPECT_THROW(Bench{config}, std::invalid_argument);
+  config.boot_offset = link::milliseconds(-1);
+  EXPECT_THROW(Bench{config}, std::invalid_argument);
+}
+
 TEST(LogiFirmware, AClientConnectingBetweenGridPointsGetsItsFirstStatAtTheNextOne) {
   Bench b;
   b.client().pipe->close();
