@@ -51,9 +51,9 @@ namespace hil::client::arduino {
 namespace {
 
 namespace proto = protocol::arduino;
+using hil::test::RandomFaults;
 using link::milliseconds;
 using link::seconds;
-using hil::test::RandomFaults;
 
 // ---------------------------------------------------------------------------
 // The core against a scripted robot: one request, each frame it sends meets
@@ -359,6 +359,10 @@ struct ArduinoRig {
   /// counted at each link change.
   std::vector<std::uint64_t> turned_away;
   std::vector<Time> operator_opens{Time{0}};  ///< when the operator opened the port
+  /// How many frames the session had logged when the operator opened the
+  /// port, one per entry of operator_opens: orders that open against frames
+  /// of the same instant.
+  std::vector<std::size_t> logged_at_operator_open{0};
   test::VirtualCar<mocks::ArduinoFirmware> car;
   std::unique_ptr<ArduinoSession> session;
 };
@@ -477,10 +481,19 @@ std::vector<Exchange> check_attempt_times(const ArduinoRig& rig,
         down = rig.links[j].to == LinkState::down;
       }
     }
+    // A frame logged after the operator opened the port in the instant the
+    // link went DOWN belongs to the new port, not to the reconnect.
+    auto after_operator_open = [&](std::size_t index, Time at) {
+      for (std::size_t k = 0; k < rig.operator_opens.size(); ++k) {
+        if (rig.operator_opens[k] == at && index >= rig.logged_at_operator_open[k]) return true;
+      }
+      return false;
+    };
     for (auto& x : out) {
       const Time began = wire[x.first].at;
       // The last attempt may fail (and the link go DOWN) in the instant it began.
-      if (began > from && (!to || began < *to || (down && began == *to))) {
+      if (began > from &&
+          (!to || began < *to || (down && began == *to && !after_operator_open(x.first, began)))) {
         RC_ASSERT(std::holds_alternative<proto::Ping>(wire[x.first].message->body));
         x.reconnect_check = true;
       }
@@ -821,6 +834,7 @@ struct OperatorToggles : ArduinoCommand {
         RC_ASSERT(rig.done[i].result.code == ResultCode::link_down);
     } else {
       rig.operator_opens.push_back(rig.now());
+      rig.logged_at_operator_open.push_back(rig.session->log().entries().size());
       rig.session->open();
       rig.car.executor.run_for(Duration::zero());
       if (model.closed || before == LinkState::down) {
