@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string_view>
@@ -13,6 +14,40 @@
 
 namespace hil::sim {
 namespace {
+
+// The length of the UTF-8 sequence starting at `i` and its code point, or
+// 0 when the bytes there are not valid UTF-8.
+std::size_t utf8_at(std::string_view s, std::size_t i, char32_t& cp) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[i + k]); };
+  const unsigned char c = b(0);
+  std::size_t n = 0;
+  if (c < 0x80) {
+    cp = c;
+    return 1;
+  }
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+    cp = c & 0x1F;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    cp = c & 0x0F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    cp = c & 0x07;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    if ((b(k) & 0xC0) != 0x80) return 0;
+    cp = (cp << 6) | (b(k) & 0x3F);
+  }
+  // Overlong forms, surrogates and values past U+10FFFF are not characters.
+  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
+      (cp >= 0xD800 && cp <= 0xDFFF))
+    return 0;
+  return n;
+}
 
 // Colours are fixed so that pictures of different runs compare at a glance.
 constexpr std::string_view kPaper = "#ffffff";
@@ -70,40 +105,6 @@ std::string seconds_text(Duration d) {
   std::string text(buf.data(), result.ptr);
   if (text == "-0.0") text = "0.0";
   return text + " s";
-}
-
-/// Text as XML character data or attribute value. Control characters are
-/// not allowed in XML 1.0 at all, so they are dropped rather than escaped.
-std::string escape_xml(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      case '\t':
-      case '\n':
-      case '\r':
-        out += ' ';
-        break;
-      default:
-        if (static_cast<unsigned char>(c) >= 0x20) out += c;
-    }
-  }
-  return out;
 }
 
 /// Width of `text` in a sans-serif face, estimated per character (in ems,
@@ -405,7 +406,7 @@ class LabelPlacer {
     const char* anchor = k.anchor == 's' ? "start" : (k.anchor == 'm' ? "middle" : "end");
     out += "<text class=\"" + r.css_class + " halo\" x=\"" + num(k.x) + "\" y=\"" +
            num(k.baseline) + "\" text-anchor=\"" + anchor + "\" fill=\"" + r.colour + "\">" +
-           escape_xml(r.text) + "</text>\n";
+           xml_escape(r.text) + "</text>\n";
   }
 
   Rect bounds_;
@@ -471,7 +472,7 @@ class Renderer {
            "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\" font-size=\"" +
            num(kLabelFontPx) + "\">\n";
     const std::string doc_title = !options_.title.empty() ? options_.title : arena_.name;
-    if (!doc_title.empty()) out += "<title>" + escape_xml(doc_title) + "</title>\n";
+    if (!doc_title.empty()) out += "<title>" + xml_escape(doc_title) + "</title>\n";
     // A white outline behind every label keeps it legible over tape and paths.
     out +=
         "<style>.halo{paint-order:stroke;stroke:#ffffff;stroke-width:3.5px;"
@@ -482,7 +483,7 @@ class Renderer {
       out += "<text class=\"title\" x=\"" + num(canvas_w_ / 2) + "\" y=\"" +
              num(kPadPx + kTitleFontPx) + "\" text-anchor=\"middle\" font-size=\"" +
              num(kTitleFontPx) + "\" font-weight=\"bold\" fill=\"" + std::string(kText) + "\">" +
-             escape_xml(options_.title) + "</text>\n";
+             xml_escape(options_.title) + "</text>\n";
     }
 
     // Labels stay on the floor, off the walls and axes.
@@ -620,7 +621,7 @@ class Renderer {
               shape_w_px = 2 * o.radius_m * ppm_;
               half_px = o.radius_m * ppm_;
             }
-            out += "<title>" + escape_xml(o.name) + "</title>";
+            out += "<title>" + xml_escape(o.name) + "</title>";
             out += std::is_same_v<T, BoxObstacle> ? "</polygon>\n" : "</circle>\n";
             if (!o.name.empty() && finite(o.center_m)) {
               // Inside the shape when it fits, beside it when the shape is small.
@@ -643,7 +644,7 @@ class Renderer {
       out += std::string("<") + element + " class=\"tape\" points=\"" + points_attr(points) +
              "\" fill=\"none\" stroke=\"" + std::string(kTape) + "\" stroke-width=\"" +
              num(stroke) + "\" stroke-linejoin=\"round\" stroke-linecap=\"round\"><title>" +
-             escape_xml(tape.name) + "</title></" + element + ">\n";
+             xml_escape(tape.name) + "</title></" + element + ">\n";
       labels.occupy_line(points, tape.closed, stroke / 2 + 1, kCoverTape);
     }
   }
@@ -658,7 +659,7 @@ class Renderer {
       const double r = tag_radius_px(tag, ppm_);
       out += "<circle class=\"tag\" cx=\"" + num(c.x) + "\" cy=\"" + num(c.y) + "\" r=\"" + num(r) +
              "\" fill=\"" + std::string(kTagFill) + "\" stroke=\"" + std::string(kTagStroke) +
-             "\" stroke-width=\"1.5\"><title>RFID " + escape_xml(tag.id) + "</title></circle>\n";
+             "\" stroke-width=\"1.5\"><title>RFID " + xml_escape(tag.id) + "</title></circle>\n";
       if (finite(tag.position_m)) labels.occupy_around(c, r, kCoverSymbol);
     }
     for (const auto& tag : arena_.tags) {
@@ -692,7 +693,7 @@ class Renderer {
       for (const auto& s : t.samples) {
         if (finite(s.pose.position())) points.push_back(to_px(s.pose.position()));
       }
-      out += "<g class=\"trajectory\" data-vehicle=\"" + escape_xml(t.vehicle) + "\">";
+      out += "<g class=\"trajectory\" data-vehicle=\"" + xml_escape(t.vehicle) + "\">";
       if (points.size() >= 2) {
         out += "<polyline class=\"path\" points=\"" + points_attr(points) +
                "\" fill=\"none\" stroke=\"" + colour +
@@ -899,7 +900,7 @@ class Renderer {
       if (draw) {
         legend_svg_ += "<text x=\"" + num(x) + "\" y=\"" + num(y + 4) +
                        "\" font-weight=\"bold\" fill=\"" + std::string(kText) + "\">" +
-                       escape_xml(section.heading) + "</text>\n";
+                       xml_escape(section.heading) + "</text>\n";
       }
       x += heading_w;
       for (const auto& e : section.entries) {
@@ -912,7 +913,7 @@ class Renderer {
           legend_svg_ += "<g class=\"legend-entry\" fill=\"none\">" +
                          legend_symbol(e.symbol, {x + kSymbolW / 2, y}) + "</g>";
           legend_svg_ += "<text x=\"" + num(x + kSymbolW + 6) + "\" y=\"" + num(y + 4) +
-                         "\" fill=\"" + std::string(kText) + "\">" + escape_xml(e.text) +
+                         "\" fill=\"" + std::string(kText) + "\">" + xml_escape(e.text) +
                          "</text>\n";
         }
         x += w;
@@ -943,6 +944,48 @@ class Renderer {
 };
 
 }  // namespace
+
+std::string xml_escape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    char32_t cp = 0;
+    const std::size_t n = utf8_at(text, i, cp);
+    if (n == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD for a byte that is not UTF-8
+      ++i;
+      continue;
+    }
+    switch (cp) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        if ((cp < 0x20 && cp != '\t' && cp != '\n' && cp != '\r') || cp == 0xFFFE || cp == 0xFFFF) {
+          // XML 1.0 cannot carry these even as references.
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\x%02X", static_cast<unsigned>(cp & 0xFF));
+          out += buf;
+        } else {
+          out.append(text.substr(i, n));
+        }
+    }
+    i += n;
+  }
+  return out;
+}
 
 std::string render_svg(const Arena& arena, std::span<const Trajectory> trajectories,
                        const SvgOptions& options) {

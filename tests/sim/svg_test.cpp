@@ -318,6 +318,36 @@ TEST(Svg, NamesAreEscapedForXml) {
   EXPECT_EQ(std::regex_search(svg, std::regex("&(?!(amp|lt|gt|quot|#39);)")), false);
 }
 
+// A name typed in a legacy code page (here "Sklad" in Windows-1251) or with
+// a control character must still give a document every XML reader opens.
+TEST(Svg, NamesThatAreNotUtf8OrHoldControlsStillGiveWellFormedXml) {
+  Arena arena;
+  arena.obstacles.push_back(BoxObstacle{"\xD1\xEA\xEB\xE0\xE4", {1.0, 1.0}, 0.4, 0.4, 0});
+  arena.tags.push_back({"bell\x07", {2.0, 1.0}, 0.05});
+  const std::string svg = render_svg(arena, {}, SvgOptions{});
+
+  EXPECT_EQ(tag_balance_problem(svg), "");
+  const std::string replacement = "\xEF\xBF\xBD";
+  EXPECT_NE(svg.find("<title>" + replacement + replacement + replacement + replacement +
+                     replacement + "</title>"),
+            std::string::npos);
+  EXPECT_NE(svg.find("bell\\x07"), std::string::npos);
+  // Apart from the replacement characters the document is plain ASCII
+  // without control characters other than line breaks.
+  std::string rest;
+  for (std::size_t i = 0; i < svg.size();) {
+    if (svg.compare(i, replacement.size(), replacement) == 0) {
+      i += replacement.size();
+      continue;
+    }
+    rest += svg[i++];
+  }
+  for (char c : rest) {
+    const auto byte = static_cast<unsigned char>(c);
+    EXPECT_TRUE(byte == '\n' || (byte >= 0x20 && byte < 0x80)) << "byte " << int{byte};
+  }
+}
+
 TEST(Svg, SameInputGivesTheSameBytes) {
   const Arena arena = default_warehouse_arena();
   const auto runs = example_run(arena);
