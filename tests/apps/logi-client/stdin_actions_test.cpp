@@ -262,6 +262,30 @@ TEST(LogiClientStdinActions, CtrlCCancelsTheActionUnderWayAndExits130) {
   EXPECT_TRUE(contains(client.output(), "event connection disconnected")) << client.output();
 }
 
+// Ctrl-C can come at any moment: while an action runs, between two actions,
+// or after an action was taken but before its first turn. Every line taken
+// still gets exactly one result line.
+TEST(LogiClientStdinActions, CtrlCAtAnyMomentAnswersEveryLineOnce) {
+  MockLogi car;
+  ASSERT_FALSE(car.port().empty()) << car.output();
+  for (int round = 0; round < 5; ++round) {
+    auto client = stdin_client(car.port());
+    ASSERT_TRUE(client.write_stdin("connect\nwait 1m\nwait 2m\n"));
+    if (round % 2 == 0) {
+      EXPECT_TRUE(client.wait_for_line("event connection connecting")) << client.output();
+    } else {
+      EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
+    }
+    EXPECT_EQ(client.interrupt(10s), 130) << client.output();
+    const std::string& out = client.output();
+    const int connect_results = static_cast<int>(contains(out, "] ok   connect")) +
+                                static_cast<int>(contains(out, "] FAIL connect: cancelled"));
+    EXPECT_EQ(connect_results, 1) << out;
+    EXPECT_TRUE(contains(out, "] FAIL wait 1m: cancelled")) << out;
+    EXPECT_TRUE(contains(out, "] FAIL wait 2m: cancelled")) << out;
+  }
+}
+
 TEST(LogiClientStdinActions, StdinActionsWithAScriptOrActionsIsAUsageError) {
   const auto result = run_to_exit(LOGI_CLIENT_BINARY, {"--stdin-actions", "connect"});
   EXPECT_EQ(result.exit_code, 2) << result.output;
