@@ -230,7 +230,6 @@ class StdinActionsRun {
         pending_.pop_front();
         continue;
       }
-      current_ = front.parsed;
       logi::OperatorStep step = std::move(*front.parsed.step);
       pending_.pop_front();
       start(std::move(step));
@@ -325,13 +324,7 @@ class StdinActionsRun {
     stopping_ = true;
     exit_code_ = code;
     input_.stop();
-    if (runner_) {
-      runner_->cancel();  // reports the action under way as cancelled
-      // A runner begins its action on a later turn; one stopped before
-      // that turn reports nothing, but its line was taken and is answered.
-      if (runner_->results().empty())
-        print(BatchReporter::result_line(failure(current_, "cancelled", executor_.now())));
-    }
+    if (runner_) runner_->cancel();  // reports the action under way as cancelled
     for (auto& [id, runner] : early_)
       runner->cancel();  // fills in their results
     // Lines received but not begun are answered too: one result per line.
@@ -378,7 +371,6 @@ class StdinActionsRun {
     std::shared_ptr<std::optional<std::string>> early_result;
   };
   std::deque<Line> pending_;
-  ActionLine current_;  ///< the line runner_ was started for
   std::map<std::uint64_t, std::unique_ptr<logi::OperatorRunner>> early_;
   std::uint64_t early_ids_ = 0;
   std::optional<logi::RequestId> confirmable_;

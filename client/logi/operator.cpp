@@ -218,6 +218,7 @@ std::optional<std::size_t> OperatorRunner::current() const {
 void OperatorRunner::start() {
   if (started_) return;
   started_ = true;
+  due_ = 0;
   std::weak_ptr<bool> alive = alive_;
   executor_.post([this, alive] {
     if (const auto a = alive.lock(); !a || !*a) return;
@@ -249,6 +250,7 @@ std::string OperatorRunner::refused(Refusal r) const {
 
 void OperatorRunner::begin(std::size_t index) {
   if (finished_) return;
+  due_.reset();
   next_ = index;
   if (next_ >= steps_.size()) {
     finish_run(false);
@@ -440,6 +442,7 @@ void OperatorRunner::finish_action(bool ok, std::string reason) {
     return;
   }
   const std::size_t following = next_ + 1;
+  due_ = following;
   std::weak_ptr<bool> alive = alive_;
   executor_.post([this, alive, following] {
     if (const auto a = alive.lock(); !a || !*a) return;
@@ -461,15 +464,26 @@ void OperatorRunner::finish_run(bool cancelled) {
 
 void OperatorRunner::cancel() {
   if (finished_) return;
+  // The action under way, or the one whose first turn is still to come
+  // (it was started or the previous one ended, on a turn of its own).
+  std::optional<std::size_t> interrupted;
   if (active_) {
+    interrupted = next_;
+  } else if (due_ && *due_ < steps_.size()) {
+    interrupted = *due_;
+    action_started_ = executor_.now();
+  }
+  due_.reset();
+  if (interrupted) {
     // Report the interrupted action, then end without starting another.
     finished_ = true;  // keeps finish_action from scheduling the next one
     stop_timer();
     active_ = false;
+    const std::size_t i = *interrupted;
     ActionResult result;
-    result.index = next_;
-    result.line = steps_[next_].line;
-    result.text = steps_[next_].text.empty() ? to_string(steps_[next_].action) : steps_[next_].text;
+    result.index = i;
+    result.line = steps_[i].line;
+    result.text = steps_[i].text.empty() ? to_string(steps_[i].action) : steps_[i].text;
     result.ok = false;
     result.reason = "cancelled";
     result.started = action_started_;

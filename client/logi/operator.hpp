@@ -168,8 +168,10 @@ class OperatorRunner {
   void start();
   /// Every event of the session, in order.
   void on_event(Time now, const Event& event);
-  /// Ends the run now: the action under way fails as "cancelled", none
-  /// after it starts. Sends nothing to the car.
+  /// Ends the run now: the action under way fails as "cancelled" (also one
+  /// whose first turn had not come yet: start() and the end of an action
+  /// begin the next on a later turn), none after it starts. Sends nothing
+  /// to the car.
   void cancel();
 
   bool finished() const { return finished_; }
@@ -199,6 +201,8 @@ class OperatorRunner {
   std::size_t next_ = 0;
   bool active_ = false;  // an action is under way
   bool started_ = false;
+  /// The action whose begin() is posted and has not run yet.
+  std::optional<std::size_t> due_;
   bool finished_ = false;
   bool any_failed_ = false;
   Time action_started_{0};

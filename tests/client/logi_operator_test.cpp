@@ -420,6 +420,47 @@ TEST(OperatorRunner, CancelEndsTheActionUnderWayAndStartsNoOther) {
   EXPECT_TRUE(b.sent().empty());
 }
 
+// start() and the end of an action begin the next action on a later turn;
+// a cancel that comes before that turn still reports that action, so every
+// action taken gets a result (a Ctrl-C never leaves one unanswered).
+TEST(OperatorRunner, CancelBeforeTheFirstTurnReportsTheFirstAction) {
+  RunnerBench b;
+  b.start("connect\nwait 30s\n");
+  b.runner().cancel();
+  ASSERT_TRUE(b.summary());
+  EXPECT_TRUE(b.summary()->cancelled);
+  ASSERT_EQ(b.results().size(), 1u);
+  EXPECT_EQ(b.results()[0].text, "connect");
+  EXPECT_EQ(b.results()[0].reason, "cancelled");
+  EXPECT_EQ(b.results()[0].started, Time{0});
+  EXPECT_EQ(b.results()[0].ended, Time{0});
+  b.executor().run_until(seconds(40));
+  EXPECT_EQ(b.results().size(), 1u);
+  EXPECT_TRUE(b.sent().empty());
+}
+
+TEST(OperatorRunner, CancelBetweenTwoActionsReportsTheNextOne) {
+  RunnerBench b;
+  b.start("connect\nwait 30s\nspeed 50\n");
+  // Task by task until the connect ended: the wait's first turn is posted.
+  while (b.results().empty() && b.executor().now() < seconds(10))
+    b.executor().run_one();
+  ASSERT_EQ(b.results().size(), 1u);
+  ASSERT_TRUE(b.results()[0].ok) << b.results()[0].reason;
+  ASSERT_FALSE(b.runner().current().has_value());
+  const Time at = b.executor().now();
+  b.runner().cancel();
+  ASSERT_TRUE(b.summary());
+  ASSERT_EQ(b.results().size(), 2u);
+  EXPECT_EQ(b.results()[1].text, "wait 30s");
+  EXPECT_EQ(b.results()[1].index, 1u);
+  EXPECT_EQ(b.results()[1].reason, "cancelled");
+  EXPECT_EQ(b.results()[1].started, at);
+  EXPECT_EQ(b.results()[1].ended, at);
+  b.executor().run_until(seconds(40));
+  EXPECT_EQ(b.results().size(), 2u);
+}
+
 // The example scripts of scenarios/clients/logi-client/ run to the end
 // against the mock car, and the car does what they say.
 std::string read_file(const std::filesystem::path& p) {
