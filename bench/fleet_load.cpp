@@ -54,7 +54,7 @@ using asio::ip::tcp;
 namespace logi = hil::protocol::logi;
 
 constexpr double kStatPeriodMs = 500;
-// The targets of issue 9 for N = 1,000 on 2 cores.
+// The fleet targets for N = 1,000 on 2 cores (docs/performance.md).
 constexpr double kTargetJitterP99Ms = 10;
 constexpr double kTargetFeedbackP99Ms = 5;
 constexpr double kTargetKibPerCar = 1024;

@@ -746,7 +746,7 @@ TEST(ExpectCheckAll, ChecksEachInOrder) {
   EXPECT_FALSE(outcomes[1].passed);
 }
 
-// ------------------------------------------------------ the issue's examples
+// ------------------------------------------ the six release checks of docs/scenarios.md
 
 // "the car received MV:STOP within 300 ms of the release"
 TEST(ExpectIssueExamples, StopWithin300msOfTheRelease) {

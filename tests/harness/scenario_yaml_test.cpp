@@ -77,9 +77,9 @@ Matcher step_started(const std::string& text) {
       Source::step, "start", {{"text", Op::equals, text}}, "step '" + text + "' started"};
 }
 
-// ------------------------------------------------------ the issue's examples
+// ------------------------------------------ the six release checks of docs/scenarios.md
 
-TEST(ScenarioYamlIssueExamples, MvStopWithin300msOfTheRelease) {
+TEST(ScenarioYamlReleaseChecks, MvStopWithin300msOfTheRelease) {
   const auto s = logi(
       "expect:\n"
       "  - received: \"MV:STOP\"\n"
@@ -97,7 +97,7 @@ TEST(ScenarioYamlIssueExamples, MvStopWithin300msOfTheRelease) {
   EXPECT_EQ(e.label, "car received MV:STOP within 300ms after step 'release' started");
 }
 
-TEST(ScenarioYamlIssueExamples, ReconnectAttemptsAt6s8s11sEachWithin250ms) {
+TEST(ScenarioYamlReleaseChecks, ReconnectAttemptsAt6s8s11sEachWithin250ms) {
   const auto s = logi(
       "schedule:\n"
       "  - at: 5s\n"
@@ -125,7 +125,7 @@ TEST(ScenarioYamlIssueExamples, ReconnectAttemptsAt6s8s11sEachWithin250ms) {
   EXPECT_EQ(faults.profile.rules.size(), 2u);
 }
 
-TEST(ScenarioYamlIssueExamples, ExactlyOneStRunReceived) {
+TEST(ScenarioYamlReleaseChecks, ExactlyOneStRunReceived) {
   const auto s = logi(
       "expect:\n"
       "  - received: \"ST:RUN\"\n"
@@ -138,7 +138,7 @@ TEST(ScenarioYamlIssueExamples, ExactlyOneStRunReceived) {
   EXPECT_EQ(e.label, "exactly 1 x car received ST:RUN");
 }
 
-TEST(ScenarioYamlIssueExamples, Station2Within90sAndStopped) {
+TEST(ScenarioYamlReleaseChecks, Station2Within90sAndStopped) {
   const auto s = logi(
       "expect:\n"
       "  - sim: {station: 2}\n"
@@ -155,7 +155,7 @@ TEST(ScenarioYamlIssueExamples, Station2Within90sAndStopped) {
   EXPECT_EQ(s.expectations[1].window, (Window{Anchor{station, 1, Duration{0}}, seconds(2)}));
 }
 
-TEST(ScenarioYamlIssueExamples, ClientNeverSentABadChecksum) {
+TEST(ScenarioYamlReleaseChecks, ClientNeverSentABadChecksum) {
   const auto s = logi(
       "expect:\n"
       "  - never: true\n"
@@ -172,7 +172,7 @@ TEST(ScenarioYamlIssueExamples, ClientNeverSentABadChecksum) {
   EXPECT_EQ(e.window, Window{});
 }
 
-TEST(ScenarioYamlIssueExamples, AtRestWithin1sOfTheEmergencyStop) {
+TEST(ScenarioYamlReleaseChecks, AtRestWithin1sOfTheEmergencyStop) {
   const auto s = logi(
       "expect:\n"
       "  - sim: at_rest\n"
@@ -186,8 +186,8 @@ TEST(ScenarioYamlIssueExamples, AtRestWithin1sOfTheEmergencyStop) {
   EXPECT_EQ(e.label, "chassis at rest within 1s after step 'estop' started");
 }
 
-TEST(ScenarioYamlIssueExamples, AllSixTogetherInOneFile) {
-  const auto s = load_scenario(kData + "/issue-examples.yaml");
+TEST(ScenarioYamlReleaseChecks, AllSixTogetherInOneFile) {
+  const auto s = load_scenario(kData + "/release-checks.yaml");
   ASSERT_EQ(s.expectations.size(), 7u);
   std::vector<Quantifier> quantifiers;
   for (const auto& e : s.expectations)

@@ -755,8 +755,8 @@ struct Mute final : Command {
 
 /// Fault rules by bit: what the link does to the frames from now on. All
 /// eight rules are always there, in the same order, and the ones left out
-/// never fire: the injector keeps a pending batch's rule by its index, and
-/// a profile with fewer rules would leave that index dangling.
+/// never fire, so a rule keeps its index (and its place in the seeded
+/// random draws) whichever others are switched on.
 link::FaultProfile profile_of(unsigned mask) {
   using namespace link;
   FaultProfile p;
