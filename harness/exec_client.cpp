@@ -39,7 +39,7 @@ bool plain_word(std::string_view word) {
                                       [](char c) { return (c >= 'a' && c <= 'z') || c == '_'; });
 }
 
-std::string_view trim(std::string_view s) {
+std::string_view trim_view(std::string_view s) {
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front())) != 0)
     s.remove_prefix(1);
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back())) != 0)
@@ -49,10 +49,10 @@ std::string_view trim(std::string_view s) {
 
 // The first whitespace-separated word of `s`, and `s` after it.
 std::pair<std::string_view, std::string_view> first_word(std::string_view s) {
-  s = trim(s);
+  s = trim_view(s);
   const auto end = s.find_first_of(" \t");
   if (end == std::string_view::npos) return {s, {}};
-  return {s.substr(0, end), trim(s.substr(end))};
+  return {s.substr(0, end), trim_view(s.substr(end))};
 }
 
 std::string lower(std::string_view s) {
@@ -495,10 +495,10 @@ std::string substitute_placeholders(std::string_view command, const Placeholders
 
 ClientLine parse_client_line(std::string_view raw) {
   ClientLine line;
-  std::string_view s = trim(raw);
+  std::string_view s = trim_view(raw);
   if (!s.empty() && s.front() == '[') {  // a time stamp such as "[   1.2340000]"
     const auto close = s.find(']');
-    if (close != std::string_view::npos) s = trim(s.substr(close + 1));
+    if (close != std::string_view::npos) s = trim_view(s.substr(close + 1));
   }
   const auto [word, rest] = first_word(s);
   const std::string w = lower(word);
@@ -512,7 +512,7 @@ ClientLine parse_client_line(std::string_view raw) {
     line.ok = false;
     const auto colon = rest.find(": ");
     line.reason =
-        std::string(colon == std::string_view::npos ? rest : trim(rest.substr(colon + 2)));
+        std::string(colon == std::string_view::npos ? rest : trim_view(rest.substr(colon + 2)));
     if (line.reason.empty()) line.reason = "the client reported a failure";
     return line;
   }

@@ -181,10 +181,6 @@ double ms_of(Duration d) {
   return std::round(std::chrono::duration<double, std::milli>(d).count() * 10) / 10;
 }
 
-double rounded(double v, double step) {
-  return std::round(v / step) * step;
-}
-
 // The recorded run as the playback script reads it: the arena in the live
 // view's shape, each car's poses over time, and what crossed the wire.
 nlohmann::json playback_json(const ScenarioOutcome& o) {
@@ -200,13 +196,15 @@ nlohmann::json playback_json(const ScenarioOutcome& o) {
         n > kMostPlaybackSamples ? (n + kMostPlaybackSamples - 1) / kMostPlaybackSamples : 1;
     for (std::size_t i = 0; i < n; i += stride) {
       const auto& s = t.samples[i];
-      samples.push_back({ms_of(s.time), rounded(s.pose.x_m, 1e-4), rounded(s.pose.y_m, 1e-4),
-                         rounded(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
+      samples.push_back({ms_of(s.time), sim::round_to(s.pose.x_m, 1e-4),
+                         sim::round_to(s.pose.y_m, 1e-4),
+                         sim::round_to(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
     }
     if (n > 0 && (n - 1) % stride != 0) {
       const auto& s = t.samples.back();
-      samples.push_back({ms_of(s.time), rounded(s.pose.x_m, 1e-4), rounded(s.pose.y_m, 1e-4),
-                         rounded(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
+      samples.push_back({ms_of(s.time), sim::round_to(s.pose.x_m, 1e-4),
+                         sim::round_to(s.pose.y_m, 1e-4),
+                         sim::round_to(sim::rad_to_deg(s.pose.heading_rad), 0.01)});
     }
     json marks = json::array();
     for (const auto& m : t.marks) {
@@ -214,8 +212,8 @@ nlohmann::json playback_json(const ScenarioOutcome& o) {
                          : m.kind == sim::MarkKind::stop    ? "stop"
                          : m.kind == sim::MarkKind::station ? "station"
                                                             : "note";
-      marks.push_back({ms_of(m.time), rounded(m.position_m.x_m, 1e-4),
-                       rounded(m.position_m.y_m, 1e-4), kind, m.label});
+      marks.push_back({ms_of(m.time), sim::round_to(m.position_m.x_m, 1e-4),
+                       sim::round_to(m.position_m.y_m, 1e-4), kind, m.label});
     }
     j["cars"].push_back({{"name", t.vehicle},
                          {"footprint", {{"length", t.length_m}, {"width", t.width_m}}},

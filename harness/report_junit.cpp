@@ -22,7 +22,7 @@ std::string classname(const ScenarioOutcome& o) {
   return folder;
 }
 
-std::string seconds(double s) {
+std::string junit_seconds(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3f", s);
   return buf;
@@ -58,7 +58,7 @@ std::string junit_xml(const std::vector<ReportEntry>& entries) {
   }
   std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   out += "<testsuite name=\"hil\" tests=\"" + std::to_string(entries.size()) + "\" failures=\"" +
-         std::to_string(failures) + "\" errors=\"0\" skipped=\"0\" time=\"" + seconds(total) +
+         std::to_string(failures) + "\" errors=\"0\" skipped=\"0\" time=\"" + junit_seconds(total) +
          "\">\n";
   for (const auto& e : entries) {
     const auto& o = e.outcome;
@@ -66,7 +66,7 @@ std::string junit_xml(const std::vector<ReportEntry>& entries) {
     if (e.repeats > 1)
       name += " #" + std::to_string(e.repeat + 1) + " (seed " + std::to_string(o.seed) + ")";
     out += "  <testcase classname=\"" + xml_escape(classname(o)) + "\" name=\"" + xml_escape(name) +
-           "\" time=\"" + seconds(o.wall_seconds) + "\"";
+           "\" time=\"" + junit_seconds(o.wall_seconds) + "\"";
     if (!o.file.empty()) out += " file=\"" + xml_escape(o.file) + "\"";
     out += ">\n";
     if (!o.passed()) {

@@ -34,6 +34,7 @@
 #include "mocks/server.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "sim/arena_yaml.hpp"
+#include "sim/geometry.hpp"
 #include "sim/recorder.hpp"
 
 namespace hil::harness {
@@ -62,7 +63,7 @@ constexpr Duration kTermGrace = seconds(2);
 // handler before looking at `done` again.
 constexpr auto kRealTimeSlice = std::chrono::milliseconds(20);
 
-std::string seconds_text(Duration d) {
+std::string run_seconds_text(Duration d) {
   const double s = std::chrono::duration<double>(d).count();
   std::ostringstream out;
   if (s == std::floor(s)) {
@@ -72,10 +73,6 @@ std::string seconds_text(Duration d) {
     out << std::fixed << s << " s";
   }
   return out.str();
-}
-
-double rounded(double value, double unit) {
-  return std::round(value / unit) * unit;
 }
 
 // The world file as written, or next to the scenario file when relative.
@@ -550,7 +547,7 @@ void ReferenceRun::begin_wait_until(std::size_t index, const WaitUntilStep& wait
   });
   const std::string what = wait.until.text.empty() ? plan_[index]->text : wait.until.text;
   r.timer = executor_.call_after(wait.timeout, [this, index, what, timeout = wait.timeout] {
-    finish_step(index, false, "no '" + what + "' within " + seconds_text(timeout));
+    finish_step(index, false, "no '" + what + "' within " + run_seconds_text(timeout));
   });
 }
 
@@ -658,10 +655,10 @@ void ReferenceRun::sim_tick() {
   if (now >= next_sample_) {
     const sim::Pose pose = vehicle.pose();
     timeline_.add(Source::sim, "sample",
-                  {{"x_m", rounded(pose.x_m, 1e-4)},
-                   {"y_m", rounded(pose.y_m, 1e-4)},
-                   {"heading_deg", rounded(pose.heading_rad * 180 / std::numbers::pi, 0.01)},
-                   {"speed_mps", rounded(speed, 1e-4)}});
+                  {{"x_m", sim::round_to(pose.x_m, 1e-4)},
+                   {"y_m", sim::round_to(pose.y_m, 1e-4)},
+                   {"heading_deg", sim::round_to(pose.heading_rad * 180 / std::numbers::pi, 0.01)},
+                   {"speed_mps", sim::round_to(speed, 1e-4)}});
     while (next_sample_ <= now)
       next_sample_ += options_.sample_period;
   }
@@ -687,14 +684,14 @@ void ReferenceRun::stop_external_client() {
   drive(finished, executor_.now() + kExitGrace);
   if (finished()) return;
   timeline_.add(Source::client, "notice",
-                {{"text", "the client did not exit within " + seconds_text(kExitGrace) +
+                {{"text", "the client did not exit within " + run_seconds_text(kExitGrace) +
                               " of its input closing: sent SIGTERM"}});
   client_->terminate(false);
   drive(finished, executor_.now() + kTermGrace);
   if (finished()) return;
-  timeline_.add(
-      Source::client, "notice",
-      {{"text", "the client ignored SIGTERM for " + seconds_text(kTermGrace) + ": sent SIGKILL"}});
+  timeline_.add(Source::client, "notice",
+                {{"text", "the client ignored SIGTERM for " + run_seconds_text(kTermGrace) +
+                              ": sent SIGKILL"}});
   client_->terminate(true);
   drive(finished, executor_.now() + kTermGrace);
 }
@@ -710,12 +707,12 @@ void ReferenceRun::run() {
   post([this] { advance(main_); });
 
   drive([this] { return main_.done; }, Time(0) + scenario_.timeout);
-  if (!main_.done) time_out(main_, "timed out after " + seconds_text(scenario_.timeout));
+  if (!main_.done) time_out(main_, "timed out after " + run_seconds_text(scenario_.timeout));
 
   post([this] { advance(teardown_); });
   drive([this] { return teardown_.done; }, executor_.now() + kTeardownGrace);
   if (!teardown_.done)
-    time_out(teardown_, "teardown timed out after " + seconds_text(kTeardownGrace));
+    time_out(teardown_, "teardown timed out after " + run_seconds_text(kTeardownGrace));
 
   drive([] { return false; }, executor_.now() + scenario_.settle);
   end();

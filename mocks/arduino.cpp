@@ -17,10 +17,6 @@ namespace arduino = protocol::arduino;
 // 96-byte frame (12 bytes of framing around it).
 constexpr std::size_t kMaxConfigText = 32;
 
-void check(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("ArduinoConfig: " + what);
-}
-
 bool field_text(std::string_view text) {
   for (const char c : text) {
     if (!arduino::is_field_char(c)) return false;
@@ -29,30 +25,26 @@ bool field_text(std::string_view text) {
 }
 
 ArduinoConfig validated(ArduinoConfig config) {
-  check(config.base_pwm >= 0 && config.base_pwm <= arduino::kMaxPwm,
-        "base_pwm " + std::to_string(config.base_pwm) + " is outside 0..255");
-  check(config.ms_per_cm > 0 && config.ms_per_cm <= 1000, "ms_per_cm must be in (0, 1000]");
-  check(config.ms_per_deg > 0 && config.ms_per_deg <= 1000, "ms_per_deg must be in (0, 1000]");
-  check(config.no_echo_cm >= 0 && config.no_echo_cm <= arduino::kMaxSignedArg,
-        "no_echo_cm must be in 0..32767");
-  check(field_text(config.ping_reply),
-        "ping_reply must be at most 32 printable characters without ^ $ * |");
-  check(!config.fault_code.empty() && field_text(config.fault_code),
-        "fault_code must be 1..32 printable characters without ^ $ * |");
-  check(!config.reject_code.empty() && field_text(config.reject_code),
-        "reject_code must be 1..32 printable characters without ^ $ * |");
-  check(config.max_frame_bytes >= arduino::kMinFrameBytes, "max_frame_bytes must be at least 10");
-  check(config.control_period > Duration::zero(), "control_period must be positive");
+  require_config("ArduinoConfig", config.base_pwm >= 0 && config.base_pwm <= arduino::kMaxPwm,
+                 "base_pwm " + std::to_string(config.base_pwm) + " is outside 0..255");
+  require_config("ArduinoConfig", config.ms_per_cm > 0 && config.ms_per_cm <= 1000,
+                 "ms_per_cm must be in (0, 1000]");
+  require_config("ArduinoConfig", config.ms_per_deg > 0 && config.ms_per_deg <= 1000,
+                 "ms_per_deg must be in (0, 1000]");
+  require_config("ArduinoConfig",
+                 config.no_echo_cm >= 0 && config.no_echo_cm <= arduino::kMaxSignedArg,
+                 "no_echo_cm must be in 0..32767");
+  require_config("ArduinoConfig", field_text(config.ping_reply),
+                 "ping_reply must be at most 32 printable characters without ^ $ * |");
+  require_config("ArduinoConfig", !config.fault_code.empty() && field_text(config.fault_code),
+                 "fault_code must be 1..32 printable characters without ^ $ * |");
+  require_config("ArduinoConfig", !config.reject_code.empty() && field_text(config.reject_code),
+                 "reject_code must be 1..32 printable characters without ^ $ * |");
+  require_config("ArduinoConfig", config.max_frame_bytes >= arduino::kMinFrameBytes,
+                 "max_frame_bytes must be at least 10");
+  require_config("ArduinoConfig", config.control_period > Duration::zero(),
+                 "control_period must be positive");
   return config;
-}
-
-sim::DifferentialChassis& differential_of(sim::Vehicle& vehicle) {
-  auto* chassis = vehicle.differential();
-  if (chassis == nullptr) {
-    throw std::invalid_argument("ArduinoFirmware: vehicle '" + vehicle.name() +
-                                "' has no differential chassis");
-  }
-  return *chassis;
 }
 
 arduino::DecoderOptions decoder_options(const ArduinoConfig& config) {
@@ -77,7 +69,7 @@ std::string_view motion_word(ArduinoMotion motion) {
 ArduinoFirmware::ArduinoFirmware(sim::World& world, sim::Vehicle& vehicle, ArduinoConfig config)
     : Firmware(world, vehicle),
       config_(validated(std::move(config))),
-      chassis_(differential_of(vehicle)),
+      chassis_(differential_chassis_of(vehicle, "ArduinoFirmware")),
       decoder_(decoder_options(config_)) {
   boot(world.time());
 }

@@ -1,10 +1,28 @@
 #include "mocks/firmware.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "protocol/common/overloaded.hpp"
 
 namespace hil::mocks {
+
+void require_config(std::string_view config, bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(std::string(config) + ": " + what);
+}
+
+sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                                  std::string_view hint) {
+  auto* chassis = vehicle.differential();
+  if (chassis == nullptr) {
+    std::string message =
+        std::string(firmware) + ": vehicle '" + vehicle.name() + "' has no differential chassis";
+    if (!hint.empty()) message += " (" + std::string(hint) + ")";
+    throw std::invalid_argument(message);
+  }
+  return *chassis;
+}
 
 Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), vehicle_(vehicle) {}
 

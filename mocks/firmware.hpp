@@ -24,6 +24,15 @@ namespace hil::mocks {
 using protocol::Bytes;
 using protocol::ByteView;
 
+/// Throws std::invalid_argument("<config>: <what>") unless `ok`: how every
+/// firmware's `*Config::checked()` refuses a field.
+void require_config(std::string_view config, bool ok, const std::string& what);
+
+/// The vehicle's differential chassis, or std::invalid_argument naming the
+/// firmware, the vehicle and `hint` (how to get a fitting vehicle).
+sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                                  std::string_view hint = {});
+
 struct FirmwareStats {
   std::uint64_t connections = 0;  ///< clients served so far
   std::uint64_t bytes_in = 0;

@@ -17,36 +17,26 @@ using leka::Rgb;
 constexpr Rgb kOff{};
 constexpr Rgb kWhite{255, 255, 255};
 
-sim::DifferentialChassis& differential_of(sim::Vehicle& vehicle) {
-  auto* chassis = vehicle.differential();
-  if (chassis == nullptr) {
-    throw std::invalid_argument("LekaFirmware: vehicle '" + vehicle.name() +
-                                "' has no differential chassis (use sim::leka_robot())");
-  }
-  return *chassis;
-}
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("LekaConfig: " + what);
-}
-
 bool printable_word(const std::string& s) {
   return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c > 0x20 && c < 0x7F; });
 }
 
 const LekaConfig& checked(const LekaConfig& c) {
   const auto positive = [](Duration d) { return d > Duration::zero(); };
-  require(positive(c.loop_period), "loop_period must be > 0");
-  require(c.serial_buffer_bytes >= leka::kOverheadBytes + 1 && c.serial_buffer_bytes <= 261,
-          "serial_buffer_bytes must be 7..261, got " + std::to_string(c.serial_buffer_bytes));
-  require(printable_word(c.robot_name), "robot_name must be printable ASCII without spaces");
-  require(printable_word(c.firmware_version),
-          "firmware_version must be printable ASCII without spaces");
-  require(positive(c.motivator_duration), "motivator_duration must be > 0");
-  require(positive(c.guidance_duration), "guidance_duration must be > 0");
-  require(positive(c.chaser_step), "chaser_step must be > 0");
-  require(positive(c.motivator_turn), "motivator_turn must be > 0");
-  require(positive(c.guidance_blink), "guidance_blink must be > 0");
+  require_config("LekaConfig", positive(c.loop_period), "loop_period must be > 0");
+  require_config(
+      "LekaConfig",
+      c.serial_buffer_bytes >= leka::kOverheadBytes + 1 && c.serial_buffer_bytes <= 261,
+      "serial_buffer_bytes must be 7..261, got " + std::to_string(c.serial_buffer_bytes));
+  require_config("LekaConfig", printable_word(c.robot_name),
+                 "robot_name must be printable ASCII without spaces");
+  require_config("LekaConfig", printable_word(c.firmware_version),
+                 "firmware_version must be printable ASCII without spaces");
+  require_config("LekaConfig", positive(c.motivator_duration), "motivator_duration must be > 0");
+  require_config("LekaConfig", positive(c.guidance_duration), "guidance_duration must be > 0");
+  require_config("LekaConfig", positive(c.chaser_step), "chaser_step must be > 0");
+  require_config("LekaConfig", positive(c.motivator_turn), "motivator_turn must be > 0");
+  require_config("LekaConfig", positive(c.guidance_blink), "guidance_blink must be > 0");
   return c;
 }
 
@@ -95,7 +85,7 @@ std::string hex_rgb(const Rgb& c) {
 LekaFirmware::LekaFirmware(sim::World& world, sim::Vehicle& vehicle, LekaConfig config)
     : Firmware(world, vehicle),
       config_(checked(config)),
-      chassis_(differential_of(vehicle)),
+      chassis_(differential_chassis_of(vehicle, "LekaFirmware", "use sim::leka_robot()")),
       decoder_(decoder_options(config_)) {
   state_.belt.assign(std::size_t{config_.max_belt_led_id} + 1, kOff);
   base_belt_ = state_.belt;

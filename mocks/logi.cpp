@@ -24,24 +24,24 @@ sim::MecanumChassis& mecanum_of(sim::Vehicle& vehicle) {
   return *chassis;
 }
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("LogiConfig: " + what);
-}
-
 const LogiConfig& checked(const LogiConfig& c) {
   for (const int s : c.stations)
-    require(s >= 0 && s <= 999, "stations must be 0..999");
-  require(c.boot_speed_percent >= 0 && c.boot_speed_percent <= 100,
-          "boot_speed_percent must be 0..100");
-  require(c.stat_period > Duration::zero(), "stat_period must be positive");
-  require(c.control_period > Duration::zero(), "control_period must be positive");
-  require(c.boot_offset >= Duration::zero() && c.boot_offset <= c.stat_period,
-          "boot_offset must be 0..stat_period");
-  require(c.obstacle_stop_cm >= 0, "obstacle_stop_cm must be >= 0");
-  require(c.obstacle_clear_hysteresis_cm >= 0, "obstacle_clear_hysteresis_cm must be >= 0");
-  require(c.line_lost_timeout >= Duration::zero(), "line_lost_timeout must be >= 0");
-  require(c.steer_gain_radps_per_mps >= 0, "steer_gain_radps_per_mps must be >= 0");
-  require(c.strafe_gain >= 0, "strafe_gain must be >= 0");
+    require_config("LogiConfig", s >= 0 && s <= 999, "stations must be 0..999");
+  require_config("LogiConfig", c.boot_speed_percent >= 0 && c.boot_speed_percent <= 100,
+                 "boot_speed_percent must be 0..100");
+  require_config("LogiConfig", c.stat_period > Duration::zero(), "stat_period must be positive");
+  require_config("LogiConfig", c.control_period > Duration::zero(),
+                 "control_period must be positive");
+  require_config("LogiConfig", c.boot_offset >= Duration::zero() && c.boot_offset <= c.stat_period,
+                 "boot_offset must be 0..stat_period");
+  require_config("LogiConfig", c.obstacle_stop_cm >= 0, "obstacle_stop_cm must be >= 0");
+  require_config("LogiConfig", c.obstacle_clear_hysteresis_cm >= 0,
+                 "obstacle_clear_hysteresis_cm must be >= 0");
+  require_config("LogiConfig", c.line_lost_timeout >= Duration::zero(),
+                 "line_lost_timeout must be >= 0");
+  require_config("LogiConfig", c.steer_gain_radps_per_mps >= 0,
+                 "steer_gain_radps_per_mps must be >= 0");
+  require_config("LogiConfig", c.strafe_gain >= 0, "strafe_gain must be >= 0");
   return c;
 }
 

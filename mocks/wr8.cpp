@@ -77,10 +77,6 @@ std::string seconds_text(Duration d) {
   return fixed(sim::to_seconds(d), 3) + " s";
 }
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("Wr8Config: " + what);
-}
-
 }  // namespace
 
 Duration wrong_auth_delay(const Wr8Config& config, std::uint64_t failures_in_a_row) {
@@ -107,30 +103,38 @@ Wr8Firmware::Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config con
       config_(std::move(config)),
       chassis_(ackermann_of(vehicle)),
       decoder_(decoder_options(config_)) {
-  require(config_.data_period > Duration::zero(), "data_period must be positive");
-  require(config_.control_period > Duration::zero(), "control_period must be positive");
-  require(config_.wrong_auth_close_delay >= Duration::zero(),
-          "wrong_auth_close_delay must not be negative");
-  require(config_.wrong_auth_max_delay >= config_.wrong_auth_close_delay,
-          "wrong_auth_max_delay must not be below wrong_auth_close_delay");
-  require(config_.stall_timeout > Duration::zero(), "stall_timeout must be positive");
-  require(config_.blink_duration >= Duration::zero(), "blink_duration must not be negative");
-  require(config_.drive_max_speed_mps > 0, "drive_max_speed_mps must be positive");
-  require(config_.drive_min_speed_mps >= 0 &&
-              config_.drive_min_speed_mps <= config_.drive_max_speed_mps,
-          "drive_min_speed_mps must be within 0..drive_max_speed_mps");
-  require(config_.max_drive_cm > 0, "max_drive_cm must be positive");
-  require(config_.stall_progress_m > 0, "stall_progress_m must be positive");
-  require(config_.servo_min_deg <= config_.servo_max_deg, "servo_min_deg above servo_max_deg");
-  require(config_.max_gain >= 0, "max_gain must not be negative");
+  require_config("Wr8Config", config_.data_period > Duration::zero(),
+                 "data_period must be positive");
+  require_config("Wr8Config", config_.control_period > Duration::zero(),
+                 "control_period must be positive");
+  require_config("Wr8Config", config_.wrong_auth_close_delay >= Duration::zero(),
+                 "wrong_auth_close_delay must not be negative");
+  require_config("Wr8Config", config_.wrong_auth_max_delay >= config_.wrong_auth_close_delay,
+                 "wrong_auth_max_delay must not be below wrong_auth_close_delay");
+  require_config("Wr8Config", config_.stall_timeout > Duration::zero(),
+                 "stall_timeout must be positive");
+  require_config("Wr8Config", config_.blink_duration >= Duration::zero(),
+                 "blink_duration must not be negative");
+  require_config("Wr8Config", config_.drive_max_speed_mps > 0,
+                 "drive_max_speed_mps must be positive");
+  require_config("Wr8Config",
+                 config_.drive_min_speed_mps >= 0 &&
+                     config_.drive_min_speed_mps <= config_.drive_max_speed_mps,
+                 "drive_min_speed_mps must be within 0..drive_max_speed_mps");
+  require_config("Wr8Config", config_.max_drive_cm > 0, "max_drive_cm must be positive");
+  require_config("Wr8Config", config_.stall_progress_m > 0, "stall_progress_m must be positive");
+  require_config("Wr8Config", config_.servo_min_deg <= config_.servo_max_deg,
+                 "servo_min_deg above servo_max_deg");
+  require_config("Wr8Config", config_.max_gain >= 0, "max_gain must not be negative");
   const auto gain_ok = [&](double g) {
     return std::isfinite(g) && g >= 0 && g <= config_.max_gain;
   };
-  require(gain_ok(config_.p) && gain_ok(config_.i) && gain_ok(config_.d),
-          "p, i and d must be within 0..max_gain");
-  require(config_.servo_zero_deg >= config_.servo_min_deg &&
-              config_.servo_zero_deg <= config_.servo_max_deg,
-          "servo_zero_deg must be within servo_min_deg..servo_max_deg");
+  require_config("Wr8Config", gain_ok(config_.p) && gain_ok(config_.i) && gain_ok(config_.d),
+                 "p, i and d must be within 0..max_gain");
+  require_config("Wr8Config",
+                 config_.servo_zero_deg >= config_.servo_min_deg &&
+                     config_.servo_zero_deg <= config_.servo_max_deg,
+                 "servo_zero_deg must be within servo_min_deg..servo_max_deg");
 
   const auto& types = config_.profile.setting_value_type;
   const double initial[wr8::kSettingCount] = {config_.p, config_.i, config_.d,

@@ -83,4 +83,10 @@ inline constexpr double rad_to_deg(double rad) {
   return rad * 180.0 / std::numbers::pi;
 }
 
+/// `value` rounded to a multiple of `step` (step > 0): how poses and times
+/// are written where people and pages read them.
+inline double round_to(double value, double step) {
+  return std::round(value / step) * step;
+}
+
 }  // namespace hil::sim

@@ -128,11 +128,11 @@ double text_width_px(std::string_view text, double font_px) {
   return ems * font_px;
 }
 
-bool finite(Vec2 p) {
+bool finite_point(Vec2 p) {
   return std::isfinite(p.x_m) && std::isfinite(p.y_m);
 }
-bool finite(const Pose& p) {
-  return finite(p.position()) && std::isfinite(p.heading_rad);
+bool finite_point(const Pose& p) {
+  return finite_point(p.position()) && std::isfinite(p.heading_rad);
 }
 
 struct Px {
@@ -623,7 +623,7 @@ class Renderer {
             }
             out += "<title>" + xml_escape(o.name) + "</title>";
             out += std::is_same_v<T, BoxObstacle> ? "</polygon>\n" : "</circle>\n";
-            if (!o.name.empty() && finite(o.center_m)) {
+            if (!o.name.empty() && finite_point(o.center_m)) {
               // Inside the shape when it fits, beside it when the shape is small.
               const bool fits = text_width_px(o.name, kLabelFontPx) + 6 <= shape_w_px;
               labels.request(o.name, c, fits ? 0 : half_px, kText, "obstacle-label", fits);
@@ -637,7 +637,7 @@ class Renderer {
     for (const auto& tape : arena_.tapes) {
       std::vector<Px> points;
       for (const auto& p : tape.points_m) {
-        if (finite(p)) points.push_back(to_px(p));
+        if (finite_point(p)) points.push_back(to_px(p));
       }
       const double stroke = std::max(2.0, std::isfinite(tape.width_m) ? tape.width_m * ppm_ : 0.0);
       const char* element = tape.closed ? "polygon" : "polyline";
@@ -660,17 +660,17 @@ class Renderer {
       out += "<circle class=\"tag\" cx=\"" + num(c.x) + "\" cy=\"" + num(c.y) + "\" r=\"" + num(r) +
              "\" fill=\"" + std::string(kTagFill) + "\" stroke=\"" + std::string(kTagStroke) +
              "\" stroke-width=\"1.5\"><title>RFID " + xml_escape(tag.id) + "</title></circle>\n";
-      if (finite(tag.position_m)) labels.occupy_around(c, r, kCoverSymbol);
+      if (finite_point(tag.position_m)) labels.occupy_around(c, r, kCoverSymbol);
     }
     for (const auto& tag : arena_.tags) {
-      if (!finite(tag.position_m)) continue;
+      if (!finite_point(tag.position_m)) continue;
       labels.request(tag.id, to_px(tag.position_m), tag_radius_px(tag, ppm_), "#5d4300",
                      "tag-label");
     }
   }
 
   void draw_start(std::string& out, LabelPlacer& labels) const {
-    if (!finite(arena_.start)) return;
+    if (!finite_point(arena_.start)) return;
     const Px from = to_px(arena_.start.position());
     const double len_px = std::max(0.2 * ppm_, 26.0);
     const Px to{from.x + len_px * std::cos(arena_.start.heading_rad),
@@ -691,7 +691,7 @@ class Renderer {
       const std::string colour(kPalette[i % kPalette.size()]);
       std::vector<Px> points;
       for (const auto& s : t.samples) {
-        if (finite(s.pose.position())) points.push_back(to_px(s.pose.position()));
+        if (finite_point(s.pose.position())) points.push_back(to_px(s.pose.position()));
       }
       out += "<g class=\"trajectory\" data-vehicle=\"" + xml_escape(t.vehicle) + "\">";
       if (points.size() >= 2) {
@@ -717,7 +717,7 @@ class Renderer {
       const std::string colour(kPalette[i % kPalette.size()]);
       const TrajectorySample* last = nullptr;
       for (const auto& s : t.samples) {
-        if (finite(s.pose)) last = &s;
+        if (finite_point(s.pose)) last = &s;
       }
       if (last == nullptr) continue;
       const Pose& pose = last->pose;
@@ -746,7 +746,7 @@ class Renderer {
     }
     for (std::size_t i = 0; i < trajectories_.size(); ++i) {
       for (const auto& m : trajectories_[i].marks) {
-        if (finite(m.position_m)) {
+        if (finite_point(m.position_m)) {
           labels.occupy_around(to_px(m.position_m), kMarkHalfPx + 3, kCoverSymbol);
         }
       }
@@ -755,7 +755,7 @@ class Renderer {
       const auto& t = trajectories_[i];
       const std::string colour(kPalette[i % kPalette.size()]);
       for (const auto& m : t.marks) {
-        if (!finite(m.position_m)) continue;
+        if (!finite_point(m.position_m)) continue;
         const Px c = to_px(m.position_m);
         out += "<g class=\"mark " + std::string(kind_name(m.kind)) + "\" fill=\"none\">" +
                mark_symbol(m.kind, c, colour) + "</g>\n";
@@ -806,7 +806,7 @@ class Renderer {
         const TrajectorySample* first = nullptr;
         const TrajectorySample* prev = nullptr;
         for (const auto& s : t.samples) {
-          if (!finite(s.pose.position())) continue;
+          if (!finite_point(s.pose.position())) continue;
           if (first == nullptr) first = &s;
           if (prev != nullptr) path_m += length(s.pose.position() - prev->pose.position());
           prev = &s;

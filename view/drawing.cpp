@@ -11,10 +11,6 @@ namespace {
 
 using nlohmann::json;
 
-double round_to(double v, double step) {
-  return std::round(v / step) * step;
-}
-
 json obstacle_json(const sim::Obstacle& o, std::size_t index) {
   json j;
   j["index"] = index;
@@ -151,7 +147,7 @@ json arena_json(const sim::Arena& arena, const std::vector<bool>* present) {
   for (const auto& tape : arena.tapes) {
     json points = json::array();
     for (const auto& p : tape.points_m)
-      points.push_back({round_to(p.x_m, 1e-4), round_to(p.y_m, 1e-4)});
+      points.push_back({sim::round_to(p.x_m, 1e-4), sim::round_to(p.y_m, 1e-4)});
     j["tapes"].push_back({{"name", tape.name},
                           {"width", tape.width_m},
                           {"closed", tape.closed},

@@ -24,10 +24,6 @@ double ms_of(link::Time t) {
   return std::chrono::duration<double, std::milli>(t).count();
 }
 
-double round_to(double v, double step) {
-  return std::round(v / step) * step;
-}
-
 std::string hex_of(protocol::ByteView bytes) {
   static constexpr char kDigits[] = "0123456789abcdef";
   std::string out;
@@ -119,7 +115,7 @@ json line_json(const sim::World& world, const sim::Vehicle& vehicle) {
 json frames_json(const std::deque<WireWatch::Frame>& frames) {
   json out = json::array();
   for (const auto& f : frames)
-    out.push_back({{"t_ms", round_to(ms_of(f.at), 0.1)},
+    out.push_back({{"t_ms", sim::round_to(ms_of(f.at), 0.1)},
                    {"valid", f.valid},
                    {"kind", f.kind},
                    {"text", f.text},
@@ -228,7 +224,7 @@ json LiveModel::car_json(const Car& car, std::size_t index, link::Time now) cons
                     {"center_ahead", footprint.center_ahead_m}};
   json trail = json::array();
   for (const auto& p : car.trail)
-    trail.push_back({round_to(p.x_m, 1e-3), round_to(p.y_m, 1e-3)});
+    trail.push_back({sim::round_to(p.x_m, 1e-3), sim::round_to(p.y_m, 1e-3)});
   j["trail"] = trail;
   j["sonar"] = sonar_json(mock.world(), vehicle);
   j["line"] = line_json(mock.world(), vehicle);
@@ -249,7 +245,7 @@ json LiveModel::car_json(const Car& car, std::size_t index, link::Time now) cons
   };
   j["mode"] = firmware.summary();
   j["in_fault"] = firmware.in_fault();
-  j["sim_time_ms"] = round_to(ms_of(now), 1);
+  j["sim_time_ms"] = sim::round_to(ms_of(now), 1);
   const auto& stats = firmware.stats();
   j["stats"] = {{"frames_in", stats.frames_in},   {"frames_out", stats.frames_out},
                 {"bad_frames", stats.bad_frames}, {"rejected", stats.rejected},
@@ -273,7 +269,7 @@ json LiveModel::car_json(const Car& car, std::size_t index, link::Time now) cons
     frames["to_car"] = frames_json(w.frames(link::Direction::to_car));
     frames["to_client"] = frames_json(w.frames(link::Direction::to_client));
     for (const auto& f : w.faults())
-      faults.push_back({{"t_ms", round_to(ms_of(f.at), 0.1)},
+      faults.push_back({{"t_ms", sim::round_to(ms_of(f.at), 0.1)},
                         {"direction", std::string(link::to_string(f.direction))},
                         {"kind", f.kind},
                         {"rule", f.rule},

@@ -16,7 +16,7 @@ namespace {
 
 namespace ard = protocol::arduino;
 
-constexpr const char* kEncodeFooter = R"(Forms (SEQ is --seq, default 1):
+constexpr const char* kArduinoEncodeFooter = R"(Forms (SEQ is --seq, default 1):
   hil encode arduino [--seq N] CMD [PAYLOAD...]     typed, checked: V 0..255, M/R -32768..32767
   hil encode arduino [--seq N] CMD:PAYLOAD          the same as one token, like the robot CLI (V:160)
   hil encode arduino [--seq N] --raw CMD [PAYLOAD]  any CMD/PAYLOAD text, unchecked (fault injection)
@@ -36,7 +36,7 @@ Examples:
   hil encode arduino --body 'G1|PING|'        ^G1|PING|*66$
   hil encode arduino --seq 2 V 160 --checksum 00   ^02|V|160*00$)";
 
-constexpr const char* kDecodeFooter =
+constexpr const char* kArduinoDecodeFooter =
     R"(Frames on the command line are joined in order and decoded as one stream;
 quote them, the shell treats ^ $ | * specially. Exit status: 0 all frames, 1 any error, 2 no bytes.
 Examples:
@@ -79,7 +79,7 @@ std::string upper(std::string text) {
   return text;
 }
 
-struct EncodeArgs {
+struct ArduinoEncodeArgs {
   std::string seq = "1";
   std::vector<std::string> words;
   bool raw = false;
@@ -110,7 +110,7 @@ std::pair<std::string, std::string> split_words(const std::vector<std::string>& 
   return {cmd, payload};
 }
 
-int run_encode(const EncodeArgs& args, bool body_given, bool seq_given) {
+int run_encode(const ArduinoEncodeArgs& args, bool body_given, bool seq_given) {
   if (!args.checksum.empty() && args.checksum.size() != 2) {
     return fail("--checksum '" + args.checksum + "' is not exactly two characters");
   }
@@ -210,7 +210,7 @@ int run_decode(const DecodeArgs& args) {
 }  // namespace
 
 void register_arduino(CommandSet& commands) {
-  auto encode_args = std::make_shared<EncodeArgs>();
+  auto encode_args = std::make_shared<ArduinoEncodeArgs>();
   auto decode_args = std::make_shared<DecodeArgs>();
 
   auto* enc = commands.encode.add_subcommand(
@@ -225,7 +225,7 @@ void register_arduino(CommandSet& commands) {
                                "Frame this text as everything between ^ and * (e.g. 'G1|PING|')");
   enc->add_option("--checksum", encode_args->checksum,
                   "Write these two characters instead of the computed checksum (fault injection)");
-  enc->footer(kEncodeFooter);
+  enc->footer(kArduinoEncodeFooter);
   enc->callback([&run = commands.run, encode_args, body, seq] {
     run = [encode_args, body = body->count() > 0, seq = seq->count() > 0]() {
       return run_encode(*encode_args, body, seq);
@@ -243,7 +243,7 @@ void register_arduino(CommandSet& commands) {
                 "Lowercase checksum hex is an error (default: accepted, shown as tolerated)");
   dec->add_flag("--nack", decode_args->nack,
                 "Also print the NACK frame the firmware answers each bad frame with");
-  dec->footer(kDecodeFooter);
+  dec->footer(kArduinoDecodeFooter);
   dec->callback([&run = commands.run, decode_args] {
     run = [decode_args]() { return run_decode(*decode_args); };
   });

@@ -14,7 +14,7 @@ namespace {
 
 namespace leka = protocol::leka;
 
-const char* const kEncodeFooter = R"(Forms:
+const char* const kLekaEncodeFooter = R"(Forms:
   hil encode leka COMMAND [VALUE...] [+ COMMAND [VALUE...]]...
       One frame whose command group holds the commands in order ('+' between
       commands). VALUEs are bytes 0..255, decimal or 0x hex.
@@ -49,7 +49,7 @@ Examples:
   hil encode leka --group "99 01 02"
 )";
 
-const char* const kDecodeFooter = R"(Examples:
+const char* const kLekaDecodeFooter = R"(Examples:
   hil decode leka 2A 2B 2C 2D 01 70 70
   hil decode leka "2A2B2C2D0515 00FF000041"
   hil decode leka --file capture.bin --no-raw
@@ -157,7 +157,7 @@ void register_leka(CommandSet& commands) {
   enc->add_option("--max-belt-id", args->max_belt_id,
                   "Highest belt LED id accepted (default 19 = 0x13; the seed table says 0x19)")
       ->check(CLI::Range(0, 255));
-  enc->footer(kEncodeFooter);
+  enc->footer(kLekaEncodeFooter);
   enc->callback([&run = commands.run, args] {
     run = [args]() -> int {
       try {
@@ -203,7 +203,7 @@ void register_leka(CommandSet& commands) {
   dec->add_option("--max-frame-bytes", args->max_frame_bytes,
                   "Frame bound in bytes (default 128, the robot's serial buffer)")
       ->check(CLI::Range(7, 261));
-  dec->footer(kDecodeFooter);
+  dec->footer(kLekaDecodeFooter);
   dec->callback([&run = commands.run, args] {
     run = [args]() -> int {
       protocol::Bytes bytes;

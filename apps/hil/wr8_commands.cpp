@@ -18,7 +18,7 @@ namespace {
 
 namespace wr8 = protocol::wr8;
 
-const char* const kEncodeFooter = R"(Forms (prints the packet as spaced hex):
+const char* const kWr8EncodeFooter = R"(Forms (prints the packet as spaced hex):
   hil encode wr8 empty
   hil encode wr8 auth [TEXT]               TEXT: exactly 10 characters (default: the
                                            profile string HIL-WR8-01)
@@ -51,7 +51,7 @@ Examples:
   hil encode wr8 packet 3 01 01 06 00 00 00 00 00 00   (a size byte not a multiple of 4)
 )";
 
-const char* const kDecodeFooter = R"(Prints one line per packet or error, with the stream offset.
+const char* const kWr8DecodeFooter = R"(Prints one line per packet or error, with the stream offset.
 Examples:
   hil decode wr8 03 01 01 04 64 00 00 00
   hil decode wr8 --sender vehicle 06 01 DC 05 00 00 07 00 78 00 00 00 03 57
@@ -149,7 +149,7 @@ protocol::Bytes parse_hex_arg(std::string_view text, std::string_view what) {
   return *bytes;
 }
 
-struct EncodeArgs {
+struct Wr8EncodeArgs {
   std::vector<std::string> words;
   ProfileArgs profile;
   bool unchecked = false;
@@ -165,7 +165,7 @@ void expect_count(const std::vector<std::string>& w, std::size_t min, std::size_
 }
 
 // Builds the packet the words describe; throws UsageError for bad words.
-protocol::Bytes build_packet(const EncodeArgs& a, const wr8::Profile& profile) {
+protocol::Bytes build_packet(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
   const auto& w = a.words;
   const std::string form = normalised(w[0]);
   const auto encode = [&](const wr8::Message& m) {
@@ -297,7 +297,7 @@ protocol::Bytes build_packet(const EncodeArgs& a, const wr8::Profile& profile) {
 }  // namespace
 
 void register_wr8(CommandSet& commands) {
-  auto enc_args = std::make_shared<EncodeArgs>();
+  auto enc_args = std::make_shared<Wr8EncodeArgs>();
   auto* enc = commands.encode.add_subcommand(
       "wr8", "WR8 packet from a form and its fields, e.g. task 1 drive 100");
   enc->add_option("form", enc_args->words, "FORM [ARGS...]: see the forms below")->required();
@@ -309,7 +309,7 @@ void register_wr8(CommandSet& commands) {
   enc->add_option(
       "--unparsed", enc_args->unparsed,
       "data: bytes appended to the block after the values (start with an unknown code)");
-  enc->footer(kEncodeFooter);
+  enc->footer(kWr8EncodeFooter);
   enc->callback([&run = commands.run, enc_args] {
     run = [enc_args]() -> int {
       try {
@@ -345,7 +345,7 @@ void register_wr8(CommandSet& commands) {
   dec->add_option("--max-packet", dec_args->max_packet,
                   "Longest packet in bytes (at least 16); longer ones are reported as oversized. "
                   "Default: the longest the profile can declare");
-  dec->footer(kDecodeFooter);
+  dec->footer(kWr8DecodeFooter);
   dec->callback([&run = commands.run, dec_args] {
     run = [dec_args]() -> int {
       const auto bytes = read_decode_input(dec_args->input, true);

@@ -14,7 +14,7 @@ namespace {
 
 constexpr std::size_t kSent = 0;
 constexpr std::size_t kDelivered = 1;
-constexpr const char* kKindNames[2] = {"sent", "delivered"};
+constexpr const char* kStageNames[2] = {"sent", "delivered"};
 
 std::size_t index_of(Direction d) {
   return static_cast<std::size_t>(d);
@@ -133,11 +133,11 @@ void WireLog::on_open(Time at, const std::string& client, const std::string& car
 }
 
 void WireLog::on_sent(Time at, Direction d, protocol::ByteView bytes) {
-  on_bytes(kKindNames[kSent], kSent, at, d, bytes);
+  on_bytes(kStageNames[kSent], kSent, at, d, bytes);
 }
 
 void WireLog::on_delivered(Time at, Direction d, protocol::ByteView bytes) {
-  on_bytes(kKindNames[kDelivered], kDelivered, at, d, bytes);
+  on_bytes(kStageNames[kDelivered], kDelivered, at, d, bytes);
 }
 
 void WireLog::on_bytes(const char* event, std::size_t kind_index, Time at, Direction d,
@@ -184,7 +184,7 @@ void WireLog::on_close(Time at, const LinkClose& close) {
       std::vector<WireFrame> frames;
       splitter->finish(frames);
       if (frames.empty()) continue;
-      leftovers.push_back({{"event", kKindNames[kind]},
+      leftovers.push_back({{"event", kStageNames[kind]},
                            {"dir", std::string(to_string(static_cast<Direction>(dir)))},
                            {"frames", frames_json(frames)}});
     }

@@ -1,5 +1,7 @@
 #include "protocol/common/bytes.hpp"
 
+#include <cstdio>
+
 namespace hil::protocol {
 namespace {
 
@@ -20,6 +22,12 @@ Bytes to_bytes(std::string_view text) {
 
 std::string to_string(ByteView bytes) {
   return std::string(bytes.begin(), bytes.end());
+}
+
+std::string hex_literal(std::uint8_t byte) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(byte));
+  return buf;
 }
 
 std::string to_hex(ByteView bytes) {

@@ -22,6 +22,9 @@ std::string to_string(ByteView bytes);
 /// Spaced uppercase hex: "2A 2B 2C".
 std::string to_hex(ByteView bytes);
 
+/// One byte as a C literal: "0x2A".
+std::string hex_literal(std::uint8_t byte);
+
 /// Parses hex written with or without spaces, commas or a 0x prefix per byte
 /// ("2A 2B", "2a2b", "0x2A,0x2B"). Returns nullopt on an odd digit count or a
 /// character that is not hex.

@@ -13,12 +13,6 @@ constexpr std::string_view kStartText = "\x2A\x2B\x2C\x2D";
 constexpr std::size_t kMinFrameBytes = kOverheadBytes + 1;
 constexpr std::size_t kLargestFrameBytes = kOverheadBytes + 255;
 
-std::string hex_byte(std::uint8_t v) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(v));
-  return buf;
-}
-
 std::string where(std::size_t group_index) {
   return "group byte " + std::to_string(group_index) + ", frame byte " +
          std::to_string(group_index + kHeaderBytes);
@@ -66,8 +60,8 @@ Item decode_checked(ByteView raw, const DecoderOptions& options) {
 
 std::string checksum_detail(ByteView candidate) {
   const ByteView group = candidate.subspan(kHeaderBytes, candidate.size() - kOverheadBytes);
-  return "checksum byte " + hex_byte(candidate.back()) + " at frame byte " +
-         std::to_string(candidate.size() - 1) + " does not match " + hex_byte(checksum(group)) +
+  return "checksum byte " + hex_literal(candidate.back()) + " at frame byte " +
+         std::to_string(candidate.size() - 1) + " does not match " + hex_literal(checksum(group)) +
          " computed over the " + std::to_string(group.size()) + "-byte command group";
 }
 
@@ -134,9 +128,9 @@ std::variant<CommandGroup, GroupError> parse_group(ByteView group) {
     const CommandSpec* spec = find_spec(group[i]);
     if (spec == nullptr) {
       return GroupError{ErrorKind::unknown_code,
-                        "unknown command id " + hex_byte(group[i]) + " at " + where(i) +
+                        "unknown command id " + hex_literal(group[i]) + " at " + where(i) +
                             " (command " + std::to_string(number) + ")",
-                        hex_byte(group[i])};
+                        hex_literal(group[i])};
     }
     const std::size_t left = group.size() - i - 1;
     if (left < spec->data_bytes) {
@@ -259,7 +253,7 @@ void Decoder::advance(std::vector<Item>& out) {
           restart_hunting();
         } else if (std::size_t{b} + kOverheadBytes > options_.max_frame_bytes) {
           emit_error(scan_, ErrorKind::oversized,
-                     "length byte " + hex_byte(b) + " announces a " + std::to_string(b) +
+                     "length byte " + hex_literal(b) + " announces a " + std::to_string(b) +
                          "-byte command group; frames are limited to " +
                          std::to_string(options_.max_frame_bytes) +
                          " bytes (the robot's serial buffer), so only the start sequence and "

@@ -49,12 +49,6 @@ Rgb rgb_at(ByteView d, std::size_t i) {
   return Rgb{d[i], d[i + 1], d[i + 2]};
 }
 
-std::string hex_byte(std::uint8_t v) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned>(v));
-  return buf;
-}
-
 std::string rgb_text(const Rgb& c) {
   return "rgb=(" + std::to_string(c.red) + "," + std::to_string(c.green) + "," +
          std::to_string(c.blue) + ")";
@@ -63,17 +57,18 @@ std::string rgb_text(const Rgb& c) {
 std::string spin_text(std::uint8_t spin) {
   if (spin == kSpinForward) return "forward";
   if (spin == kSpinBackward) return "backward";
-  return "spin?" + hex_byte(spin);
+  return "spin?" + hex_literal(spin);
 }
 
 std::optional<std::string> check_spin(std::uint8_t spin, const char* field) {
   if (spin <= kSpinBackward) return std::nullopt;
-  return std::string(field) + " " + hex_byte(spin) + " is neither 0 (forward) nor 1 (backward)";
+  return std::string(field) + " " + hex_literal(spin) + " is neither 0 (forward) nor 1 (backward)";
 }
 
 std::optional<std::string> check_belt(std::uint8_t led, const char* field, const ValueLimits& l) {
   if (led <= l.max_belt_led_id) return std::nullopt;
-  return std::string(field) + " " + hex_byte(led) + " outside 0x00.." + hex_byte(l.max_belt_led_id);
+  return std::string(field) + " " + hex_literal(led) + " outside 0x00.." +
+         hex_literal(l.max_belt_led_id);
 }
 
 }  // namespace
@@ -177,7 +172,7 @@ std::optional<std::string> range_problem(const Command& c, const ValueLimits& li
                  [](const EarAll&) -> R { return std::nullopt; },
                  [](const EarSingle& v) -> R {
                    if (v.led <= 1) return std::nullopt;
-                   return "ear LED id " + hex_byte(v.led) + " outside 0x00..0x01";
+                   return "ear LED id " + hex_literal(v.led) + " outside 0x00..0x01";
                  },
                  [](const BeltAll&) -> R { return std::nullopt; },
                  [&](const BeltRange& v) -> R {
@@ -185,8 +180,8 @@ std::optional<std::string> range_problem(const Command& c, const ValueLimits& li
                    if (auto p = check_belt(v.last, "last belt LED id", limits)) return p;
                    // A robot walking first..last would light nothing: surely a mistake.
                    if (v.first > v.last) {
-                     return "first belt LED id " + hex_byte(v.first) + " is after last " +
-                            hex_byte(v.last);
+                     return "first belt LED id " + hex_literal(v.first) + " is after last " +
+                            hex_literal(v.last);
                    }
                    return std::nullopt;
                  },
@@ -200,11 +195,11 @@ std::optional<std::string> range_problem(const Command& c, const ValueLimits& li
                  [](const MotorRight& v) -> R { return check_spin(v.spin, "spin"); },
                  [](const Motivator& v) -> R {
                    if (v.id >= 0x51 && v.id <= 0x55) return std::nullopt;
-                   return "motivator id " + hex_byte(v.id) + " outside 0x51..0x55";
+                   return "motivator id " + hex_literal(v.id) + " outside 0x51..0x55";
                  },
                  [](const Guidance& v) -> R {
                    if (v.id >= 0x41 && v.id <= 0x4F) return std::nullopt;
-                   return "guidance id " + hex_byte(v.id) + " outside 0x41..0x4F";
+                   return "guidance id " + hex_literal(v.id) + " outside 0x41..0x4F";
                  }},
       c);
 }
@@ -240,8 +235,8 @@ std::string describe(const Command& c) {
           [&](const MotorRight& v) {
             add(spin_text(v.spin) + " speed=" + std::to_string(v.speed));
           },
-          [&](const Motivator& v) { add("id=" + hex_byte(v.id)); },
-          [&](const Guidance& v) { add("id=" + hex_byte(v.id)); }},
+          [&](const Motivator& v) { add("id=" + hex_literal(v.id)); },
+          [&](const Guidance& v) { add("id=" + hex_literal(v.id)); }},
       c);
   return out;
 }

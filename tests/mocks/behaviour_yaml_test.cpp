@@ -111,8 +111,9 @@ TEST(BehaviourYaml, ErrorsNameTheFileLineColumnAndWhatWasExpected) {
 
 TEST(BehaviourYaml, EveryShippedBehavioursFileLoads) {
   std::size_t files = 0;
-  for (const auto& entry :
-       std::filesystem::directory_iterator(std::string(HIL_SOURCE_DIR) + "/scenarios/behaviours")) {
+  const std::filesystem::path folder =
+      std::filesystem::path(HIL_SOURCE_DIR) / "scenarios" / "behaviours";
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (entry.path().extension() != ".yaml") continue;
     ++files;
     EXPECT_FALSE(load_behaviours(entry.path().string()).empty()) << entry.path();

@@ -19,6 +19,7 @@
 #include "sim/presets.hpp"
 #include "tests/mocks/mock_test_support.hpp"
 #include "tests/protocol/leka/leka_generators.hpp"
+#include "tests/support/hex.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -40,11 +41,7 @@ link::Time at_ms(int ms) {
   return link::Time(milliseconds(ms));
 }
 
-Bytes hex(std::string_view text) {
-  auto bytes = protocol::parse_hex(text);
-  if (!bytes) throw std::invalid_argument("bad hex in test: " + std::string(text));
-  return *bytes;
-}
+using hil::test::hex;
 
 Bytes frame(std::initializer_list<leka::Command> commands) {
   return leka::encode(leka::CommandGroup{commands});

@@ -19,13 +19,6 @@ using proto::Mode;
 
 namespace {
 
-std::string ms(Duration d) {
-  return link::format_ms(d);
-}
-std::string text_of(const protocol::Bytes& b) {
-  return std::string(b.begin(), b.end());
-}
-
 std::string frame_of(const std::string& payload) {
   const std::string base = "LOGI:" + payload;
   unsigned sum = 0;
@@ -39,11 +32,6 @@ std::string three(int n) {
   char b[8];
   std::snprintf(b, sizeof b, "%03d", n);
   return b;
-}
-const char* dir_word(Direction d) {
-  static const char* words[] = {"STOP", "FWD", "BWD", "LEFT", "RIGHT", "LF",
-                                "RF",   "LB",  "RB",  "CW",   "CCW"};
-  return words[static_cast<int>(d)];
 }
 /// The payload written from the documentation's command table.
 std::string payload_text(const proto::Message& m) {

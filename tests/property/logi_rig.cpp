@@ -131,6 +131,19 @@ Focus focus_for(Prop p) {
 
 namespace {
 
+bool is_movement(const proto::Message& m) {
+  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction != Direction::stop;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
+  return false;
+}
+bool is_stop(const proto::Message& m) {
+  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction == Direction::stop;
+  if (const auto* st = std::get_if<proto::SetRun>(&m)) return !st->run;
+  return false;
+}
+
+}  // namespace
+
 const char* dir_word(Direction d) {
   switch (d) {
     case Direction::stop:
@@ -159,17 +172,6 @@ const char* dir_word(Direction d) {
   return "?";
 }
 
-bool is_movement(const proto::Message& m) {
-  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction != Direction::stop;
-  if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
-  return false;
-}
-bool is_stop(const proto::Message& m) {
-  if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction == Direction::stop;
-  if (const auto* st = std::get_if<proto::SetRun>(&m)) return !st->run;
-  return false;
-}
-
 std::string ms(Duration d) {
   return link::format_ms(d);
 }
@@ -177,8 +179,6 @@ std::string ms(Duration d) {
 std::string text_of(const protocol::Bytes& b) {
   return std::string(b.begin(), b.end());
 }
-
-}  // namespace
 
 // ---------------------------------------------------------------- the rig
 

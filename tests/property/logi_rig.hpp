@@ -29,6 +29,13 @@ using link::milliseconds;
 using link::seconds;
 using link::Time;
 
+/// A direction as the LOGI command table spells it ("FWD", "CCW").
+const char* dir_word(protocol::logi::Direction d);
+/// A duration in milliseconds, as the checks print it.
+std::string ms(Duration d);
+/// A frame's bytes as text (LOGI frames are ASCII).
+std::string text_of(const protocol::Bytes& b);
+
 /// Every session runs this long in virtual time.
 inline constexpr Duration kSessionLength = seconds(60);
 

@@ -13,7 +13,7 @@ namespace {
 
 using protocol::to_bytes;
 
-constexpr std::int64_t kWallUs = 1'700'000'000'000'000;
+using test::kWallUs;
 
 struct Collected {
   std::string data;

@@ -14,6 +14,10 @@
 
 namespace hil::link::test {
 
+/// The wall clock the capture tests give the wire log and the pcap writer
+/// (2023-11-14 22:13:20 UTC, in microseconds).
+inline constexpr std::int64_t kWallUs = 1'700'000'000'000'000;
+
 /// A file path unique to this process and test, removed when it goes away.
 class ScratchFile {
  public:

@@ -17,7 +17,7 @@ namespace {
 using protocol::to_bytes;
 using test::ScratchFile;
 
-constexpr std::int64_t kWallUs = 1'700'000'000'000'000;
+using test::kWallUs;
 
 bool tshark_installed() {
   return std::system("command -v tshark >/dev/null 2>&1") == 0;
@@ -79,7 +79,8 @@ struct PcapTest : ::testing::Test {
   // A short LOGI exchange: the client sets the speed, the car answers with
   // feedback and a status frame cut in two by a fragment fault.
   void write_logi_exchange(PcapWriter& w,
-                           const LinkClose& close = {LinkClose::By::car, CloseMode::graceful, "car closed"}) {
+                           const LinkClose& close = {LinkClose::By::car, CloseMode::graceful,
+                                                     "car closed"}) {
     w.on_open(seconds(1), "client", "car");
     w.on_sent(seconds(1) + milliseconds(10), Direction::to_car,
               to_bytes("ignored: pcap shows deliveries"));
@@ -185,7 +186,8 @@ TEST_F(PcapTest, HandshakeDataAndGracefulCloseByTheCar) {
 TEST_F(PcapTest, ResetReasonEndsWithOneRst) {
   REQUIRE_TSHARK();
   auto w = make();
-  write_logi_exchange(*w, {LinkClose::By::fault, CloseMode::reset, "fault injected: reset (to_car)"});
+  write_logi_exchange(*w,
+                      {LinkClose::By::fault, CloseMode::reset, "fault injected: reset (to_car)"});
   const auto rows = tshark(file.path(), "-T fields -e tcp.srcport -e tcp.flags");
   ASSERT_EQ(rows.size(), 8u);
   EXPECT_EQ(rows.back(), (std::vector<std::string>{"40000", "0x0014"}));

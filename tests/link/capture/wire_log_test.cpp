@@ -13,11 +13,11 @@ namespace {
 using protocol::to_bytes;
 using test::ScratchFile;
 
-constexpr std::int64_t kWallUs = 1'700'000'000'123'456;
+constexpr std::int64_t kLogWallUs = 1'700'000'000'123'456;
 
 struct LogFixture : ::testing::Test {
   ScratchFile file{".ndjson"};
-  std::int64_t wall_us = kWallUs;
+  std::int64_t wall_us = kLogWallUs;
 
   std::shared_ptr<WireLog> make(
       std::shared_ptr<const ProtocolAdapter> protocol = protocol_adapter("logi"),
@@ -44,7 +44,7 @@ TEST_F(WireLogTest, OpenRecordCarriesTimesSidesAndProtocol) {
   EXPECT_EQ(r[0]["event"], "open");
   EXPECT_EQ(r[0]["link"], "car0");
   EXPECT_EQ(r[0]["t_ms"], 5.0);
-  EXPECT_EQ(r[0]["wall_us"], kWallUs);
+  EXPECT_EQ(r[0]["wall_us"], kLogWallUs);
   EXPECT_EQ(r[0]["client"], "tcp 127.0.0.1:9000 <- 127.0.0.1:53422");
   EXPECT_EQ(r[0]["car"], "mem car0");
   EXPECT_EQ(r[0]["protocol"], "logi");
@@ -169,7 +169,7 @@ TEST_F(WireLogTest, FaultRecordShowsRuleAndBytesBeforeAndAfter) {
   ASSERT_EQ(r.size(), 1u);
   EXPECT_EQ(r[0]["event"], "fault");
   EXPECT_EQ(r[0]["t_ms"], 2.5);
-  EXPECT_EQ(r[0]["wall_us"], kWallUs);
+  EXPECT_EQ(r[0]["wall_us"], kLogWallUs);
   EXPECT_EQ(r[0]["dir"], "to_client");
   EXPECT_EQ(r[0]["kind"], "corrupt");
   EXPECT_EQ(r[0]["rule"], "flip-checksum");
@@ -194,7 +194,7 @@ TEST_F(WireLogTest, DropFaultHasEmptyAfter) {
 TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
   auto log = make();
   log->on_delivered(milliseconds(1), Direction::to_client, to_bytes("LOGI:STAT:1:"));
-  wall_us = kWallUs + 7;
+  wall_us = kLogWallUs + 7;
   log->on_close(milliseconds(3), {LinkClose::By::car, CloseMode::graceful, "car closed"});
   const auto r = records();
   ASSERT_EQ(r.size(), 2u);
@@ -203,7 +203,7 @@ TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
   EXPECT_EQ(r[1]["by"], "car");
   EXPECT_EQ(r[1]["mode"], "graceful");
   EXPECT_EQ(r[1]["t_ms"], 3.0);
-  EXPECT_EQ(r[1]["wall_us"], kWallUs + 7);
+  EXPECT_EQ(r[1]["wall_us"], kLogWallUs + 7);
   ASSERT_EQ(r[1]["unfinished"].size(), 1u);
   EXPECT_EQ(r[1]["unfinished"][0]["event"], "delivered");
   EXPECT_EQ(r[1]["unfinished"][0]["dir"], "to_client");

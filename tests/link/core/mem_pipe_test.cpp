@@ -6,7 +6,7 @@
 namespace hil::link {
 namespace {
 
-struct Recorder {
+struct PipeRecorder {
   std::string data;
   std::optional<std::error_code> closed;
   BytePipe::Handlers handlers() {
@@ -18,7 +18,7 @@ struct Recorder {
 TEST(MemPipe, DeliversInOrderOnTheExecutor) {
   VirtualExecutor ex;
   auto [a, b] = make_mem_pipe(ex, "t");
-  Recorder ra, rb;
+  PipeRecorder ra, rb;
   a->start(ra.handlers());
   b->start(rb.handlers());
   a->write(protocol::to_bytes("hello "));
@@ -33,7 +33,7 @@ TEST(MemPipe, DeliversInOrderOnTheExecutor) {
 TEST(MemPipe, BytesBeforeStartAreKept) {
   VirtualExecutor ex;
   auto [a, b] = make_mem_pipe(ex, "t");
-  Recorder ra, rb;
+  PipeRecorder ra, rb;
   a->start(ra.handlers());
   a->write(protocol::to_bytes("early"));
   ex.run_until_idle();
@@ -45,7 +45,7 @@ TEST(MemPipe, BytesBeforeStartAreKept) {
 TEST(MemPipe, GracefulCloseDeliversDataThenEndOfStream) {
   VirtualExecutor ex;
   auto [a, b] = make_mem_pipe(ex, "t");
-  Recorder ra, rb;
+  PipeRecorder ra, rb;
   a->start(ra.handlers());
   b->start(rb.handlers());
   a->write(protocol::to_bytes("last words"));
@@ -62,7 +62,7 @@ TEST(MemPipe, GracefulCloseDeliversDataThenEndOfStream) {
 TEST(MemPipe, ResetDropsDataInFlight) {
   VirtualExecutor ex;
   auto [a, b] = make_mem_pipe(ex, "t");
-  Recorder ra, rb;
+  PipeRecorder ra, rb;
   a->start(ra.handlers());
   b->start(rb.handlers());
   a->write(protocol::to_bytes("lost"));
@@ -85,7 +85,7 @@ TEST(MemNetwork, ConnectsToAListener) {
   });
   ex.run_until_idle();
   ASSERT_TRUE(server && client);
-  Recorder rs, rc;
+  PipeRecorder rs, rc;
   server->start(rs.handlers());
   client->start(rc.handlers());
   client->write(protocol::to_bytes("LOGI:SP:050:D7#"));

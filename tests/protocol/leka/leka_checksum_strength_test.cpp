@@ -17,14 +17,13 @@
 #include <string>
 
 #include "protocol/leka/codec.hpp"
+#include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::leka {
 namespace {
 
-Bytes hex(std::string_view text) {
-  return parse_hex(text).value();
-}
+using test::hex;
 
 // Measured over the 106-byte seed frame (SeedBeltFrameExhaustive).
 constexpr std::size_t kBeltLengthEscapes = 0;
@@ -128,7 +127,7 @@ void print(const char* title, const Table& t) {
   line("whole frame", t.total());
 }
 
-const Bytes kBeltFrame =
+const Bytes kSeedBeltFrame =
     hex("2A 2B 2C 2D 64 15 00 33 00 00 15 01 66 00 00 15 02 99 00 00 15 03 CC 00 00 15 04 FF 00 00 "
         "15 05 00 00 00 15 06 00 33 00 15 07 00 66 00 15 08 00 99 00 15 09 00 CC 00 15 0A 00 FF 00 "
         "15 0B 00 00 00 15 0C 00 00 33 15 0D 00 00 66 15 0E 00 00 99 15 0F 00 00 CC 15 10 FF 00 00 "
@@ -157,7 +156,7 @@ TEST(LekaChecksumStrength, FiveByteSeedFrameLetsNineChangesThrough) {
 
 TEST(LekaChecksumStrength, SeedBeltFrameExhaustive) {
   Table t;
-  measure(kBeltFrame, t);
+  measure(kSeedBeltFrame, t);
   print("106-byte seed frame (20 belt LEDs)", t);
   EXPECT_EQ(t.total().changes, 106u * 255u);
   EXPECT_EQ(t.rows[kStartRow].escaped, 0u);

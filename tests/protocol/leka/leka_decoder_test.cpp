@@ -1,14 +1,13 @@
 #include <gtest/gtest.h>
 
 #include "protocol/leka/codec.hpp"
+#include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::leka {
 namespace {
 
-Bytes hex(std::string_view text) {
-  return parse_hex(text).value();
-}
+using test::hex;
 
 const Bytes kInfo = hex("2A 2B 2C 2D 01 70 70");
 const Bytes kBeltRed = hex("2A 2B 2C 2D 05 15 00 FF 00 00 41");

@@ -5,13 +5,12 @@
 #include <gtest/gtest.h>
 
 #include "protocol/leka/codec.hpp"
+#include "tests/support/hex.hpp"
 
 namespace hil::protocol::leka {
 namespace {
 
-Bytes hex(std::string_view text) {
-  return parse_hex(text).value();
-}
+using test::hex;
 
 CommandGroup belt_of_twenty() {
   // The seed's 20-LED example: LED i gets the i-th colour of this list.

@@ -3,14 +3,13 @@
 #include <stdexcept>
 
 #include "protocol/wr8/codec.hpp"
+#include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::wr8 {
 namespace {
 
-Bytes hex(std::string_view text) {
-  return parse_hex(text).value();
-}
+using test::hex;
 
 std::vector<Item> decode_all(std::string_view hex_stream, DecoderOptions options = {}) {
   return test::decode_whole<Decoder, Item>(Decoder(std::move(options)), hex(hex_stream));

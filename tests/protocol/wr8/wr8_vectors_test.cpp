@@ -7,14 +7,13 @@
 #include <gtest/gtest.h>
 
 #include "protocol/wr8/codec.hpp"
+#include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::wr8 {
 namespace {
 
-Bytes hex(std::string_view text) {
-  return parse_hex(text).value();
-}
+using test::hex;
 
 Profile big_endian() {
   Profile p;
