@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The CI fuzz run: every libFuzzer target for a few seconds from its seed
 # corpus (ci/fuzz.sh with seconds instead of minutes, in a throw-away work
-# folder). Usage: ci/fuzz-smoke.sh [SECONDS_PER_TARGET]
+# folder), one target per core at a time (HIL_FUZZ_JOBS sets how many).
+# Usage: ci/fuzz-smoke.sh [SECONDS_PER_TARGET]
 # The long hunt is ci/fuzz.sh (minutes per target, corpora kept).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,7 +11,7 @@ seconds="${1:-20}"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 status=0
-bash ci/fuzz.sh --seconds="$seconds" --work="$work" | tee "$work/out" || status=$?
+bash ci/fuzz.sh --seconds="$seconds" --jobs="${HIL_FUZZ_JOBS:-$(nproc)}" --work="$work" | tee "$work/out" || status=$?
 # Crash artifacts would vanish with the work folder; keep them for CI.
 if compgen -G "$work/artifacts/*" >/dev/null; then
   mkdir -p build-fuzz/fuzz-artifacts

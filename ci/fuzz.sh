@@ -12,6 +12,8 @@
 #   --merge             afterwards, add the inputs that reach new coverage to
 #                       the checked-in seeds in tests/fuzz/corpus/<target>/.
 #   --no-build          use the targets already in build-fuzz.
+#   --jobs=N            run N targets at a time (default 1; the CI smoke run
+#                       uses one per core).
 #
 # Each target starts from tests/fuzz/corpus/<target>/ plus what earlier runs
 # found. A crash, leak, timeout or out-of-memory input is saved as
@@ -26,6 +28,7 @@ minutes=3
 work=build-fuzz/fuzz-work
 merge=0
 build=1
+jobs=1
 targets=()
 for arg in "$@"; do
   case "$arg" in
@@ -33,7 +36,8 @@ for arg in "$@"; do
     --work=*) work="${arg#*=}" ;;
     --merge) merge=1 ;;
     --no-build) build=0 ;;
-    -h | --help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --jobs=*) jobs="${arg#*=}" ;;
+    -h | --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "ci/fuzz.sh: unknown option $arg" >&2; exit 2 ;;
     *)
       if [[ "$arg" =~ ^[0-9]+([.][0-9]+)?$ ]] && [ ${#targets[@]} -eq 0 ] && [ -z "${minutes_given:-}" ]; then
@@ -43,6 +47,7 @@ for arg in "$@"; do
       fi ;;
   esac
 done
+[[ "$jobs" =~ ^[1-9][0-9]*$ ]] || { echo "ci/fuzz.sh: --jobs wants a positive number, got '$jobs'" >&2; exit 2; }
 [ -n "$seconds" ] || seconds=$(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')
 
 if [ "$build" = 1 ]; then
@@ -57,52 +62,72 @@ if [ ${#targets[@]} -eq 0 ]; then
 fi
 [ ${#targets[@]} -gt 0 ] || { echo "ci/fuzz.sh: no fuzz targets were built" >&2; exit 1; }
 
-mkdir -p "$work/corpus" "$work/logs" "$work/artifacts"
+mkdir -p "$work/corpus" "$work/logs" "$work/artifacts" "$work/rows"
 summary="$work/summary.txt"
 printf '%-18s %12s %9s %8s %8s %8s  %s\n' target runs execs/s cov ft corpus result >"$summary"
-passed=0
-failed=0
-for name in "${targets[@]}"; do
-  fuzzer="build-fuzz/tests/fuzz/${name}_fuzz"
+
+# run_target NAME: one fuzzer for $seconds; its console lines go to
+# $work/rows/NAME.out, its summary row to NAME.row, and its exit status says
+# whether it passed. Targets share nothing, so several run side by side.
+run_target() {
+  local name=$1 fuzzer="build-fuzz/tests/fuzz/${1}_fuzz"
+  local row="$work/rows/$name.row" out="$work/rows/$name.out"
   if [ ! -x "$fuzzer" ]; then
-    echo "ci/fuzz.sh: no target $name (looked for $fuzzer)" >&2
-    failed=$((failed + 1))
-    printf '%-18s %12s %9s %8s %8s %8s  %s\n' "$name" - - - - - "not built" >>"$summary"
-    continue
+    echo "ci/fuzz.sh: no target $name (looked for $fuzzer)" >"$out"
+    printf '%-18s %12s %9s %8s %8s %8s  %s\n' "$name" - - - - - "not built" >"$row"
+    return 1
   fi
-  corpus="$work/corpus/$name"
-  log="$work/logs/$name.log"
+  local corpus="$work/corpus/$name" log="$work/logs/$name.log"
   mkdir -p "$corpus"
   # Seeds are copied in, so the source tree is only written with --merge.
   if [ -d "tests/fuzz/corpus/$name" ]; then cp -n tests/fuzz/corpus/"$name"/* "$corpus"/ 2>/dev/null || true; fi
-  echo "-- $name: ${seconds}s"
-  result=ok
+  echo "-- $name: ${seconds}s" >"$out"
+  local result=ok status=0
   # -timeout: one input taking 10 s is a hang; -rss_limit_mb: a leak-like
   # growth is a finding, not a machine brought to its knees.
   if ! "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$work/artifacts/$name-" "$corpus" >"$log" 2>&1; then
     result="FAILED"
+    local artifact
     artifact=$(sed -n 's/.*Test unit written to \(.*\)$/\1/p' "$log" | tail -1)
     [ -z "$artifact" ] || result="FAILED: $artifact"
-    failed=$((failed + 1))
-    echo "FAILED: $name (last lines of $log follow)"
-    tail -40 "$log"
-  else
-    passed=$((passed + 1))
+    status=1
+    { echo "FAILED: $name (last lines of $log follow)"; tail -40 "$log"; } >>"$out"
   fi
+  local runs speed cov ft files
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
   ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
   files=$(find "$corpus" -type f | wc -l)
   printf '%-18s %12s %9s %8s %8s %8s  %s\n' "$name" "${runs:--}" "${speed:--}" "${cov:--}" \
-    "${ft:--}" "$files" "$result" >>"$summary"
+    "${ft:--}" "$files" "$result" >"$row"
   if [ "$merge" = 1 ] && [ "$result" = ok ]; then
     mkdir -p "tests/fuzz/corpus/$name"
     # -merge=1 adds to the first folder only inputs that reach new features.
     "$fuzzer" -merge=1 -timeout=10 "tests/fuzz/corpus/$name" "$corpus" >>"$log" 2>&1
   fi
+  return "$status"
+}
+
+# At most $jobs targets at a time; each one's lines are printed when it ends.
+declare -A name_of=()
+passed=0
+failed=0
+reap_one() {
+  local done_pid status=0
+  wait -n -p done_pid || status=$?
+  if [ "$status" -eq 0 ]; then passed=$((passed + 1)); else failed=$((failed + 1)); fi
+  cat "$work/rows/${name_of[$done_pid]}.out"
+  unset "name_of[$done_pid]"
+}
+for name in "${targets[@]}"; do
+  while [ "${#name_of[@]}" -ge "$jobs" ]; do reap_one; done
+  run_target "$name" &
+  name_of[$!]=$name
 done
+while [ "${#name_of[@]}" -gt 0 ]; do reap_one; done
+for name in "${targets[@]}"; do cat "$work/rows/$name.row" >>"$summary"; done
 
 echo
 cat "$summary"

@@ -12,7 +12,7 @@ packages=(
   libbox2d-dev               # Box2D 2.4
   libcli11-dev               # command-line parsing
   libbenchmark-dev           # Google Benchmark
-  libyaml-cpp-dev            # fault profiles (and, later, scenarios and worlds)
+  libyaml-cpp-dev            # fault profiles, scenarios, worlds and behaviours
   nlohmann-json3-dev         # NDJSON wire logs and timelines
   tshark                     # reads the pcap files hil writes (tested)
   libncurses-dev             # the logi-client terminal UI

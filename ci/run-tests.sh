@@ -1,50 +1,108 @@
 #!/usr/bin/env bash
 # Sets up this machine (Debian 12) and runs every test hil has:
-#   1. the default RelWithDebInfo build and its CTest suite,
+#   1. the default RelWithDebInfo build and its whole CTest suite,
 #   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer,
-#   3. the same suite built with ThreadSanitizer,
-#   4. a short smoke run of every libFuzzer target (ci/fuzz-smoke.sh).
-# Set HIL_SKIP_ASAN=1, HIL_SKIP_TSAN=1 or HIL_SKIP_FUZZ=1 to leave a stage
-# out locally.
+#   3. the tests that start threads, processes or real sockets and ptys
+#      (label `threads`, from every source folder) built with ThreadSanitizer,
+#   4. a short run of every libFuzzer target (ci/fuzz-smoke.sh).
+# It ends with the wall time of each stage and of the whole run.
+#
+#   ci/run-tests.sh                 everything, as CI runs it
+#   ci/run-tests.sh --default-only  stage 1 alone: the fast path while developing
+#
+# HIL_SKIP_ASAN=1, HIL_SKIP_TSAN=1 or HIL_SKIP_FUZZ=1 leave one stage out.
+# docs/ci.md has the stages, what each one costs and why.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+default_only=0
+for arg in "$@"; do
+  case "$arg" in
+    --default-only) default_only=1 ;;
+    -h | --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "ci/run-tests.sh: unknown argument '$arg' (try --help)" >&2; exit 2 ;;
+  esac
+done
+
+run_start=$SECONDS
+stage_names=()
+stage_seconds=()
+stage_start=$SECONDS
+# stage NAME: ends the stage that was running (if any) and starts NAME.
+current_stage=""
+stage() {
+  if [ -n "$current_stage" ]; then
+    stage_names+=("$current_stage")
+    stage_seconds+=($((SECONDS - stage_start)))
+  fi
+  current_stage=$1
+  stage_start=$SECONDS
+  [ -z "$1" ] || echo "== $1"
+}
+# The table of stage times: on success just before the closing line, on a
+# failure on the way out, so a slow stage shows in every CI log.
+print_times() {
+  echo
+  echo "stage times (wall):"
+  local i total=$((SECONDS - run_start))
+  for i in "${!stage_names[@]}"; do
+    printf '  %-34s %5d s  (%d min %02d s)\n' "${stage_names[$i]}" "${stage_seconds[$i]}" \
+      $((stage_seconds[i] / 60)) $((stage_seconds[i] % 60))
+  done
+  printf '  %-34s %5d s  (%d min %02d s)\n' "total" "$total" $((total / 60)) $((total % 60))
+}
+on_exit() {
+  local status=$?
+  if [ "$status" -ne 0 ]; then
+    stage ""
+    print_times
+  fi
+  rm -f "$log"
+  exit "$status"
+}
+log=$(mktemp)
+trap on_exit EXIT
+
+stage "install dependencies"
 bash ci/install-deps.sh
 
-log=$(mktemp)
-trap 'rm -f "$log"' EXIT
 # Number of tests CTest ran, from its closing line ("... out of N").
 ran() { sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$log" | tail -1; }
 passed=0
 
-echo "== default build and tests"
+stage "default: build"
 cmake --preset default
 cmake --build --preset default
+stage "default: tests"
 ctest --preset default | tee "$log"
 passed=$((passed + $(ran)))
 
-if [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
-  echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
+if [ "$default_only" = 0 ] && [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
+  stage "asan+ubsan: build"
   cmake --preset asan
   cmake --build --preset asan
+  stage "asan+ubsan: tests"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --preset asan | tee "$log"
   passed=$((passed + $(ran)))
 fi
 
-if [ "${HIL_SKIP_TSAN:-0}" != 1 ]; then
-  echo "== ThreadSanitizer build and tests"
+if [ "$default_only" = 0 ] && [ "${HIL_SKIP_TSAN:-0}" != 1 ]; then
+  stage "tsan: build (threaded tests)"
   cmake --preset tsan
-  cmake --build --preset tsan
+  cmake --build --preset tsan   # only hil_threaded_tests (CMakePresets.json)
+  stage "tsan: tests"
   ctest --preset tsan | tee "$log"
   passed=$((passed + $(ran)))
 fi
 
-if [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
-  echo "== fuzz smoke run"
+if [ "$default_only" = 0 ] && [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
+  stage "fuzz: build and smoke run"
   bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}" | tee "$log"
   passed=$((passed + $(sed -n 's/^fuzz smoke: \([0-9]*\) target.*/\1/p' "$log")))
 fi
 
+stage ""
+print_times
 # Reached only when every stage passed (set -e, pipefail).
 echo "hil: $passed passed, 0 failed"

@@ -1,0 +1,33 @@
+# How hil keeps its builds short on a 2-core machine (docs/ci.md has the
+# measured effect of each): unity builds, one precompiled header of the
+# heavy third-party headers that every test program reuses, and test
+# programs compiled for a short build (tests/CMakeLists.txt).
+
+option(HIL_UNITY_BUILD "Compile each library and program as one unity source" ON)
+option(HIL_PRECOMPILED_HEADERS "Precompile GoogleTest, rapidcheck and the other heavy headers for the tests" ON)
+
+# Unity builds: every target defined after this point compiles its sources
+# as one. That shares one parse of Asio, CLI11, yaml-cpp and the standard
+# library, which cost more than the code of most hil sources.
+# The whole target is one batch, so two files of one target that define the
+# same name in their anonymous namespaces always collide, whatever files are
+# added later (docs/ci.md). GCC takes the sources a unity file includes for
+# headers and warns when a class there holds a type of an anonymous
+# namespace (-Wsubobject-linkage); within one target that is intended.
+if(HIL_UNITY_BUILD)
+  set(CMAKE_UNITY_BUILD ON)
+  set(CMAKE_UNITY_BUILD_BATCH_SIZE 0)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(hil_warnings INTERFACE -Wno-subobject-linkage)
+  endif()
+endif()
+
+# hil_reuse_test_pch(target): the test program compiles against the one
+# precompiled header of hil_test_pch (tests/CMakeLists.txt). All targets in
+# a tree share the compiler flags that matter to a PCH (standard, sanitizer
+# and optimisation flags come from the tree, not the target).
+function(hil_reuse_test_pch target)
+  if(HIL_PRECOMPILED_HEADERS AND TARGET hil_test_pch)
+    target_precompile_headers(${target} REUSE_FROM hil_test_pch)
+  endif()
+endfunction()
