@@ -37,7 +37,7 @@ for arg in "$@"; do
     --merge) merge=1 ;;
     --no-build) build=0 ;;
     --jobs=*) jobs="${arg#*=}" ;;
-    -h | --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "ci/fuzz.sh: unknown option $arg" >&2; exit 2 ;;
     *)
       if [[ "$arg" =~ ^[0-9]+([.][0-9]+)?$ ]] && [ ${#targets[@]} -eq 0 ] && [ -z "${minutes_given:-}" ]; then
