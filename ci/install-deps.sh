@@ -5,7 +5,8 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  clang libclang-rt-14-dev   # libFuzzer targets and the fuzz smoke run
+  clang libclang-rt-14-dev   # the ASan, TSan and libFuzzer trees (clang 14)
+  mold                       # the linker of every tree (cmake/hil_build_speed.cmake)
   libasio-dev                # standalone Asio (header-only)
   libgtest-dev libgmock-dev  # GoogleTest / GoogleMock
   librapidcheck-dev          # property-based tests
