@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The long fuzzing run: builds the libFuzzer targets (fuzz preset: clang,
-# ASan + UBSan) and runs each in turn, keeping its corpus between runs.
+# -O2, ASan + UBSan) and runs each in turn, keeping its corpus between runs.
 #
 #   ci/fuzz.sh [options] [MINUTES_PER_TARGET] [TARGET...]
 #
@@ -8,24 +8,28 @@
 #                       "_fuzz" (logi, scenario, wr8_firmware, ...); default all.
 #   --seconds=N         run each target N seconds instead (the CI smoke run).
 #   --work=DIR          where corpora, logs and crash artifacts live
-#                       (default build-fuzz/fuzz-work; kept between runs).
+#                       (default TREE/fuzz-work; kept between runs).
 #   --merge             afterwards, add the inputs that reach new coverage to
 #                       the checked-in seeds in tests/fuzz/corpus/<target>/.
-#   --no-build          use the targets already in build-fuzz.
+#   --preset=NAME       the tree whose targets run: fuzz (default, build-fuzz/,
+#                       optimised) or asan (build-asan/, the Debug tree of the
+#                       sanitizer stage, which builds them too).
+#   --no-build          use the targets already in the tree.
 #   --jobs=N            run N targets at a time (default 1; the CI smoke run
 #                       uses one per core).
 #
 # Each target starts from tests/fuzz/corpus/<target>/ plus what earlier runs
 # found. A crash, leak, timeout or out-of-memory input is saved as
 # DIR/artifacts/<target>-<kind>-<sha1> and fails the run; replay one with
-# build-fuzz/tests/fuzz/<target>_fuzz DIR/artifacts/<file>. The last line is
+# TREE/tests/fuzz/<target>_fuzz DIR/artifacts/<file>. The last line is
 # "fuzz: N target(s) passed, M failed".
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=""
 minutes=3
-work=build-fuzz/fuzz-work
+work=""
+preset=fuzz
 merge=0
 build=1
 jobs=1
@@ -35,9 +39,10 @@ for arg in "$@"; do
     --seconds=*) seconds="${arg#*=}" ;;
     --work=*) work="${arg#*=}" ;;
     --merge) merge=1 ;;
+    --preset=*) preset="${arg#*=}" ;;
     --no-build) build=0 ;;
     --jobs=*) jobs="${arg#*=}" ;;
-    -h | --help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "ci/fuzz.sh: unknown option $arg" >&2; exit 2 ;;
     *)
       if [[ "$arg" =~ ^[0-9]+([.][0-9]+)?$ ]] && [ ${#targets[@]} -eq 0 ] && [ -z "${minutes_given:-}" ]; then
@@ -48,15 +53,20 @@ for arg in "$@"; do
   esac
 done
 [[ "$jobs" =~ ^[1-9][0-9]*$ ]] || { echo "ci/fuzz.sh: --jobs wants a positive number, got '$jobs'" >&2; exit 2; }
+case "$preset" in
+  fuzz | asan) tree="build-$preset" ;;
+  *) echo "ci/fuzz.sh: --preset takes fuzz or asan, got '$preset'" >&2; exit 2 ;;
+esac
+[ -n "$work" ] || work="$tree/fuzz-work"
 [ -n "$seconds" ] || seconds=$(awk -v m="$minutes" 'BEGIN { printf "%d", m * 60 }')
 
 if [ "$build" = 1 ]; then
-  cmake --preset fuzz >/dev/null
-  cmake --build --preset fuzz
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" --target hil_fuzzers
 fi
 
 if [ ${#targets[@]} -eq 0 ]; then
-  for fuzzer in build-fuzz/tests/fuzz/*_fuzz; do
+  for fuzzer in "$tree"/tests/fuzz/*_fuzz; do
     [ -x "$fuzzer" ] && targets+=("$(basename "$fuzzer" _fuzz)")
   done
 fi
@@ -70,7 +80,7 @@ printf '%-18s %12s %9s %8s %8s %8s  %s\n' target runs execs/s cov ft corpus resu
 # $work/rows/NAME.out, its summary row to NAME.row, and its exit status says
 # whether it passed. Targets share nothing, so several run side by side.
 run_target() {
-  local name=$1 fuzzer="build-fuzz/tests/fuzz/${1}_fuzz"
+  local name=$1 fuzzer="$tree/tests/fuzz/${1}_fuzz"
   local row="$work/rows/$name.row" out="$work/rows/$name.out"
   if [ ! -x "$fuzzer" ]; then
     echo "ci/fuzz.sh: no target $name (looked for $fuzzer)" >"$out"
