@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Sets up this machine (Debian 12) and runs every test hil has:
 #   1. the default RelWithDebInfo build and its whole CTest suite,
-#   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer,
+#   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer
+#      (clang), in a tree that builds the libFuzzer targets too,
 #   3. the tests that start threads, processes or real sockets and ptys
 #      (label `threads`, from every source folder) built with ThreadSanitizer,
-#   4. a short run of every libFuzzer target (ci/fuzz-smoke.sh).
+#   4. a short run of every libFuzzer target of that tree (ci/fuzz-smoke.sh).
 # It ends with the wall time of each stage and of the whole run.
 #
 #   ci/run-tests.sh                 everything, as CI runs it
@@ -19,7 +20,7 @@ default_only=0
 for arg in "$@"; do
   case "$arg" in
     --default-only) default_only=1 ;;
-    -h | --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "ci/run-tests.sh: unknown argument '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -97,7 +98,7 @@ if [ "$default_only" = 0 ] && [ "${HIL_SKIP_TSAN:-0}" != 1 ]; then
 fi
 
 if [ "$default_only" = 0 ] && [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
-  stage "fuzz: build and smoke run"
+  stage "fuzz: smoke run (asan tree)"
   bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}" | tee "$log"
   passed=$((passed + $(sed -n 's/^fuzz smoke: \([0-9]*\) target.*/\1/p' "$log")))
 fi
