@@ -8,7 +8,7 @@
 # The long hunt is ci/fuzz.sh (minutes per target, corpora kept).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds="${1:-20}"
+seconds="${1:-10}"
 preset="${HIL_FUZZ_PRESET:-asan}"
 
 work=$(mktemp -d)

@@ -99,7 +99,7 @@ fi
 
 if [ "$default_only" = 0 ] && [ "${HIL_SKIP_FUZZ:-0}" != 1 ]; then
   stage "fuzz: smoke run (asan tree)"
-  bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-20}" | tee "$log"
+  bash ci/fuzz-smoke.sh "${HIL_FUZZ_SECONDS:-10}" | tee "$log"
   passed=$((passed + $(sed -n 's/^fuzz smoke: \([0-9]*\) target.*/\1/p' "$log")))
 fi
 
