@@ -11,7 +11,8 @@
 #   ci/run-tests.sh                 everything, as CI runs it
 #   ci/run-tests.sh --default-only  stage 1 alone: the fast path while developing
 #
-# HIL_SKIP_ASAN=1, HIL_SKIP_TSAN=1 or HIL_SKIP_FUZZ=1 leave one stage out.
+# HIL_SKIP_ASAN=1, HIL_SKIP_TSAN=1 or HIL_SKIP_FUZZ=1 leave one stage out;
+# HIL_FUZZ_SECONDS=N gives each fuzz target N seconds (default 10).
 # docs/ci.md has the stages, what each one costs and why.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +21,7 @@ default_only=0
 for arg in "$@"; do
   case "$arg" in
     --default-only) default_only=1 ;;
-    -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "ci/run-tests.sh: unknown argument '$arg' (try --help)" >&2; exit 2 ;;
   esac
 done

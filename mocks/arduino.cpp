@@ -84,6 +84,7 @@ void ArduinoFirmware::boot(Time now) {
   last_answer_.clear();
   // The receive buffer does not survive a reset.
   decoder_ = arduino::Decoder(decoder_options(config_));
+  sketch_.reset();
 }
 
 void ArduinoFirmware::on_connect(Time now) {
@@ -117,6 +118,10 @@ void ArduinoFirmware::on_bytes(Time now, ByteView bytes) {
   // A request that arrives as the move ends sees it ended, whichever of the
   // two the driver runs first.
   end_due_motion(now);
+  if (config_.dialect == arduino::Dialect::firmware) {
+    receive_as_sketch(now, bytes);
+    return;
+  }
   items_.clear();
   decoder_.feed(bytes, items_);
   for (const auto& item : items_) {
@@ -205,7 +210,7 @@ arduino::Body ArduinoFirmware::execute(Time now, const Message& request) {
           },
           [&](const arduino::IrRead&) -> arduino::Body { return arduino::Ack{ir_text()}; },
           [&](const arduino::Help&) -> arduino::Body {
-            return arduino::Ack{std::string(help_text())};
+            return arduino::Ack{std::string(help_text(config_.dialect))};
           },
           // ACK and NACK are the board's own answers, not requests it knows.
           [&](const arduino::Ack&) -> arduino::Body {
@@ -220,10 +225,14 @@ arduino::Body ArduinoFirmware::execute(Time now, const Message& request) {
 
 void ArduinoFirmware::start_motion(Time now, ArduinoMotion motion, int arg) {
   const double ms_per_unit = motion == ArduinoMotion::move ? config_.ms_per_cm : config_.ms_per_deg;
-  double ms = std::abs(arg) * ms_per_unit;
+  // In double: the sketch takes any 32-bit argument, INT_MIN included.
+  double ms = std::abs(static_cast<double>(arg)) * ms_per_unit;
   if (config_.scale_duration_with_pwm && state_.pwm > 0) {
     ms = ms * config_.base_pwm / state_.pwm;
   }
+  // The sketch keeps the end time in whole milliseconds.
+  if (config_.dialect == arduino::Dialect::firmware) ms = std::floor(ms);
+  state_.last_dir = motion == ArduinoMotion::move ? (arg >= 0 ? 1 : -1) : 0;
   const Duration duration{std::llround(ms * 1e6)};
   if (duration <= Duration::zero()) {
     // A move of nothing is over as it starts; it still replaces a running one.
@@ -246,12 +255,14 @@ void ArduinoFirmware::start_motion(Time now, ArduinoMotion motion, int arg) {
 
 void ArduinoFirmware::stop_motion() {
   chassis_.set_pwm(0, 0);
+  state_.last_dir = 0;
   state_.motion = ArduinoMotion::idle;
   state_.motion_arg = 0;
   state_.motion_pwm = 0;
 }
 
 std::string ArduinoFirmware::status_text(Time now) const {
+  if (config_.dialect == arduino::Dialect::firmware) return sketch_status(now);
   std::string text = activity() + " PWM=" + std::to_string(state_.pwm);
   if (moving()) {
     // Rounded up, so a running move never shows 0 ms left.
@@ -266,7 +277,8 @@ std::string ArduinoFirmware::status_text(Time now) const {
   return text;
 }
 
-std::string_view ArduinoFirmware::help_text() {
+std::string_view ArduinoFirmware::help_text(arduino::Dialect dialect) {
+  if (dialect == arduino::Dialect::firmware) return "CMDS:PING,HELP,STATUS,V,M,R,S,B,I";
   return "PING STATUS V<pwm> M<cm> R<deg> S B I HELP";
 }
 

@@ -14,12 +14,17 @@
 #include "mocks/firmware.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/message.hpp"
+#include "protocol/arduino/sketch.hpp"
 
 namespace hil::mocks {
 
 /// How the mock Arduino firmware behaves where real sketches could differ.
 /// The defaults are the sketch the protocol document describes.
 struct ArduinoConfig {
+  /// Which board to be: the real sketch (`firmware`: its parser, its reply
+  /// texts, malformed frames dropped without an answer) or the README's
+  /// examples (`readme`). docs/mocks/arduino.md has both.
+  protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme;
   /// Duty after a boot, and what V sets (the sketch's basePWM), 0..255.
   int base_pwm = 140;
   /// M runs for |cm| * this many milliseconds (MS_PER_CM), > 0 and <= 1000.
@@ -40,7 +45,7 @@ struct ArduinoConfig {
   /// What B answers when no echo comes back within the sonar's range
   /// (pulseIn timing out reads 0 on most sketches).
   int no_echo_cm = 0;
-  /// The ACK text for PING.
+  /// The ACK text for PING in the readme dialect (the sketch says PONG).
   std::string ping_reply = "OK";
   /// NACK code for V, M and R while the firmware is in its fault state.
   std::string fault_code = "FAULT";
@@ -68,6 +73,10 @@ struct ArduinoState {
   int motion_arg = 0;
   /// The duty the running move drives at (V when it started).
   int motion_pwm = 0;
+  /// The sketch's lastDir: +1 after a forward move starts, -1 after a
+  /// backward one, 0 after a stop, a rotation or a move's end. STATUS
+  /// shows it as DIR=fwd, rev or stop.
+  int last_dir = 0;
   Time motion_started{0};
   Time motion_ends{0};
   /// Boots so far: power-on counts as the first, then one per reset.
@@ -90,10 +99,11 @@ class ArduinoFirmware final : public Firmware {
   const ArduinoConfig& config() const { return config_; }
   bool moving() const { return state_.motion != ArduinoMotion::idle; }
 
-  /// The STATUS answer at `now` (also what a client sees).
+  /// The STATUS answer at `now` in the configured dialect.
   std::string status_text(Time now) const;
-  /// The HELP answer.
-  static std::string_view help_text();
+  /// The HELP answer of a dialect.
+  static std::string_view help_text(
+      protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme);
 
  protected:
   void on_connect(Time now) override;
@@ -118,10 +128,25 @@ class ArduinoFirmware final : public Firmware {
   void answer(const Message& message);
   std::string ir_text() const;
 
+  // The real sketch's receive path and commands (mocks/arduino_sketch.cpp).
+  struct SketchReply {
+    bool ack = true;
+    std::string text;
+  };
+  void receive_as_sketch(Time now, ByteView bytes);
+  void handle_sketch_request(Time now, const Bytes& raw,
+                             const protocol::arduino::SketchRequest& request);
+  SketchReply execute_sketch(Time now, std::string_view command, std::string_view payload);
+  void sketch_answer(std::string_view seq, bool ack, std::string_view text);
+  std::string sketch_status(Time now) const;
+  std::string sketch_ir() const;
+
   ArduinoConfig config_;
   sim::DifferentialChassis& chassis_;
   protocol::arduino::Decoder decoder_;
   std::vector<protocol::arduino::Item> items_;
+  protocol::arduino::SketchReceiver sketch_;
+  std::vector<protocol::arduino::SketchFrame> sketch_frames_;
   ArduinoState state_;
   Time last_tick_{0};
   protocol::Bytes last_request_;

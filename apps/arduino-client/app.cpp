@@ -16,6 +16,8 @@
 #include "client/arduino/session.hpp"
 #include "link/asio_executor.hpp"
 #include "link/transport.hpp"
+#include "protocol/arduino/codec.hpp"
+#include "protocol/common/car_profile.hpp"
 
 namespace hil::apps::arduino_client {
 
@@ -130,6 +132,11 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
   add_log_and_script_options(app, o.log_path,
                              "Write the frame log here at exit: .txt, .csv, .json or .ndjson",
                              o.script, "Run the commands of this file, one per line");
+  app.add_option("--profile", o.profile,
+                 "The board's dialect: firmware (the real sketch) or readme (the README's "
+                 "examples); the default is hil mock arduino's")
+      ->check(
+          [](const std::string& name) { return protocol::car_profile_problem("arduino", name); });
   app.add_flag("--keep-going", o.keep_going,
                "Tokens and scripts: run every command even after one failed (exit 1 at the end)");
   app.add_option("tokens", o.tokens,
@@ -196,6 +203,7 @@ int run(const AppOptions& options) {
   config.base_timeout =
       link::Duration(static_cast<link::Duration::rep>(std::llround(options.timeout_s * 1e9)));
   config.max_retries = options.retries;
+  config.dialect = protocol::arduino::dialect_named(options.profile);
 
   asio::io_context io;
   link::AsioExecutor executor{io};

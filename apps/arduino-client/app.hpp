@@ -20,6 +20,8 @@ struct AppOptions {
   std::string log_path;  ///< the frame log is written here at exit (format by extension)
   std::string script;
   bool keep_going = false;  ///< batch: run every command even after a failure
+  /// The board's profile: "firmware" (the real sketch, the default) or "readme".
+  std::string profile;
   std::vector<std::string> tokens;
 };
 

@@ -9,6 +9,9 @@
 
 #include "apps/hil/cli_common.hpp"
 #include "protocol/arduino/codec.hpp"
+#include "protocol/arduino/sketch.hpp"
+#include "protocol/common/car_profile.hpp"
+#include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
 namespace hil::apps {
@@ -34,7 +37,8 @@ Examples:
   hil encode arduino --seq 4 NACK BAD_CS      ^04|NACK|BAD_CS*0B$
   hil encode arduino --seq 9 --raw JUMP HIGH  ^09|JUMP|HIGH*05$
   hil encode arduino --body 'G1|PING|'        ^G1|PING|*66$
-  hil encode arduino --seq 2 V 160 --checksum 00   ^02|V|160*00$)";
+  hil encode arduino --seq 2 V 160 --checksum 00   ^02|V|160*00$
+  hil encode arduino --profile firmware PING  ^01|PING| *31$  (the real client's one-space payload))";
 
 constexpr const char* kArduinoDecodeFooter =
     R"(Frames on the command line are joined in order and decoded as one stream;
@@ -44,7 +48,8 @@ Examples:
   hil decode arduino '^01|PING|*11$^01|ACK|OK*4C$'
   hil decode arduino --nack '^2A|S|*00$'       also print the NACK the firmware answers
   hil decode arduino --firmware -f capture.bin  the firmware's 96-byte frame bound
-  hil decode arduino --hex '5E 30 37 7C 53 7C 2A 35 34 24')";
+  hil decode arduino --hex '5E 30 37 7C 53 7C 2A 35 34 24'
+  hil decode arduino --profile firmware '^01|PING|*11$'   what the real sketch does with it)";
 
 // Decimal 0..255, or 0x00..0xFF.
 std::optional<std::uint8_t> parse_seq(const std::string& text) {
@@ -80,6 +85,7 @@ std::string upper(std::string text) {
 }
 
 struct ArduinoEncodeArgs {
+  std::string profile;
   std::string seq = "1";
   std::vector<std::string> words;
   bool raw = false;
@@ -139,7 +145,7 @@ int run_encode(const ArduinoEncodeArgs& args, bool body_given, bool seq_given) {
                     "\n(use --raw to frame it anyway)");
       }
       try {
-        frame = ard::encode_text(std::get<ard::Message>(typed));
+        frame = ard::encode_text(std::get<ard::Message>(typed), ard::dialect_named(args.profile));
       } catch (const std::invalid_argument& e) {
         return fail(std::string(e.what()) + "\n(use --raw to frame it anyway)");
       }
@@ -154,6 +160,7 @@ int run_encode(const ArduinoEncodeArgs& args, bool body_given, bool seq_given) {
 }
 
 struct DecodeArgs {
+  std::string profile;
   DecodeInput input;
   bool firmware = false;
   bool strict_checksum = false;
@@ -161,12 +168,57 @@ struct DecodeArgs {
   bool nack = false;
 };
 
+// The real sketch's verdict on each frame it would store: acted on,
+// refused with a NACK (the reply printed), or dropped without a word.
+int run_sketch_decode(const protocol::Bytes& bytes) {
+  ard::SketchReceiver receiver;
+  std::vector<ard::SketchFrame> frames;
+  receiver.feed(bytes, frames);
+  int status = 0;
+  for (const auto& frame : frames) {
+    const std::string raw(frame.raw.begin(), frame.raw.end());
+    std::visit(protocol::Overloaded{
+                   [&](const ard::SketchRequest& r) {
+                     std::cout << "request seq=" << r.seq << " cmd=" << r.cmd << " payload='"
+                               << r.payload << "'  " << raw << '\n';
+                   },
+                   [&](const ard::SketchRefusal& r) {
+                     status = 1;
+                     std::cout << "refused " << raw << " -> "
+                               << ard::sketch_frame(r.seq, "NACK", ard::to_string(r.code)) << '\n';
+                   },
+                   [&](const ard::SketchDrop& d) {
+                     status = 1;
+                     std::cout << "dropped without an answer " << raw << ": " << d.reason << '\n';
+                   },
+               },
+               frame.verdict);
+  }
+  if (receiver.buffered() > 0) {
+    status = 1;
+    std::cout << "incomplete: " << receiver.buffered() << " byte(s) wait for '$'\n";
+  }
+  if (frames.empty() && receiver.buffered() == 0) {
+    if (bytes.empty()) return 2;
+    std::cout << "ignored: " << bytes.size()
+              << " byte(s) and no '^' the sketch would start a frame at\n";
+    return 1;
+  }
+  return status;
+}
+
 int run_decode(const DecodeArgs& args) {
   protocol::Bytes bytes;
   try {
     bytes = read_decode_input(args.input, false);
   } catch (const CLI::Error& e) {
     std::cerr << "hil decode arduino: " << e.what() << '\n';
+    return 1;
+  }
+  try {
+    if (ard::dialect_named(args.profile) == ard::Dialect::firmware) return run_sketch_decode(bytes);
+  } catch (const protocol::ProfileError& e) {
+    std::cerr << "hil decode arduino: --profile: " << e.what() << '\n';
     return 1;
   }
   ard::DecoderOptions options =
@@ -207,6 +259,10 @@ int run_decode(const DecodeArgs& args) {
   return status;
 }
 
+std::string profile_check(const std::string& name) {
+  return protocol::car_profile_problem("arduino", name);
+}
+
 }  // namespace
 
 void register_arduino(CommandSet& commands) {
@@ -215,6 +271,10 @@ void register_arduino(CommandSet& commands) {
 
   auto* enc = commands.encode.add_subcommand(
       "arduino", "Arduino robot frame ^SEQ|CMD|PAYLOAD*CS$, e.g. --seq 2 V 160 or ACK OK");
+  enc->add_option("--profile", encode_args->profile,
+                  "readme (the default) or firmware: argument-less requests with the one-space "
+                  "payload the real sketch needs")
+      ->check(profile_check);
   enc->add_option("words", encode_args->words,
                   "CMD then PAYLOAD words (V 160), or one CMD:PAYLOAD token (V:160)");
   auto* seq = enc->add_option("--seq", encode_args->seq,
@@ -235,6 +295,10 @@ void register_arduino(CommandSet& commands) {
   auto* dec =
       commands.decode.add_subcommand("arduino", "Decode Arduino robot frames or a byte stream");
   add_decode_input(*dec, decode_args->input, false);
+  dec->add_option("--profile", decode_args->profile,
+                  "readme (the default: the README's rules) or firmware: what the real sketch "
+                  "does with each frame (acted on, refused with a NACK, or dropped)")
+      ->check(profile_check);
   dec->add_flag("--firmware", decode_args->firmware,
                 "Use the firmware's 96-byte frame bound instead of the PC's 256-byte guard");
   dec->add_option("--max-frame-bytes", decode_args->max_frame_bytes,

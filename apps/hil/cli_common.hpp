@@ -105,5 +105,7 @@ void register_world(CLI::App& app, std::function<int()>& run);
 void register_mock(CLI::App& app, std::function<int()>& run);
 /// `hil run`: scenario files, the table, JUnit and the report folder (apps/hil/run_command.cpp).
 void register_run(CLI::App& app, std::function<int()>& run);
+/// hil profiles [CAR]: the registry of car profiles (protocol/common/car_profile.hpp).
+void register_profiles(CLI::App& app, std::function<int()>& run);
 
 }  // namespace hil::apps

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
       "  hil world check scenarios/worlds/*.yaml\n"
       "  hil world render scenarios/worlds/corridor.yaml -o corridor.svg\n"
       "  hil run scenarios/ --junit hil.xml --report-dir hil-report\n"
+      "  hil profiles                                each car's dialects and their sources\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode =
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
   hil::apps::register_world(app, run);
   hil::apps::register_mock(app, run);
   hil::apps::register_run(app, run);
+  hil::apps::register_profiles(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&

@@ -30,6 +30,8 @@
 #include "mocks/behaviour_yaml.hpp"
 #include "mocks/car.hpp"
 #include "mocks/server.hpp"
+#include "protocol/arduino/codec.hpp"
+#include "protocol/common/car_profile.hpp"
 #include "sim/arena_yaml.hpp"
 #include "view/live_model.hpp"
 #include "view/server.hpp"
@@ -39,6 +41,7 @@ namespace {
 
 struct MockArgs {
   std::string car;
+  std::string profile;  ///< empty: the car's default profile
   std::string bind = "127.0.0.1";
   std::optional<std::uint16_t> port;
   std::string pty;
@@ -404,6 +407,15 @@ int run_mock(const MockArgs& args) {
     std::cerr << "hil mock: " << e.what() << '\n';
     return 1;
   }
+  try {
+    const protocol::CarProfile& profile = protocol::find_car_profile(args.car, args.profile);
+    if (*kind == mocks::CarKind::arduino) {
+      base.configs.arduino.dialect = protocol::arduino::dialect_named(profile.name);
+    }
+  } catch (const protocol::ProfileError& e) {
+    std::cerr << "hil mock: --profile: " << e.what() << '\n';
+    return 2;
+  }
   if (!args.auth.empty()) {
     if (args.auth.size() != protocol::wr8::kAuthTextBytes) {
       std::cerr << "hil mock: --auth must be exactly " << protocol::wr8::kAuthTextBytes
@@ -607,6 +619,9 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("car", args->car, "Which car: logi, wr8 (TCP), arduino, leka (pty)")
       ->required()
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka"}));
+  cmd->add_option("--profile", args->profile,
+                  "The car's profile, its dialect (hil profiles CAR lists them; default: the "
+                  "car's default profile), e.g. arduino --profile firmware plays the real sketch");
   cmd->add_option(
       "--bind", args->bind,
       "Address TCP cars listen on (default 127.0.0.1; 0.0.0.0 opens it to the network)");

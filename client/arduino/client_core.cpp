@@ -1,9 +1,10 @@
 #include "client/arduino/client_core.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <stdexcept>
 #include <utility>
+
+#include "protocol/common/text.hpp"
 
 namespace hil::client::arduino {
 
@@ -76,6 +77,15 @@ Duration ArduinoClientCore::timeout_of(int attempt) const {
   return config_.base_timeout * (std::int64_t{1} << attempt);
 }
 
+Bytes ArduinoClientCore::frame_of(const Pending& pending, std::uint8_t seq) const {
+  if (pending.raw) {
+    proto::Envelope e = *pending.raw;
+    e.seq = seq;
+    return protocol::to_bytes(proto::frame_text(e));
+  }
+  return protocol::to_bytes(proto::encode_text({seq, pending.body}, config_.dialect));
+}
+
 void ArduinoClientCore::open(Time now) {
   if (state_ != LinkState::closed && state_ != LinkState::down) return;
   reconnect_failures_ = 0;
@@ -98,7 +108,7 @@ RequestId ArduinoClientCore::request(Time now, proto::Body body) {
     return id;
   }
   try {
-    (void)proto::encode({0, body});
+    (void)proto::encode_text({0, body}, config_.dialect);
   } catch (const std::invalid_argument& e) {
     complete(id, outcome(ResultCode::invalid_request, e.what()));
     return id;
@@ -116,18 +126,33 @@ RequestId ArduinoClientCore::request(Time now, proto::Body body) {
 RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
   proto::Envelope envelope;
   const auto colon = token.find(':');
-  const std::string_view cmd = token.substr(0, colon);
-  envelope.cmd.reserve(cmd.size());
-  for (char c : cmd)
-    envelope.cmd += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  envelope.cmd = protocol::ascii_upper(token.substr(0, colon));
   if (colon != std::string_view::npos) envelope.payload = std::string(token.substr(colon + 1));
   auto typed = proto::to_message(envelope);
-  if (auto* error = std::get_if<proto::PayloadError>(&typed)) {
-    const RequestId id = next_id_++;
-    complete(id, outcome(ResultCode::invalid_request, error->detail));
+  if (auto* message = std::get_if<proto::Message>(&typed)) return request(now, message->body);
+  // Not a request hil types (a value out of range, an unknown command): it
+  // goes out as given, and the board's answer is the result.
+  const RequestId id = next_id_++;
+  const auto framable = [](const std::string& field) {
+    return std::all_of(field.begin(), field.end(), proto::is_field_char);
+  };
+  if (envelope.cmd.empty() || !framable(envelope.cmd) || !framable(envelope.payload)) {
+    complete(id, outcome(ResultCode::invalid_request,
+                         "'" + std::string(token) +
+                             "' cannot be framed: a command, then ':' and a payload, "
+                             "of printable characters but ^ $ * |"));
     return id;
   }
-  return request(now, std::get<proto::Message>(typed).body);
+  if (envelope.payload.empty())
+    envelope.payload = std::string(proto::empty_payload(config_.dialect));
+  if (state_ == LinkState::closed || state_ == LinkState::down) {
+    complete(id, outcome(ResultCode::link_down,
+                         std::string("the link is ") + std::string(to_string(state_))));
+    return id;
+  }
+  queue_.push_back({id, Purpose::user, proto::Body{}, std::move(envelope)});
+  pump(now);
+  return id;
 }
 
 void ArduinoClientCore::on_connected(Time now) {
@@ -143,7 +168,7 @@ void ArduinoClientCore::on_connected(Time now) {
     inflight_->pending = {0, Purpose::reconnect_check, proto::Ping{}};
     inflight_->max_retries = config_.reconnect_ping_retries;
     inflight_->seq = next_seq_++;
-    inflight_->frame = proto::encode({inflight_->seq, proto::Ping{}});
+    inflight_->frame = frame_of(inflight_->pending, inflight_->seq);
     send_current(now);
   }
 }
@@ -202,6 +227,9 @@ void ArduinoClientCore::handle_message(Time now, const proto::Message& m) {
   if (const auto* ack = std::get_if<proto::Ack>(&m.body)) {
     Result r = outcome(ResultCode::ok, "");
     r.info = ack->info;
+    if (!inflight_->pending.raw) {
+      r.reply = proto::parse_reply(config_.dialect, inflight_->pending.body, ack->info);
+    }
     finish(now, std::move(r));
     return;
   }
@@ -271,7 +299,7 @@ void ArduinoClientCore::pump(Time now) {
   inflight_->pending = std::move(next);
   inflight_->max_retries = config_.max_retries;
   inflight_->seq = next_seq_++;  // wraps FF -> 00 as an 8-bit value
-  inflight_->frame = proto::encode({inflight_->seq, inflight_->pending.body});
+  inflight_->frame = frame_of(inflight_->pending, inflight_->seq);
   send_current(now);
 }
 

@@ -15,6 +15,7 @@
 #include "link/time.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/message.hpp"
+#include "protocol/arduino/reply.hpp"
 
 namespace hil::client::arduino {
 
@@ -24,6 +25,11 @@ using protocol::Bytes;
 using protocol::ByteView;
 
 struct ClientConfig {
+  /// The board's dialect (its profile): `firmware`, the real sketch, sends
+  /// a request without an argument with a one-space payload and reads the
+  /// sketch's replies; `readme` frames and reads the README's examples. The
+  /// default is the one `hil mock arduino` plays by default.
+  protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme;
   /// Timeout of the first attempt; each retry doubles it.
   Duration base_timeout = link::milliseconds(600);
   /// Retries after the first attempt (timeouts 0.6, 1.2, 2.4, 4.8 s by default).
@@ -55,6 +61,10 @@ std::string_view to_string(ResultCode c);
 struct Result {
   ResultCode code = ResultCode::ok;
   std::string info;  ///< ACK payload
+  /// The ACK payload's meaning in the board's dialect, the same type for
+  /// both ("B:232" and "232" are SonarReply{232}); empty for a raw request
+  /// hil does not type, or a text the dialect does not answer that request with.
+  std::optional<protocol::arduino::Reply> reply;
   std::optional<protocol::arduino::Nack> nack;
   std::string detail;  ///< why, for a person
   int attempts = 0;    ///< timed attempts sent (BAD_CS resends not counted)
@@ -104,8 +114,10 @@ class ArduinoClientCore {
 
   /// Queues a request; requests go out one at a time, in order.
   RequestId request(Time now, protocol::arduino::Body body);
-  /// A token as the robot's CLI takes it: "PING", "V:160", "R:-90" (case of
-  /// the command is ignored). A token that is no request ends invalid_request.
+  /// A token as the robot's CLI takes it: "PING", "V:160", "R:-90" (the
+  /// command is upper-cased). It goes to the robot as typed, out-of-range or
+  /// unknown ones too ("V:999" is answered NACK BAD_V by the board); only a
+  /// token that cannot be framed (empty, or with ^ $ * |) ends invalid_request.
   RequestId raw(Time now, std::string_view token);
   RequestId ping(Time now) { return request(now, protocol::arduino::Ping{}); }
   RequestId status(Time now) { return request(now, protocol::arduino::StatusRequest{}); }
@@ -146,6 +158,8 @@ class ArduinoClientCore {
     RequestId id = 0;
     Purpose purpose = Purpose::user;
     protocol::arduino::Body body;
+    /// A raw token that is no typed request, framed as given.
+    std::optional<protocol::arduino::Envelope> raw;
   };
   struct Inflight {
     Pending pending;
@@ -159,6 +173,7 @@ class ArduinoClientCore {
 
   static Result lost_result(const Inflight& lost, ResultCode code, const std::string& detail);
   Duration timeout_of(int attempt) const;
+  Bytes frame_of(const Pending& pending, std::uint8_t seq) const;
   void pump(Time now);
   void send_current(Time now);
   void finish(Time now, Result result);

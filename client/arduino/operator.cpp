@@ -1,5 +1,6 @@
 #include "client/arduino/operator.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -39,6 +40,7 @@ std::string to_text(const OperatorCommand& command) {
       [](const auto& c) -> std::string {
         using T = std::decay_t<decltype(c)>;
         if constexpr (std::is_same_v<T, RobotRequest>) {
+          if (c.raw) return *c.raw;
           std::string word(proto::command_of(c.body));
           if (auto* v = std::get_if<proto::SetSpeed>(&c.body))
             return word + " " + std::to_string(v->pwm);
@@ -62,13 +64,31 @@ std::string to_text(const OperatorCommand& command) {
       command);
 }
 
+namespace {
+OperatorLine parse_typed_line(std::string_view line, const std::vector<Word>& words);
+}  // namespace
+
 OperatorLine parse_operator_line(std::string_view line) {
   if (const auto hash = line.find('#'); hash != std::string_view::npos) {
     line = line.substr(0, hash);
   }
-  auto words = split_words(line).words;
+  const auto words = split_words(line).words;
   if (words.empty()) return {};
+  OperatorLine typed = parse_typed_line(line, words);
+  // One word in the raw form CMD:PAYLOAD that hil would not type goes to
+  // the robot as given, as the robot's own CLI sends it ("V:999" is the
+  // board's NACK BAD_V to report, not a usage error).
+  const std::string_view token = words.front().text;
+  if (typed.error && words.size() == 1 && token.find(':') != std::string_view::npos &&
+      token.front() != ':' &&
+      std::all_of(token.begin(), token.end(), [](char c) { return proto::is_field_char(c); })) {
+    return command_line(RobotRequest{proto::Ping{}, std::string(token)});
+  }
+  return typed;
+}
 
+namespace {
+OperatorLine parse_typed_line(std::string_view line, const std::vector<Word>& words) {
   // "V:160" is the seed CLI's raw form of "V 160".
   Word head = words.front();
   std::optional<Word> glued;
@@ -156,6 +176,7 @@ OperatorLine parse_operator_line(std::string_view line) {
   return error_at(head.column,
                   "unknown command '" + std::string(head.text) + "' (expected " + kExpected + ")");
 }
+}  // namespace
 
 std::string ScriptError::to_string() const {
   if (line == 0) return file + ": " + message;
@@ -287,14 +308,19 @@ void OperatorRunner::start(Queued queued) {
   current_ = outcome;
 
   if (auto* request = std::get_if<RobotRequest>(&queued.command)) {
-    session_.request(request->body, [this, alive = alive_](const Result& r) {
+    auto done_with = [this, alive = alive_](const Result& r) {
       if (!*alive || !current_) return;
       CommandOutcome done = std::move(*current_);
       done.ok = r.code == ResultCode::ok;
       done.result = r;
       done.text = describe_result(r);
       finish(std::move(done));
-    });
+    };
+    if (request->raw) {
+      session_.raw(*request->raw, std::move(done_with));
+    } else {
+      session_.request(request->body, std::move(done_with));
+    }
     return;
   }
   if (auto* wait = std::get_if<WaitCommand>(&queued.command)) {

@@ -26,6 +26,10 @@ namespace hil::client::arduino {
 /// A request for the robot (PING, STATUS, V, M, R, S, B, I, HELP).
 struct RobotRequest {
   protocol::arduino::Body body;
+  /// A token in the robot CLI's raw form ("V:999", "X:1") that hil would not
+  /// type: it goes to the robot as given and the board answers it (`body`
+  /// is unused then). The spaced form ("V 999") is checked instead.
+  std::optional<std::string> raw;
   friend bool operator==(const RobotRequest&, const RobotRequest&) = default;
 };
 /// `wait 500ms`: nothing happens for this long (scripts pace themselves with it).

@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
@@ -88,6 +89,19 @@ DecodeError framing_error(DelimitedFramer::Event&& event, std::size_t max_frame_
 
 }  // namespace
 
+std::string_view to_string(Dialect dialect) {
+  return dialect == Dialect::firmware ? "firmware" : "readme";
+}
+
+Dialect dialect_named(std::string_view profile) {
+  const CarProfile& p = find_car_profile("arduino", profile);
+  return p.name == "readme" ? Dialect::readme : Dialect::firmware;
+}
+
+std::string_view empty_payload(Dialect dialect) {
+  return dialect == Dialect::firmware ? " " : "";
+}
+
 std::uint8_t checksum(std::string_view body) {
   std::uint8_t x = 0;
   for (const char c : body)
@@ -162,6 +176,15 @@ std::string encode_text(const Message& m) {
 
 Bytes encode(const Message& m) {
   return to_bytes(encode_text(m));
+}
+
+std::string encode_text(const Message& m, Dialect dialect) {
+  if (dialect == Dialect::readme || !is_request(m.body) || !takes_no_payload(command_of(m.body))) {
+    return encode_text(m);
+  }
+  Envelope e = to_envelope(m);
+  e.payload = std::string(empty_payload(dialect));
+  return frame_text(e);
 }
 
 std::variant<Message, PayloadError> to_message(const Envelope& envelope) {

@@ -35,6 +35,23 @@ inline constexpr int kMinSignedArg = -32768;
 inline constexpr int kMaxSignedArg = 32767;
 inline constexpr int kMaxPwm = 255;
 
+/// The two dialects of the protocol (the car's profiles, see
+/// protocol/common/car_profile.hpp): the real sketch and its client
+/// (`firmware`), and the README's examples (`readme`). They differ in what a
+/// request without an argument carries (one space, or nothing) and in the
+/// board's replies (docs/protocols/arduino.md, "Profiles").
+enum class Dialect : std::uint8_t { firmware, readme };
+
+/// "firmware" or "readme".
+std::string_view to_string(Dialect dialect);
+/// The dialect of an Arduino profile name; empty is the default profile.
+/// Throws protocol::ProfileError for a name that is not an Arduino profile.
+Dialect dialect_named(std::string_view profile);
+
+/// The payload a request without an argument carries in a dialect: one
+/// space for the real sketch, which refuses an empty payload, else nothing.
+std::string_view empty_payload(Dialect dialect);
+
 /// XOR of every byte of `body` (the text between '^' and '*': SEQ|CMD|PAYLOAD).
 std::uint8_t checksum(std::string_view body);
 
@@ -67,6 +84,10 @@ Envelope to_envelope(const Message& m);
 /// when the frame would exceed kMaxFrameBytes (no receiver would take it).
 std::string encode_text(const Message& m);
 Bytes encode(const Message& m);
+/// The frame in a dialect: in `firmware` a request without an argument
+/// carries one space ("^01|PING| *31$", as the real client sends it), which
+/// the real sketch needs; in `readme` it is encode_text(m).
+std::string encode_text(const Message& m, Dialect dialect);
 
 /// Why an envelope does not make a typed message.
 struct PayloadError {

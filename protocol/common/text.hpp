@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -21,5 +22,8 @@ std::vector<std::string_view> split(std::string_view text, char sep);
 
 /// Printable ASCII (0x20..0x7E) only.
 bool is_printable_ascii(std::string_view text);
+
+/// The text with a..z made A..Z and every other byte kept (no locale).
+std::string ascii_upper(std::string_view text);
 
 }  // namespace hil::protocol

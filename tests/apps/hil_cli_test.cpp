@@ -231,5 +231,47 @@ TEST(HilCli, HelpListsEveryProtocol) {
     EXPECT_THAT(r.output, HasSubstr(p));
 }
 
+// hil profiles: every car with each profile, its source and how it
+// differs; one car alone; an unknown car refused with the list.
+TEST(HilCli, ProfilesListsEveryCarsProfilesWithTheirSources) {
+  const auto all = run_hil("profiles");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  for (const char* car : {"logi\n", "wr8\n", "arduino\n", "leka\n"})
+    EXPECT_THAT(all.output, HasSubstr(car));
+  const auto arduino = run_hil("profiles arduino");
+  ASSERT_EQ(arduino.exit_code, 0) << arduino.output;
+  EXPECT_THAT(arduino.output, HasSubstr("  readme (default)\n"));
+  EXPECT_THAT(arduino.output, HasSubstr("  firmware\n"));
+  EXPECT_THAT(arduino.output, HasSubstr("andrii-mazurchuk/arduino_robot_steering- at 8dcfab0"));
+  EXPECT_EQ(arduino.output.find("leka"), std::string::npos) << arduino.output;
+  const auto tank = run_hil("profiles tank");
+  EXPECT_EQ(tank.exit_code, 2) << tank.output;
+  EXPECT_THAT(tank.output,
+              HasSubstr("unknown car 'tank'; the cars are logi, wr8, arduino and leka"));
+}
+
+// The real client's frames (robot_client.py at 8dcfab0) from hil encode,
+// and the real sketch's verdict on the README's frame from hil decode.
+TEST(HilCli, ArduinoFirmwareProfileEncodesAndJudgesAsTheRealBoard) {
+  const auto ping = run_hil("encode arduino --profile firmware PING");
+  EXPECT_EQ(ping.exit_code, 0) << ping.output;
+  EXPECT_EQ(ping.output, "^01|PING| *31$\n");
+  const auto sonar = run_hil("encode arduino --profile firmware --seq 5 B");
+  EXPECT_EQ(sonar.output, "^05|B| *67$\n");
+  EXPECT_EQ(run_hil("encode arduino --profile readme PING").output, "^01|PING|*11$\n");
+
+  const auto refused = run_hil("decode arduino --profile firmware '^01|PING|*11$'");
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_THAT(refused.output, HasSubstr("refused ^01|PING|*11$ -> ^01|NACK|BAD_FMT*41$"));
+  const auto taken = run_hil("decode arduino --profile firmware '^01|PING| *31$'");
+  EXPECT_EQ(taken.exit_code, 0) << taken.output;
+  EXPECT_THAT(taken.output, HasSubstr("request seq=01 cmd=PING payload=' '"));
+
+  const auto wrong = run_hil("encode arduino --profile sketch PING");
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_THAT(wrong.output, HasSubstr("arduino has no profile 'sketch'; its profiles are readme "
+                                      "(the default) and firmware"));
+}
+
 }  // namespace
 }  // namespace hil::test

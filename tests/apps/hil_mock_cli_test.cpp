@@ -121,6 +121,35 @@ TEST(HilMock, ArduinoRobotAnswersOnAPty) {
   std::filesystem::remove_all(dir);
 }
 
+// --profile firmware plays the real sketch: the README's empty-payload PING
+// is refused as the board refuses it, and the real client's one-space PING
+// is answered PONG (arduino.ino at 8dcfab0).
+TEST(HilMock, ArduinoFirmwareProfileAnswersAsTheRealSketch) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("hil-mock-fw-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "robot0").string();
+  HilProcess mock({"mock", "arduino", "--profile", "firmware", "--pty", path});
+  ASSERT_TRUE(mock.wait_for_line("as a serial port at 9600 baud")) << mock.output();
+  Fd port(::open(path.c_str(), O_RDWR | O_NOCTTY));
+  ASSERT_TRUE(port.ok());
+  port.send("^01|PING|*11$");
+  EXPECT_TRUE(port.read_until("^01|NACK|BAD_FMT*41$")) << port.received;
+  port.send("^02|PING| *32$");
+  EXPECT_TRUE(port.read_until("^02|ACK|PONG*5D$")) << port.received;
+  EXPECT_EQ(mock.interrupt(), 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(HilMock, AnUnknownProfileIsRefusedWithTheCarsProfiles) {
+  HilProcess mock({"mock", "leka", "--profile", "firmware", "--pty", "/tmp/hil-unused-leka"});
+  EXPECT_EQ(mock.wait_exit(), 2) << mock.output();
+  EXPECT_NE(mock.output().find("leka has no profile 'firmware'; its profiles are readme (the "
+                               "default)"),
+            std::string::npos)
+      << mock.output();
+}
+
 TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
   HilProcess mock({"mock", "wr8", "--port", "0", "--auth", "0123456789"});
   const auto line = mock.wait_for_line("connect to tcp://");

@@ -162,13 +162,32 @@ TEST(ArduinoClientCore, RawTokensAreFramedAsTheRobotsCliTakesThem) {
   EXPECT_EQ(h.sent[2].frame, proto::encode_text({0x02, proto::Ping{}}));
 }
 
+// As the robot's own CLI does: a token hil would not type is the board's
+// to judge (the board answers NACK BAD_CMD or BAD_V, or takes "fast" as 0).
+TEST(ArduinoClientCore, RawTokensHilDoesNotTypeGoToTheRobotAsGiven) {
+  Harness h(no_health_check());
+  h.open_now();
+  h.submit([](auto& c, Time t) { return c.raw(t, "JUMP"); });
+  h.answer(0x00, proto::Nack{proto::NackCode::bad_cmd});
+  h.submit([](auto& c, Time t) { return c.raw(t, "V:fast"); });
+  h.answer(0x01, proto::Nack{proto::NackCode::bad_v});
+  h.submit([](auto& c, Time t) { return c.raw(t, "history:2"); });
+  ASSERT_EQ(h.sent.size(), 3u);
+  EXPECT_EQ(h.sent[0].frame, "^00|JUMP|*02$");
+  EXPECT_EQ(h.sent[1].frame, "^01|V|fast*57$");
+  EXPECT_EQ(h.sent[2].frame, "^02|HISTORY|2*72$");
+  ASSERT_EQ(h.done.size(), 2u);
+  EXPECT_EQ(h.done[0].result.code, ResultCode::nack);
+  EXPECT_EQ(h.done[1].result.code, ResultCode::nack);
+}
+
 TEST(ArduinoClientCore, RequestsTheProtocolCannotCarryEndAtOnceWithoutSendingAnything) {
   Harness h(no_health_check());
   h.open_now();
   h.submit([](auto& c, Time t) { return c.set_v(t, 300); });
-  h.submit([](auto& c, Time t) { return c.raw(t, "JUMP"); });
-  h.submit([](auto& c, Time t) { return c.raw(t, "V:fast"); });
-  h.submit([](auto& c, Time t) { return c.raw(t, "HISTORY"); });
+  h.submit([](auto& c, Time t) { return c.raw(t, ""); });
+  h.submit([](auto& c, Time t) { return c.raw(t, "V:1|2"); });
+  h.submit([](auto& c, Time t) { return c.raw(t, "^PING"); });
   h.submit([](auto& c, Time t) { return c.request(t, proto::Ack{"x"}); });
   EXPECT_TRUE(h.sent.empty());
   ASSERT_EQ(h.done.size(), 5u);

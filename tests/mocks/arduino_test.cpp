@@ -12,7 +12,7 @@
 #include <string>
 
 #include "protocol/arduino/codec.hpp"
-#include "tests/mocks/mock_test_support.hpp"
+#include "tests/mocks/arduino_rig.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -20,17 +20,8 @@ namespace {
 namespace arduino = protocol::arduino;
 using link::milliseconds;
 using link::seconds;
-
-using Car = test::VirtualCar<ArduinoFirmware>;
-
-std::unique_ptr<Car> make_car(ArduinoConfig config = {}, sim::WorldDef world = {}) {
-  return std::make_unique<Car>(
-      sim::arduino_robot(),
-      [config](sim::World& w, sim::Vehicle& v) {
-        return std::make_unique<ArduinoFirmware>(w, v, config);
-      },
-      ServerOptions{}, std::move(world));
-}
+using test_arduino::heading_deg;
+using test_arduino::Robot;
 
 std::string request(std::uint8_t seq, arduino::Body body) {
   return arduino::encode_text(arduino::Message{seq, std::move(body)});
@@ -43,35 +34,6 @@ std::string nack(std::uint8_t seq, arduino::NackCode code) {
 }
 std::string nack(std::uint8_t seq, std::string text) {
   return request(seq, arduino::Nack{std::move(text)});
-}
-
-/// A robot with a client on its serial port.
-struct Robot {
-  explicit Robot(ArduinoConfig config = {}, sim::WorldDef world = {})
-      : car(make_car(std::move(config), std::move(world))), client(car->connect()) {}
-
-  /// Sends `frame` and returns what came back at the same instant.
-  std::string ask(std::string_view frame) {
-    client->write(frame);
-    car->run_for(Duration::zero());
-    return client->take_text();
-  }
-  ArduinoFirmware& firmware() { return car->firmware(); }
-  const ArduinoState& state() { return car->firmware().state(); }
-  sim::DifferentialChassis& chassis() { return *car->vehicle().differential(); }
-  sim::Pose pose() { return car->vehicle().pose(); }
-  Time now() const { return car->now(); }
-  void run_until(Time t) { car->run_until(t); }
-  void run_for(Duration d) { car->run_for(d); }
-  /// What STATUS answers at `now`, as the firmware would write it.
-  std::string status_at(Time now) { return car->firmware().status_text(now); }
-
-  std::unique_ptr<Car> car;
-  std::shared_ptr<test::ClientEnd> client;
-};
-
-double heading_deg(const sim::Pose& pose) {
-  return sim::rad_to_deg(pose.heading_rad);
 }
 
 // ---------------------------------------------------------------- answers

@@ -65,6 +65,35 @@ TEST_F(ArduinoClientCli, RawTokensRunOnceEachAndTheStatusShowsTheSpeedSet) {
   EXPECT_TRUE(contains(move.output, "STATUS -> ACK MOVING M:20 PWM=200 ")) << move.output;
 }
 
+// The real CLI's own command line (CLI.py at 8dcfab0) against the mock
+// playing the real sketch: every command is answered as the board answers
+// it, and V:999 goes out as typed and comes back NACK BAD_V.
+TEST_F(ArduinoClientCli, TheRealClisCommandsAgainstTheSketchProfile) {
+  start_mock({"--profile", "firmware"});
+  const auto r = client({"--profile", "firmware", "--keep-going", "PING", "V:160", "M:20", "B", "I",
+                         "STATUS", "S", "V:999", "HELP"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "PING -> ACK PONG\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 160 -> ACK OK\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "M 20 -> ACK ACCEPTED\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "B -> ACK B:")) << r.output;
+  EXPECT_TRUE(contains(r.output, "I -> ACK I:AL=")) << r.output;
+  // (Moving or done by then, depending on the machine: 20 cm take 360 ms.)
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=160,DIR=")) << r.output;
+  EXPECT_TRUE(contains(r.output, "S -> ACK STOPPED\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "V:999 -> NACK BAD_V\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "HELP -> ACK CMDS:PING,HELP,STATUS,V,M,R,S,B,I\n")) << r.output;
+}
+
+TEST_F(ArduinoClientCli, AnUnknownProfileIsRefusedWithTheValidNames) {
+  const auto r = client({"--profile", "sketch", "PING"});
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output,
+                       "arduino has no profile 'sketch'; its profiles are readme (the "
+                       "default) and firmware"))
+      << r.output;
+}
+
 TEST_F(ArduinoClientCli, AScriptRunsAndItsFrameLogIsWritten) {
   start_mock();
   const auto script = write("cmds.txt", "# speed, then look\nping\nV 120\n\nB\nstatus\n");

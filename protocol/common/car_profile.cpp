@@ -1,0 +1,114 @@
+#include "protocol/common/car_profile.hpp"
+
+#include <algorithm>
+#include <array>
+
+namespace hil::protocol {
+namespace {
+
+// Sources are named by repository and commit; the facts are described in
+// docs/protocols/<car>.md.
+constexpr std::array kProfiles{
+    CarProfile{"logi", "firmware",
+               "car_stm32f103vet6 firmware: docs/upper_computer_ai_guide.md and the frame parser "
+               "of Core/Bsp/protocol.c",
+               "the guide's frames; the checksum field is found from the last ':', as the STM32 "
+               "parser finds it",
+               true},
+    CarProfile{"wr8", "document", "the WR8 protocol document of 2019-01-06 (smart_vehicle_gui)",
+               "packets exactly as the document gives them: no length byte before a packet", true},
+    CarProfile{
+        "arduino", "firmware",
+        "andrii-mazurchuk/arduino_robot_steering- at 8dcfab0: arduino.ino and robot_client.py",
+        "the real sketch: the payload field may not be empty (the real client sends one "
+        "space), replies PONG, STATUS:V=..,DIR=..,MOT:.., ACCEPTED, STOPPED, B:<cm>, "
+        "I:AL=..; malformed frames dropped without an answer",
+        false},
+    CarProfile{"arduino", "readme",
+               "the README of andrii-mazurchuk/arduino_robot_steering- (hil's protocol document)",
+               "the README's examples: argument-less commands with an empty payload, replies OK, "
+               "IDLE PWM=.., the bare sonar distance",
+               true},
+    CarProfile{"leka", "readme", "the README of leka/LKAlphaComSpecs v3.0.0 (381046f)",
+               "the README's command ids (belt single 0x15) and its worked examples' checksum: "
+               "the low byte of a 16-bit BSD sum over the command group",
+               true},
+};
+
+std::string spoken_list(const std::vector<std::string_view>& names) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) text += i + 1 == names.size() ? " and " : ", ";
+    text += names[i];
+  }
+  return text;
+}
+
+void require_car(std::string_view car) {
+  const auto cars = car_profile_cars();
+  if (std::find(cars.begin(), cars.end(), car) == cars.end()) {
+    throw ProfileError("unknown car '" + std::string(car) + "'; the cars are " + spoken_list(cars));
+  }
+}
+
+}  // namespace
+
+std::span<const CarProfile> car_profiles() {
+  return kProfiles;
+}
+
+std::vector<std::string_view> car_profile_cars() {
+  std::vector<std::string_view> cars;
+  for (const CarProfile& p : kProfiles) {
+    if (std::find(cars.begin(), cars.end(), p.car) == cars.end()) cars.push_back(p.car);
+  }
+  return cars;
+}
+
+std::vector<CarProfile> car_profiles_of(std::string_view car) {
+  require_car(car);
+  std::vector<CarProfile> out;
+  for (const CarProfile& p : kProfiles) {
+    if (p.car == car) out.push_back(p);
+  }
+  std::stable_partition(out.begin(), out.end(), [](const CarProfile& p) { return p.is_default; });
+  return out;
+}
+
+const CarProfile& default_car_profile(std::string_view car) {
+  require_car(car);
+  for (const CarProfile& p : kProfiles) {
+    if (p.car == car && p.is_default) return p;
+  }
+  throw ProfileError("car '" + std::string(car) + "' has no default profile");
+}
+
+const CarProfile& find_car_profile(std::string_view car, std::string_view name) {
+  if (name.empty()) return default_car_profile(car);
+  require_car(car);
+  for (const CarProfile& p : kProfiles) {
+    if (p.car == car && p.name == name) return p;
+  }
+  throw ProfileError(std::string(car) + " has no profile '" + std::string(name) +
+                     "'; its profiles are " + car_profile_names(car));
+}
+
+std::string car_profile_problem(std::string_view car, std::string_view name) {
+  try {
+    (void)find_car_profile(car, name);
+    return {};
+  } catch (const ProfileError& e) {
+    return e.what();
+  }
+}
+
+std::string car_profile_names(std::string_view car) {
+  std::vector<std::string> names;
+  for (const CarProfile& p : car_profiles_of(car)) {
+    names.push_back(std::string(p.name) + (p.is_default ? " (the default)" : ""));
+  }
+  std::vector<std::string_view> views(names.begin(), names.end());
+  return spoken_list(views);
+}
+
+}  // namespace hil::protocol
