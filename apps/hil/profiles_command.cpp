@@ -35,7 +35,8 @@ void register_profiles(CLI::App& app, std::function<int()>& run) {
           print_car(std::cout, *car);
           return 0;
         }
-        for (const auto c : protocol::car_profile_cars()) print_car(std::cout, c);
+        for (const auto c : protocol::car_profile_cars())
+          print_car(std::cout, c);
         return 0;
       } catch (const protocol::ProfileError& e) {
         std::cerr << "hil profiles: " << e.what() << '\n';

@@ -23,7 +23,8 @@ std::vector<std::string_view> strtok_fields(std::string_view text, std::size_t m
   std::vector<std::string_view> fields;
   std::size_t i = 0;
   while (fields.size() < most) {
-    while (i < text.size() && text[i] == '|') ++i;
+    while (i < text.size() && text[i] == '|')
+      ++i;
     if (i == text.size()) break;
     const std::size_t end = text.find('|', i);
     const std::size_t stop = end == std::string_view::npos ? text.size() : end;
@@ -93,8 +94,8 @@ void SketchReceiver::feed(ByteView bytes, std::vector<SketchFrame>& out) {
       buffer_.push_back(c);
     } else {
       // The byte that does not fit is lost with the frame, even a '^'.
-      out.push_back(SketchFrame{to_bytes(buffer_),
-                                SketchDrop{"no '$' within 96 bytes of the '^'"}});
+      out.push_back(
+          SketchFrame{to_bytes(buffer_), SketchDrop{"no '$' within 96 bytes of the '^'"}});
       in_frame_ = false;
       buffer_.clear();
     }
@@ -130,7 +131,8 @@ long sketch_atol(std::string_view text) {
   constexpr long long kMax = std::numeric_limits<std::int32_t>::max();
   constexpr long long kMin = std::numeric_limits<std::int32_t>::min();
   std::size_t i = 0;
-  while (i < text.size() && (text[i] == ' ' || (text[i] >= '\t' && text[i] <= '\r'))) ++i;
+  while (i < text.size() && (text[i] == ' ' || (text[i] >= '\t' && text[i] <= '\r')))
+    ++i;
   bool negative = false;
   if (i < text.size() && (text[i] == '+' || text[i] == '-')) negative = text[i++] == '-';
   long long value = 0;

@@ -71,11 +71,11 @@ TEST(ArduinoSketch, LowerCaseHexIsAcceptedInTheChecksumAndTheSeq) {
 
 TEST(ArduinoSketch, MalformedFramesAreDroppedWithoutAnAnswer) {
   for (const char* frame : {
-           "^1*00$",            // 6 bytes: shorter than 7
-           "^01|PING| 31$",     // no '*'
-           "^01|V|1*0*63$",     // four characters between the first '*' and '$'
-           "^01|PING| *3$",     // one checksum character
-           "^01|PING| *G1$",    // checksum not hex
+           "^1*00$",          // 6 bytes: shorter than 7
+           "^01|PING| 31$",   // no '*'
+           "^01|V|1*0*63$",   // four characters between the first '*' and '$'
+           "^01|PING| *3$",   // one checksum character
+           "^01|PING| *G1$",  // checksum not hex
        }) {
     EXPECT_TRUE(std::holds_alternative<SketchDrop>(judge(frame))) << frame;
   }
@@ -129,7 +129,8 @@ TEST(ArduinoSketch, AnyChunkingGivesTheSameFrames) {
   const auto whole = receive(stream);
   SketchReceiver receiver;
   std::vector<SketchFrame> bytewise;
-  for (const char c : stream) receiver.feed(to_bytes(std::string_view(&c, 1)), bytewise);
+  for (const char c : stream)
+    receiver.feed(to_bytes(std::string_view(&c, 1)), bytewise);
   ASSERT_EQ(bytewise.size(), whole.size());
   for (std::size_t i = 0; i < whole.size(); ++i) {
     EXPECT_EQ(bytewise[i].raw, whole[i].raw);
