@@ -78,12 +78,13 @@ Duration ArduinoClientCore::timeout_of(int attempt) const {
 }
 
 Bytes ArduinoClientCore::frame_of(const Pending& pending, std::uint8_t seq) const {
-  if (pending.raw) {
-    proto::Envelope e = *pending.raw;
+  if (const auto* raw = std::get_if<proto::Envelope>(&pending.what)) {
+    proto::Envelope e = *raw;
     e.seq = seq;
     return protocol::to_bytes(proto::frame_text(e));
   }
-  return protocol::to_bytes(proto::encode_text({seq, pending.body}, config_.dialect));
+  return protocol::to_bytes(
+      proto::encode_text({seq, std::get<proto::Body>(pending.what)}, config_.dialect));
 }
 
 void ArduinoClientCore::open(Time now) {
@@ -150,7 +151,7 @@ RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
                          std::string("the link is ") + std::string(to_string(state_))));
     return id;
   }
-  queue_.push_back({id, Purpose::user, proto::Body{}, std::move(envelope)});
+  queue_.push_back({id, Purpose::user, std::move(envelope)});
   pump(now);
   return id;
 }
@@ -227,8 +228,8 @@ void ArduinoClientCore::handle_message(Time now, const proto::Message& m) {
   if (const auto* ack = std::get_if<proto::Ack>(&m.body)) {
     Result r = outcome(ResultCode::ok, "");
     r.info = ack->info;
-    if (!inflight_->pending.raw) {
-      r.reply = proto::parse_reply(config_.dialect, inflight_->pending.body, ack->info);
+    if (const auto* body = std::get_if<proto::Body>(&inflight_->pending.what)) {
+      r.reply = proto::parse_reply(config_.dialect, *body, ack->info);
     }
     finish(now, std::move(r));
     return;

@@ -157,9 +157,8 @@ class ArduinoClientCore {
   struct Pending {
     RequestId id = 0;
     Purpose purpose = Purpose::user;
-    protocol::arduino::Body body;
-    /// A raw token that is no typed request, framed as given.
-    std::optional<protocol::arduino::Envelope> raw;
+    /// A typed request, or a raw token hil does not type, framed as given.
+    std::variant<protocol::arduino::Body, protocol::arduino::Envelope> what;
   };
   struct Inflight {
     Pending pending;

@@ -29,7 +29,7 @@ struct RobotRequest {
   /// A token in the robot CLI's raw form ("V:999", "X:1") that hil would not
   /// type: it goes to the robot as given and the board answers it (`body`
   /// is unused then). The spaced form ("V 999") is checked instead.
-  std::optional<std::string> raw;
+  std::optional<std::string> raw = std::nullopt;
   friend bool operator==(const RobotRequest&, const RobotRequest&) = default;
 };
 /// `wait 500ms`: nothing happens for this long (scripts pace themselves with it).

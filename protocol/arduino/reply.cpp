@@ -87,11 +87,14 @@ std::optional<Reply> sketch_ir(std::string_view info) {
   return IrReply{*al, *ar, *dlb, *drb};
 }
 
+/// DoneReply when the board answered exactly `expected` (OK, ACCEPTED, STOPPED).
+std::optional<Reply> done_if(std::string_view info, std::string_view expected) {
+  if (info != expected) return std::nullopt;
+  return DoneReply{};
+}
+
 std::optional<Reply> sketch_reply(const Body& request, std::string_view info) {
-  const auto word = [&](std::string_view expected) -> std::optional<Reply> {
-    if (info != expected) return std::nullopt;
-    return DoneReply{};
-  };
+  const auto word = [&](std::string_view expected) { return done_if(info, expected); };
   return std::visit(Overloaded{
                         [&](const Ping&) -> std::optional<Reply> {
                           if (info != "PONG") return std::nullopt;
@@ -195,18 +198,9 @@ std::optional<Reply> readme_reply(const Body& request, std::string_view info) {
                           if (!pwm) return std::nullopt;
                           return DoneReply{pwm};
                         },
-                        [&](const Move&) -> std::optional<Reply> {
-                          if (info != "OK") return std::nullopt;
-                          return DoneReply{};
-                        },
-                        [&](const Rotate&) -> std::optional<Reply> {
-                          if (info != "OK") return std::nullopt;
-                          return DoneReply{};
-                        },
-                        [&](const Stop&) -> std::optional<Reply> {
-                          if (info != "OK") return std::nullopt;
-                          return DoneReply{};
-                        },
+                        [&](const Move&) { return done_if(info, "OK"); },
+                        [&](const Rotate&) { return done_if(info, "OK"); },
+                        [&](const Stop&) { return done_if(info, "OK"); },
                         [&](const StatusRequest&) { return readme_status(info); },
                         [&](const SonarRead&) -> std::optional<Reply> {
                           const auto cm = number(info);
