@@ -45,6 +45,7 @@ leka::DecoderOptions decoder_options(const LekaConfig& c) {
   options.max_frame_bytes = c.serial_buffer_bytes;
   options.limits.max_belt_led_id = c.max_belt_led_id;
   options.accept_out_of_range = c.accept_out_of_range;
+  options.dialect = c.dialect;
   return options;
 }
 
@@ -276,6 +277,11 @@ void LekaFirmware::execute(Time at, const Command& command) {
           },
           [&](const leka::EarAll& c) {
             base_ears_.fill(c.color);
+            show_base_leds();
+          },
+          [&](const leka::EarRange& c) {
+            for (std::size_t i = c.first; i <= c.last && i < base_ears_.size(); ++i)
+              base_ears_[i] = c.color;
             show_base_leds();
           },
           [&](const leka::EarSingle& c) {

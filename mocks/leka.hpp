@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "link/protocol_adapter.hpp"
 #include "mocks/firmware.hpp"
 #include "protocol/leka/codec.hpp"
 #include "protocol/leka/message.hpp"
@@ -20,6 +21,9 @@ namespace hil::mocks {
 
 /// How the mock Leka firmware behaves where real firmwares could differ.
 struct LekaConfig {
+  /// Command ids and checksum the robot reads: the README's (readme, the
+  /// default) or the spec's tables (comspecs_v3); docs/protocols/leka.md.
+  protocol::leka::Dialect dialect = protocol::leka::Dialect::readme;
   /// Period of the firmware's main loop: each pass reads the serial buffer
   /// and runs the commands found. Passes fall on multiples of it. > 0.
   Duration loop_period = link::milliseconds(10);
@@ -107,6 +111,10 @@ class LekaFirmware final : public Firmware {
   LekaFirmware(sim::World& world, sim::Vehicle& vehicle, LekaConfig config = {});
 
   std::string_view protocol() const override { return "leka"; }
+  /// Frames the link by this robot's profile (its dialect).
+  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
+    return link::protocol_adapter("leka", hil::protocol::leka::to_string(config_.dialect));
+  }
   std::string summary() const override;
 
   const LekaState& state() const { return state_; }

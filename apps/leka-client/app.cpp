@@ -14,6 +14,8 @@
 #include "link/asio_executor.hpp"
 #include "link/transport.hpp"
 #include "protocol/common/bytes.hpp"
+#include "protocol/common/car_profile.hpp"
+#include "protocol/leka/message.hpp"
 
 namespace hil::apps::leka_client {
 
@@ -76,6 +78,10 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
                  "Largest frame, and the most bytes sent per 10 ms (default 64, half the "
                  "robot's 128-byte buffer; more risks lost bytes)")
       ->check(CLI::Range(12, 128));
+  add_profile_option(
+      app, o.profile, "leka",
+      "The robot's convention: readme (the default: the README's ids and checksum) or "
+      "comspecs-v3 (the spec's YAML ids, the 8-bit checksum over length and group)");
   app.add_option("groups", o.groups,
                  "Command groups, one per argument, e.g. \"ear all 255 0 0; motor all 0 120\"");
   app.footer(
@@ -91,7 +97,8 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
       "Examples:\n"
       "  leka-client --port /tmp/hil-leka0 \"ear all 255 0 0; motor all 0 120\" info\n"
       "  leka-client --port /tmp/hil-leka0 --script show.leka --log run.csv\n"
-      "  leka-client --dry-run \"belt single 0 255 0 0\"\n");
+      "  leka-client --dry-run \"belt single 0 255 0 0\"\n"
+      "  leka-client --dry-run --profile comspecs-v3 \"belt single 0x12 100 150 200\"\n");
   return parse_options<AppOptions>(
       app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
         if (!given.script.empty() && !given.groups.empty())
@@ -112,6 +119,7 @@ leka::ClientConfig config_for(const AppOptions& options) {
   config.info_timeout = link::milliseconds(options.info_timeout_ms);
   config.max_frame_bytes = static_cast<std::size_t>(options.frame_bytes);
   config.bytes_per_period = static_cast<std::size_t>(options.frame_bytes);
+  config.dialect = protocol::leka::dialect_named(options.profile);
   return config;
 }
 

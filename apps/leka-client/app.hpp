@@ -25,6 +25,7 @@ struct AppOptions {
   bool dry_run = false;
   int info_timeout_ms = 200;
   int frame_bytes = 64;  ///< largest frame, and the most bytes sent per 10 ms
+  std::string profile;   ///< the robot's profile; empty is the default (readme)
 };
 
 /// What the command line asks for, or the exit code when it asks for nothing

@@ -42,6 +42,12 @@ GroupBuilder& GroupBuilder::belt_all(proto::Rgb color) {
   return add(proto::BeltAll{color});
 }
 
+GroupBuilder& GroupBuilder::ear_range(int first, int last, proto::Rgb color) {
+  if (!check("led.ear.range first", first, 0, 1)) return *this;
+  if (!check("led.ear.range last", last, first, 1)) return *this;
+  return add(proto::EarRange{u8(first), u8(last), color});
+}
+
 GroupBuilder& GroupBuilder::ear_single(int led, proto::Rgb color) {
   if (!check("led.ear.single led", led, 0, 1)) return *this;
   return add(proto::EarSingle{u8(led), color});
@@ -102,21 +108,22 @@ BuildResult GroupBuilder::result() const {
   return {};
 }
 
-std::vector<Bytes> split_frames(const proto::CommandGroup& group, std::size_t max_group_bytes) {
+std::vector<Bytes> split_frames(const proto::CommandGroup& group, std::size_t max_group_bytes,
+                                proto::Dialect dialect) {
   std::vector<Bytes> frames;
   proto::CommandGroup part;
   std::size_t part_bytes = 0;
   for (const auto& c : group.commands) {
     const std::size_t size = 1 + proto::spec_of(c).data_bytes;
     if (!part.commands.empty() && part_bytes + size > max_group_bytes) {
-      frames.push_back(proto::encode(part));
+      frames.push_back(proto::encode(part, {}, dialect));
       part.commands.clear();
       part_bytes = 0;
     }
     part.commands.push_back(c);
     part_bytes += size;
   }
-  if (!part.commands.empty()) frames.push_back(proto::encode(part));
+  if (!part.commands.empty()) frames.push_back(proto::encode(part, {}, dialect));
   return frames;
 }
 
@@ -186,8 +193,11 @@ BuildResult LekaClientCore::send(Time now, const proto::CommandGroup& group) {
   for (const auto& c : group.commands) {
     if (auto problem = proto::range_problem(c))
       return {BuildError::out_of_range, std::string(proto::spec_of(c).name)};
+    if (!proto::spec_of(c).in(config_.dialect))
+      return {BuildError::not_in_profile, std::string(proto::spec_of(c).name)};
   }
-  for (auto& f : split_frames(group, config_.max_frame_bytes - proto::kOverheadBytes))
+  for (auto& f :
+       split_frames(group, config_.max_frame_bytes - proto::kOverheadBytes, config_.dialect))
     queue_.push_back({std::move(f), std::nullopt});
   pump(now);
   return {};
@@ -196,7 +206,7 @@ BuildResult LekaClientCore::send(Time now, const proto::CommandGroup& group) {
 RequestId LekaClientCore::info(Time now) {
   const RequestId id = next_id_++;
   pending_.push_back({id, std::nullopt});
-  queue_.push_back({proto::encode(proto::CommandGroup{{proto::Info{}}}), id});
+  queue_.push_back({proto::encode(proto::CommandGroup{{proto::Info{}}}, {}, config_.dialect), id});
   pump(now);
   return id;
 }

@@ -27,7 +27,9 @@ using protocol::ByteView;
 namespace proto = protocol::leka;
 
 /// Why a builder call was refused; `field` names the wrong value.
-enum class BuildError : std::uint8_t { ok, out_of_range, group_empty };
+/// not_in_profile: a command the client's profile does not have
+/// (led.ear.range outside comspecs-v3).
+enum class BuildError : std::uint8_t { ok, out_of_range, group_empty, not_in_profile };
 
 struct BuildResult {
   BuildError error = BuildError::ok;
@@ -46,6 +48,8 @@ class GroupBuilder {
   GroupBuilder& stop_motor();
   GroupBuilder& stop_robot();
   GroupBuilder& ear_all(proto::Rgb color);
+  /// Ears first..last (0..1); a command of profile comspecs-v3 only.
+  GroupBuilder& ear_range(int first, int last, proto::Rgb color);
   GroupBuilder& ear_single(int led, proto::Rgb color);
   GroupBuilder& belt_all(proto::Rgb color);
   GroupBuilder& belt_range(int first, int last, proto::Rgb color);
@@ -71,10 +75,16 @@ class GroupBuilder {
 };
 
 /// Splits a group into frames of at most `max_group_bytes` group bytes each,
-/// cutting only between commands (a command is never split).
-std::vector<Bytes> split_frames(const proto::CommandGroup& group, std::size_t max_group_bytes);
+/// cutting only between commands (a command is never split), in the ids and
+/// checksum of `dialect`. Throws std::invalid_argument for a command the
+/// dialect does not have.
+std::vector<Bytes> split_frames(const proto::CommandGroup& group, std::size_t max_group_bytes,
+                                proto::Dialect dialect = proto::Dialect::readme);
 
 struct ClientConfig {
+  /// Command ids and checksum of the robot: its profile (readme, the
+  /// default, or comspecs_v3; docs/protocols/leka.md).
+  proto::Dialect dialect = proto::Dialect::readme;
   /// Main-loop period of the robot: each pass empties its serial buffer.
   Duration loop_period = link::milliseconds(10);
   /// Most frame bytes sent within any loop_period (half-open window). Two

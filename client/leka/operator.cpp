@@ -360,10 +360,10 @@ std::vector<Bytes> frames_of(const OperatorLine& line, const ClientConfig& confi
   std::vector<Bytes> frames;
   for (const auto& part : line.parts) {
     if (const auto* builder = std::get_if<GroupBuilder>(&part)) {
-      for (auto& f : split_frames(builder->group(), max_group))
+      for (auto& f : split_frames(builder->group(), max_group, config.dialect))
         frames.push_back(std::move(f));
     } else {
-      frames.push_back(proto::encode(proto::CommandGroup{{proto::Info{}}}));
+      frames.push_back(proto::encode(proto::CommandGroup{{proto::Info{}}}, {}, config.dialect));
     }
   }
   return frames;

@@ -20,10 +20,28 @@ std::string where(std::size_t group_index) {
 
 // Name of the group's first command, when its id is known: the context of
 // errors found before the group could be parsed.
-std::string first_command_name(ByteView frame) {
+std::string first_command_name(ByteView frame, Dialect dialect) {
   if (frame.size() <= kHeaderBytes) return {};
-  const CommandSpec* spec = find_spec(frame[kHeaderBytes]);
+  const CommandSpec* spec = find_spec(frame[kHeaderBytes], dialect);
   return spec != nullptr ? std::string(spec->name) : std::string();
+}
+
+// Where the frame would pass in the car's other convention, say so: the
+// commonest cause of a frame refused here is a client of the other profile.
+std::string other_profile_hint(ByteView frame, Dialect dialect) {
+  const Dialect other = dialect == Dialect::readme ? Dialect::comspecs_v3 : Dialect::readme;
+  const ByteView group = frame.subspan(kHeaderBytes, frame.size() - kOverheadBytes);
+  if (checksum(group, other) != frame.back()) return {};
+  return "; it matches profile " + std::string(to_string(other)) + " (--profile " +
+         std::string(to_string(other)) + ")";
+}
+
+// The command an id is in the car's other convention, for error messages.
+std::string other_id_hint(std::uint8_t id, Dialect dialect) {
+  const Dialect other = dialect == Dialect::readme ? Dialect::comspecs_v3 : Dialect::readme;
+  const CommandSpec* spec = find_spec(id, other);
+  if (spec == nullptr) return {};
+  return "; in profile " + std::string(to_string(other)) + " it is " + std::string(spec->name);
 }
 
 Item error_item(ByteView raw, ErrorKind kind, std::string detail, std::string context = {}) {
@@ -34,7 +52,7 @@ Item error_item(ByteView raw, ErrorKind kind, std::string detail, std::string co
 // A frame whose checksum is already known to be right: parse, then ranges.
 Item decode_checked(ByteView raw, const DecoderOptions& options) {
   const ByteView group = raw.subspan(kHeaderBytes, raw.size() - kOverheadBytes);
-  auto parsed = parse_group(group);
+  auto parsed = parse_group(group, options.dialect);
   if (auto* e = std::get_if<GroupError>(&parsed)) {
     return error_item(raw, e->kind, std::move(e->detail), std::move(e->context));
   }
@@ -58,11 +76,13 @@ Item decode_checked(ByteView raw, const DecoderOptions& options) {
   return Item{Frame<Message>{std::move(commands), Bytes(raw.begin(), raw.end()), tolerated}};
 }
 
-std::string checksum_detail(ByteView candidate) {
+std::string checksum_detail(ByteView candidate, Dialect dialect) {
   const ByteView group = candidate.subspan(kHeaderBytes, candidate.size() - kOverheadBytes);
   return "checksum byte " + hex_literal(candidate.back()) + " at frame byte " +
-         std::to_string(candidate.size() - 1) + " does not match " + hex_literal(checksum(group)) +
-         " computed over the " + std::to_string(group.size()) + "-byte command group";
+         std::to_string(candidate.size() - 1) + " does not match " +
+         hex_literal(checksum(group, dialect)) + " computed over the " +
+         (dialect == Dialect::readme ? "" : "length byte and the ") + std::to_string(group.size()) +
+         "-byte command group" + other_profile_hint(candidate, dialect);
 }
 
 }  // namespace
@@ -76,21 +96,40 @@ std::uint16_t bsd_checksum16(ByteView bytes) {
   return sum;
 }
 
-std::uint8_t checksum(ByteView group) {
-  return static_cast<std::uint8_t>(bsd_checksum16(group) & 0xFFu);
+std::uint8_t bsd_checksum8(ByteView bytes) {
+  std::uint8_t sum = 0;
+  for (const std::uint8_t b : bytes) {
+    sum = static_cast<std::uint8_t>((sum >> 1) | ((sum & 1u) << 7));
+    sum = static_cast<std::uint8_t>(sum + b);
+  }
+  return sum;
 }
 
-Bytes group_bytes(const CommandGroup& group) {
+std::uint8_t checksum(ByteView group, Dialect dialect) {
+  if (dialect == Dialect::readme) return static_cast<std::uint8_t>(bsd_checksum16(group) & 0xFFu);
+  Bytes covered;
+  covered.reserve(group.size() + 1);
+  covered.push_back(static_cast<std::uint8_t>(group.size()));
+  covered.insert(covered.end(), group.begin(), group.end());
+  return bsd_checksum8(covered);
+}
+
+Bytes group_bytes(const CommandGroup& group, Dialect dialect) {
   Bytes out;
   for (const Command& c : group.commands) {
-    out.push_back(static_cast<std::uint8_t>(spec_of(c).id));
+    const CommandSpec& spec = spec_of(c);
+    if (!spec.in(dialect)) {
+      throw std::invalid_argument("Leka: " + std::string(spec.name) + " is not a command of the " +
+                                  std::string(to_string(dialect)) + " profile");
+    }
+    out.push_back(spec.id(dialect));
     const Bytes data = data_of(c);
     out.insert(out.end(), data.begin(), data.end());
   }
   return out;
 }
 
-Bytes frame_group(ByteView group) {
+Bytes frame_group(ByteView group, Dialect dialect) {
   if (group.size() > 255) {
     throw std::invalid_argument("Leka frame: a command group of " + std::to_string(group.size()) +
                                 " bytes does not fit the one-byte length field");
@@ -98,11 +137,11 @@ Bytes frame_group(ByteView group) {
   Bytes out(kStartSequence.begin(), kStartSequence.end());
   out.push_back(static_cast<std::uint8_t>(group.size()));
   out.insert(out.end(), group.begin(), group.end());
-  out.push_back(checksum(group));
+  out.push_back(checksum(group, dialect));
   return out;
 }
 
-Bytes encode(const Message& m, const ValueLimits& limits) {
+Bytes encode(const Message& m, const ValueLimits& limits, Dialect dialect) {
   if (m.commands.empty())
     throw std::invalid_argument("Leka encode: a command group needs a command");
   for (std::size_t i = 0; i < m.commands.size(); ++i) {
@@ -111,25 +150,26 @@ Bytes encode(const Message& m, const ValueLimits& limits) {
                                   std::string(spec_of(m.commands[i]).name) + "): " + *problem);
     }
   }
-  const Bytes group = group_bytes(m);
+  const Bytes group = group_bytes(m, dialect);
   if (group.size() > kMaxGroupBytes) {
     throw std::invalid_argument("Leka encode: command group of " + std::to_string(group.size()) +
                                 " bytes exceeds the robot's " + std::to_string(kMaxGroupBytes));
   }
-  return frame_group(group);
+  return frame_group(group, dialect);
 }
 
-std::variant<CommandGroup, GroupError> parse_group(ByteView group) {
+std::variant<CommandGroup, GroupError> parse_group(ByteView group, Dialect dialect) {
   if (group.empty()) return GroupError{ErrorKind::bad_format, "empty command group", {}};
   CommandGroup out;
   std::size_t i = 0;
   while (i < group.size()) {
     const std::size_t number = out.commands.size() + 1;
-    const CommandSpec* spec = find_spec(group[i]);
+    const CommandSpec* spec = find_spec(group[i], dialect);
     if (spec == nullptr) {
       return GroupError{ErrorKind::unknown_code,
                         "unknown command id " + hex_literal(group[i]) + " at " + where(i) +
-                            " (command " + std::to_string(number) + ")",
+                            " (command " + std::to_string(number) + ")" +
+                            other_id_hint(group[i], dialect),
                         hex_literal(group[i])};
     }
     const std::size_t left = group.size() - i - 1;
@@ -162,17 +202,18 @@ Item decode_frame(ByteView raw, const DecoderOptions& options) {
                       "length byte announces a " + std::to_string(length) +
                           "-byte command group; frames are limited to " +
                           std::to_string(options.max_frame_bytes) + " bytes",
-                      first_command_name(raw));
+                      first_command_name(raw, options.dialect));
   }
   if (length + kOverheadBytes != raw.size()) {
     return error_item(raw, ErrorKind::bad_format,
                       "length byte announces a " + std::to_string(length) +
                           "-byte command group, the frame carries " +
                           std::to_string(raw.size() - kOverheadBytes),
-                      first_command_name(raw));
+                      first_command_name(raw, options.dialect));
   }
-  if (checksum(raw.subspan(kHeaderBytes, length)) != raw.back()) {
-    return error_item(raw, ErrorKind::bad_checksum, checksum_detail(raw), first_command_name(raw));
+  if (checksum(raw.subspan(kHeaderBytes, length), options.dialect) != raw.back()) {
+    return error_item(raw, ErrorKind::bad_checksum, checksum_detail(raw, options.dialect),
+                      first_command_name(raw, options.dialect));
   }
   return decode_checked(raw, options);
 }
@@ -276,19 +317,20 @@ void Decoder::advance(std::vector<Item>& out) {
 void Decoder::complete_candidate(std::vector<Item>& out) {
   const ByteView candidate(buf_.data(), need_);
   const ByteView group = candidate.subspan(kHeaderBytes, need_ - kOverheadBytes);
-  if (checksum(group) == candidate.back()) {
+  if (checksum(group, options_.dialect) == candidate.back()) {
     out.push_back(decode_checked(candidate, options_));
     buf_.erase(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(need_));
     restart_hunting();
     return;
   }
   const std::size_t k = resync_point(need_);
-  std::string detail = checksum_detail(candidate);
+  std::string detail = checksum_detail(candidate, options_.dialect);
   if (k < need_) {
     detail += "; reported up to frame byte " + std::to_string(k) +
               ", where a start sequence begins and decoding resumes";
   }
-  emit_error(k, ErrorKind::bad_checksum, std::move(detail), first_command_name(candidate), out);
+  emit_error(k, ErrorKind::bad_checksum, std::move(detail),
+             first_command_name(candidate, options_.dialect), out);
   restart_hunting();
 }
 
@@ -315,7 +357,7 @@ void Decoder::finish(std::vector<Item>& out) {
       detail += "; reported up to frame byte " + std::to_string(k) +
                 ", where a start sequence begins and decoding resumes";
     }
-    std::string context = first_command_name(ByteView(buf_.data(), k));
+    std::string context = first_command_name(ByteView(buf_.data(), k), options_.dialect);
     emit_error(k, ErrorKind::truncated, std::move(detail), std::move(context), out);
     restart_hunting();
     advance(out);

@@ -28,22 +28,31 @@ inline constexpr std::size_t kMaxGroupBytes = kMaxFrameBytes - kOverheadBytes;
 /// The 16-bit BSD checksum: per byte, rotate the sum right by one bit, then
 /// add the byte (mod 2^16).
 std::uint16_t bsd_checksum16(ByteView bytes);
-/// The frame's checksum byte: low byte of the BSD checksum of the command
-/// group alone (the length byte is not an input; see the doc).
-std::uint8_t checksum(ByteView group);
+/// The 8-bit BSD checksum: the same walk within one byte (rotate right by
+/// one bit within 8 bits, then add the byte, mod 2^8).
+std::uint8_t bsd_checksum8(ByteView bytes);
+/// The frame's checksum byte for a command group (its length byte is
+/// group.size()). readme: the low byte of the 16-bit BSD checksum of the
+/// group alone, as the README's worked examples have it. comspecs_v3: the
+/// 8-bit BSD checksum of the length byte and the group, as the third-party
+/// generator computes it (docs/protocols/leka.md).
+std::uint8_t checksum(ByteView group, Dialect dialect = Dialect::readme);
 
-/// The wire bytes of the commands, in order, without any checking.
-Bytes group_bytes(const CommandGroup& group);
+/// The wire bytes of the commands, in order, without checking values.
+/// Throws std::invalid_argument for a command the dialect does not have
+/// (led.ear.range in readme).
+Bytes group_bytes(const CommandGroup& group, Dialect dialect = Dialect::readme);
 
 /// Frames any group bytes as they are (for odd frames in fault injection and
 /// QA). Throws std::invalid_argument only when the group does not fit the
 /// one-byte length field (more than 255 bytes).
-Bytes frame_group(ByteView group);
+Bytes frame_group(ByteView group, Dialect dialect = Dialect::readme);
 
 /// A complete frame. Throws std::invalid_argument for groups the robot cannot
-/// take: no command, more than kMaxGroupBytes, or a value outside its range
-/// under `limits` (use frame_group(group_bytes(g)) to send such a group anyway).
-Bytes encode(const Message& m, const ValueLimits& limits = {});
+/// take: no command, more than kMaxGroupBytes, a command the dialect does
+/// not have, or a value outside its range under `limits` (use
+/// frame_group(group_bytes(g)) to send such a group anyway).
+Bytes encode(const Message& m, const ValueLimits& limits = {}, Dialect dialect = Dialect::readme);
 
 struct GroupError {
   ErrorKind kind;  ///< bad_format or unknown_code
@@ -51,15 +60,18 @@ struct GroupError {
   std::string context;  ///< the command name (or unknown id) where parsing stopped
 };
 
-/// Splits command-group bytes into typed commands; checks structure only
-/// (known ids, complete data), not value ranges.
-std::variant<CommandGroup, GroupError> parse_group(ByteView group);
+/// Splits command-group bytes into typed commands by the ids of `dialect`;
+/// checks structure only (known ids, complete data), not value ranges.
+std::variant<CommandGroup, GroupError> parse_group(ByteView group,
+                                                   Dialect dialect = Dialect::readme);
 
 struct DecoderOptions {
   /// Frame bound in bytes, start sequence to checksum (7..261). The default
   /// is the robot's serial buffer; it is also the most the decoder holds.
   std::size_t max_frame_bytes = kMaxFrameBytes;
   ValueLimits limits;
+  /// Command ids and checksum of this convention.
+  Dialect dialect = Dialect::readme;
   /// When false, a frame with a value out of range (ear/belt LED id, spin,
   /// motivator or guidance id) is a bad_value error; when true it decodes,
   /// marked tolerated = bad_value.

@@ -2,48 +2,44 @@
 
 #include <cstdio>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
 
 namespace hil::protocol::leka {
 
-const std::array<CommandSpec, 15> kCommandSpecs = {{
-    {CommandId::info, "info", 0, ""},
-    {CommandId::stop_led, "stop.led", 0, ""},
-    {CommandId::stop_motor, "stop.motor", 0, ""},
-    {CommandId::stop_robot, "stop.robot", 0, ""},
-    {CommandId::led_ear_all, "led.ear.all", 3, "R G B"},
-    {CommandId::led_ear_single, "led.ear.single", 4, "ID(0..1) R G B"},
-    {CommandId::led_belt_all, "led.belt.all", 3, "R G B"},
-    {CommandId::led_belt_range, "led.belt.range", 5, "FIRST LAST R G B"},
-    {CommandId::led_belt_single, "led.belt.single", 4, "ID R G B"},
-    {CommandId::motor_all, "motor.all", 2, "DIRECTION(0|1) SPEED"},
-    {CommandId::motor_duo, "motor.duo", 4, "LEFT_SPIN(0|1) LEFT_SPEED RIGHT_SPIN(0|1) RIGHT_SPEED"},
-    {CommandId::motor_left, "motor.left", 2, "SPIN(0|1) SPEED"},
-    {CommandId::motor_right, "motor.right", 2, "SPIN(0|1) SPEED"},
-    {CommandId::motivator, "motivator", 1, "ID(0x51..0x55)"},
-    {CommandId::guidance, "guidance", 1, "ID(0x41..0x4F)"},
+// Ids: the README's table (readme) and the spec's YAML / Swift tables of
+// the same release (comspecs-v3), leka/LKAlphaComSpecs at 381046f.
+const std::array<CommandSpec, 16> kCommandSpecs = {{
+    {"info", 0x70, 0x70, 0, ""},
+    {"stop.led", 0xFD, 0xFD, 0, ""},
+    {"stop.motor", 0xFE, 0xFE, 0, ""},
+    {"stop.robot", 0xFF, 0xFF, 0, ""},
+    {"led.ear.all", 0x11, 0x11, 3, "R G B"},
+    {"led.ear.range", 0, 0x12, 5, "FIRST(0..1) LAST(0..1) R G B"},
+    {"led.ear.single", 0x12, 0x13, 4, "ID(0..1) R G B"},
+    {"led.belt.all", 0x13, 0x14, 3, "R G B"},
+    {"led.belt.range", 0x14, 0x15, 5, "FIRST LAST R G B"},
+    {"led.belt.single", 0x15, 0x16, 4, "ID R G B"},
+    {"motor.all", 0x21, 0x21, 2, "DIRECTION(0|1) SPEED"},
+    {"motor.duo", 0x22, 0x22, 4, "LEFT_SPIN(0|1) LEFT_SPEED RIGHT_SPIN(0|1) RIGHT_SPEED"},
+    {"motor.left", 0x23, 0x23, 2, "SPIN(0|1) SPEED"},
+    {"motor.right", 0x24, 0x24, 2, "SPIN(0|1) SPEED"},
+    {"motivator", 0x50, 0x50, 1, "ID(0x51..0x55)"},
+    {"guidance", 0x40, 0x40, 1, "ID(0x41..0x4F)"},
 }};
+static_assert(std::variant_size_v<Command> == kCommandSpecs.size(),
+              "one row of kCommandSpecs per alternative of Command, in order");
+
+std::string_view to_string(Dialect dialect) {
+  return dialect == Dialect::readme ? "readme" : "comspecs-v3";
+}
+
+Dialect dialect_named(std::string_view profile) {
+  const CarProfile& p = find_car_profile("leka", profile);
+  return p.name == "comspecs-v3" ? Dialect::comspecs_v3 : Dialect::readme;
+}
 
 namespace {
-
-CommandId id_of(const Command& c) {
-  return std::visit(Overloaded{[](const Info&) { return CommandId::info; },
-                               [](const StopLed&) { return CommandId::stop_led; },
-                               [](const StopMotor&) { return CommandId::stop_motor; },
-                               [](const StopRobot&) { return CommandId::stop_robot; },
-                               [](const EarAll&) { return CommandId::led_ear_all; },
-                               [](const EarSingle&) { return CommandId::led_ear_single; },
-                               [](const BeltAll&) { return CommandId::led_belt_all; },
-                               [](const BeltRange&) { return CommandId::led_belt_range; },
-                               [](const BeltSingle&) { return CommandId::led_belt_single; },
-                               [](const MotorAll&) { return CommandId::motor_all; },
-                               [](const MotorDuo&) { return CommandId::motor_duo; },
-                               [](const MotorLeft&) { return CommandId::motor_left; },
-                               [](const MotorRight&) { return CommandId::motor_right; },
-                               [](const Motivator&) { return CommandId::motivator; },
-                               [](const Guidance&) { return CommandId::guidance; }},
-                    c);
-}
 
 Rgb rgb_at(ByteView d, std::size_t i) {
   return Rgb{d[i], d[i + 1], d[i + 2]};
@@ -73,9 +69,10 @@ std::optional<std::string> check_belt(std::uint8_t led, const char* field, const
 
 }  // namespace
 
-const CommandSpec* find_spec(std::uint8_t id) {
+const CommandSpec* find_spec(std::uint8_t id, Dialect dialect) {
+  if (id == 0) return nullptr;
   for (const auto& s : kCommandSpecs) {
-    if (static_cast<std::uint8_t>(s.id) == id) return &s;
+    if (s.id(dialect) == id) return &s;
   }
   return nullptr;
 }
@@ -88,8 +85,8 @@ const CommandSpec* find_spec(std::string_view name) {
 }
 
 const CommandSpec& spec_of(const Command& c) {
-  // Every alternative of Command has a row in the table.
-  return *find_spec(static_cast<std::uint8_t>(id_of(c)));
+  // Every alternative of Command has a row in the table, in order.
+  return kCommandSpecs[c.index()];
 }
 
 Bytes data_of(const Command& c) {
@@ -98,6 +95,9 @@ Bytes data_of(const Command& c) {
       Overloaded{[](const Info&) { return Bytes{}; }, [](const StopLed&) { return Bytes{}; },
                  [](const StopMotor&) { return Bytes{}; }, [](const StopRobot&) { return Bytes{}; },
                  [&](const EarAll& v) { return rgb(v.color); },
+                 [](const EarRange& v) {
+                   return Bytes{v.first, v.last, v.color.red, v.color.green, v.color.blue};
+                 },
                  [](const EarSingle& v) {
                    return Bytes{v.led, v.color.red, v.color.green, v.color.blue};
                  },
@@ -127,39 +127,43 @@ Bytes data_of(const Command& c) {
 
 std::optional<Command> make_command(const CommandSpec& spec, ByteView d) {
   if (d.size() != spec.data_bytes) return std::nullopt;
-  switch (spec.id) {
-    case CommandId::info:
+  // The row's place in kCommandSpecs is the alternative's index in Command.
+  switch (&spec - kCommandSpecs.data()) {
+    case 0:
       return Info{};
-    case CommandId::stop_led:
+    case 1:
       return StopLed{};
-    case CommandId::stop_motor:
+    case 2:
       return StopMotor{};
-    case CommandId::stop_robot:
+    case 3:
       return StopRobot{};
-    case CommandId::led_ear_all:
+    case 4:
       return EarAll{rgb_at(d, 0)};
-    case CommandId::led_ear_single:
+    case 5:
+      return EarRange{d[0], d[1], rgb_at(d, 2)};
+    case 6:
       return EarSingle{d[0], rgb_at(d, 1)};
-    case CommandId::led_belt_all:
+    case 7:
       return BeltAll{rgb_at(d, 0)};
-    case CommandId::led_belt_range:
+    case 8:
       return BeltRange{d[0], d[1], rgb_at(d, 2)};
-    case CommandId::led_belt_single:
+    case 9:
       return BeltSingle{d[0], rgb_at(d, 1)};
-    case CommandId::motor_all:
+    case 10:
       return MotorAll{d[0], d[1]};
-    case CommandId::motor_duo:
+    case 11:
       return MotorDuo{d[0], d[1], d[2], d[3]};
-    case CommandId::motor_left:
+    case 12:
       return MotorLeft{d[0], d[1]};
-    case CommandId::motor_right:
+    case 13:
       return MotorRight{d[0], d[1]};
-    case CommandId::motivator:
+    case 14:
       return Motivator{d[0]};
-    case CommandId::guidance:
+    case 15:
       return Guidance{d[0]};
+    default:
+      return std::nullopt;
   }
-  return std::nullopt;
 }
 
 std::optional<std::string> range_problem(const Command& c, const ValueLimits& limits) {
@@ -170,6 +174,19 @@ std::optional<std::string> range_problem(const Command& c, const ValueLimits& li
                  [](const StopMotor&) -> R { return std::nullopt; },
                  [](const StopRobot&) -> R { return std::nullopt; },
                  [](const EarAll&) -> R { return std::nullopt; },
+                 [](const EarRange& v) -> R {
+                   if (v.first > 1) {
+                     return "first ear LED id " + hex_literal(v.first) + " outside 0x00..0x01";
+                   }
+                   if (v.last > 1) {
+                     return "last ear LED id " + hex_literal(v.last) + " outside 0x00..0x01";
+                   }
+                   if (v.first > v.last) {
+                     return "first ear LED id " + hex_literal(v.first) + " is after last " +
+                            hex_literal(v.last);
+                   }
+                   return std::nullopt;
+                 },
                  [](const EarSingle& v) -> R {
                    if (v.led <= 1) return std::nullopt;
                    return "ear LED id " + hex_literal(v.led) + " outside 0x00..0x01";
@@ -211,6 +228,10 @@ std::string describe(const Command& c) {
       Overloaded{
           [](const Info&) {}, [](const StopLed&) {}, [](const StopMotor&) {},
           [](const StopRobot&) {}, [&](const EarAll& v) { add(rgb_text(v.color)); },
+          [&](const EarRange& v) {
+            add("leds=" + std::to_string(v.first) + ".." + std::to_string(v.last));
+            add(rgb_text(v.color));
+          },
           [&](const EarSingle& v) {
             add("led=" + std::to_string(v.led));
             add(rgb_text(v.color));

@@ -15,24 +15,19 @@
 
 namespace hil::protocol::leka {
 
-/// Wire id of every command the profile knows.
-enum class CommandId : std::uint8_t {
-  led_ear_all = 0x11,
-  led_ear_single = 0x12,
-  led_belt_all = 0x13,
-  led_belt_range = 0x14,
-  led_belt_single = 0x15,
-  motor_all = 0x21,
-  motor_duo = 0x22,
-  motor_left = 0x23,
-  motor_right = 0x24,
-  guidance = 0x40,
-  motivator = 0x50,
-  info = 0x70,
-  stop_led = 0xFD,
-  stop_motor = 0xFE,
-  stop_robot = 0xFF,
-};
+/// The two conventions of the Leka Alpha spec (the car's profiles, see
+/// protocol/common/car_profile.hpp). `readme`: the command table and worked
+/// examples of the spec's README. `comspecs_v3`: the command ids of the
+/// same release's machine-readable tables (one more command, led.ear.range,
+/// shifts the LED ids after it) and an 8-bit checksum over length and
+/// group (docs/protocols/leka.md, "Profiles").
+enum class Dialect : std::uint8_t { readme, comspecs_v3 };
+
+/// "readme" or "comspecs-v3".
+std::string_view to_string(Dialect dialect);
+/// The dialect of a Leka profile name; empty is the default profile.
+/// Throws protocol::ProfileError for a name that is not a Leka profile.
+Dialect dialect_named(std::string_view profile);
 
 /// The seed does not define spin or direction bytes; this profile uses 0 and 1.
 inline constexpr std::uint8_t kSpinForward = 0;
@@ -67,25 +62,32 @@ struct EarAll {
   Rgb color;
   friend bool operator==(const EarAll&, const EarAll&) = default;
 };
-/// 0x12: one ear (led 0 or 1).
+/// led.ear.range (comspecs-v3 only, 0x12): ears first..last in one colour.
+struct EarRange {
+  std::uint8_t first = 0;
+  std::uint8_t last = 0;
+  Rgb color;
+  friend bool operator==(const EarRange&, const EarRange&) = default;
+};
+/// 0x12 (comspecs-v3: 0x13): one ear (led 0 or 1).
 struct EarSingle {
   std::uint8_t led = 0;
   Rgb color;
   friend bool operator==(const EarSingle&, const EarSingle&) = default;
 };
-/// 0x13: the whole belt in one colour.
+/// 0x13 (comspecs-v3: 0x14): the whole belt in one colour.
 struct BeltAll {
   Rgb color;
   friend bool operator==(const BeltAll&, const BeltAll&) = default;
 };
-/// 0x14: belt LEDs first..last (inclusive) in one colour.
+/// 0x14 (comspecs-v3: 0x15): belt LEDs first..last (inclusive) in one colour.
 struct BeltRange {
   std::uint8_t first = 0;
   std::uint8_t last = 0;
   Rgb color;
   friend bool operator==(const BeltRange&, const BeltRange&) = default;
 };
-/// 0x15: one belt LED.
+/// 0x15 (comspecs-v3: 0x16): one belt LED.
 struct BeltSingle {
   std::uint8_t led = 0;
   Rgb color;
@@ -128,9 +130,9 @@ struct Guidance {
   friend bool operator==(const Guidance&, const Guidance&) = default;
 };
 
-using Command =
-    std::variant<Info, StopLed, StopMotor, StopRobot, EarAll, EarSingle, BeltAll, BeltRange,
-                 BeltSingle, MotorAll, MotorDuo, MotorLeft, MotorRight, Motivator, Guidance>;
+using Command = std::variant<Info, StopLed, StopMotor, StopRobot, EarAll, EarRange, EarSingle,
+                             BeltAll, BeltRange, BeltSingle, MotorAll, MotorDuo, MotorLeft,
+                             MotorRight, Motivator, Guidance>;
 
 /// What one frame carries: one or more commands, run by the robot in order.
 struct CommandGroup {
@@ -141,18 +143,24 @@ struct CommandGroup {
 /// The decoder's message is a whole command group (one per frame).
 using Message = CommandGroup;
 
-/// Static facts about one command: its id, dotted name and data size.
+/// Static facts about one command: its ids, dotted name and data size.
 struct CommandSpec {
-  CommandId id;
-  std::string_view name;       ///< "led.belt.single", as in the command table
+  std::string_view name;  ///< "led.belt.single", as in the command table
+  /// The wire id in each dialect; 0 where the dialect has no such command.
+  std::uint8_t readme_id;
+  std::uint8_t comspecs_id;
   std::size_t data_bytes;      ///< bytes after the id
   std::string_view data_help;  ///< the data fields in order, for help texts
+
+  std::uint8_t id(Dialect d) const { return d == Dialect::readme ? readme_id : comspecs_id; }
+  bool in(Dialect d) const { return id(d) != 0; }
 };
 
-/// Every known command, in the order of the seed's table.
-extern const std::array<CommandSpec, 15> kCommandSpecs;
+/// Every known command, in the order of Command's alternatives.
+extern const std::array<CommandSpec, 16> kCommandSpecs;
 
-const CommandSpec* find_spec(std::uint8_t id);
+/// The command with wire id `id` in `dialect`, or null.
+const CommandSpec* find_spec(std::uint8_t id, Dialect dialect = Dialect::readme);
 const CommandSpec* find_spec(std::string_view name);
 const CommandSpec& spec_of(const Command& c);
 

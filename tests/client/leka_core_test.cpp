@@ -95,6 +95,34 @@ TEST(LekaFrames, OneBeltLedIsTheSeedFrame) {
             (Bytes{0x2A, 0x2B, 0x2C, 0x2D, 0x05, 0x15, 0x00, 0xFF, 0x00, 0x00, 0x41}));
 }
 
+// Profile comspecs-v3: the spec's YAML ids and the 8-bit checksum over
+// length and group; the vector is MMyster/Leka-Command-Generator's demo.
+TEST(LekaFrames, ComspecsProfileSendsTheYamlIdsAndTheirChecksum) {
+  ClientConfig config;
+  config.dialect = proto::Dialect::comspecs_v3;
+  LekaClientCore core(config);
+  core.on_connected(at_ms(0));
+  ASSERT_TRUE(core.send(at_ms(0), GroupBuilder{}.belt_single(0x12, {100, 150, 200})).ok());
+  core.info(at_ms(0));
+  std::vector<SendFrame> actions = core.take_actions();
+  for (int ms = 1; ms <= 20 && actions.size() < 2; ++ms) {
+    core.on_timer(at_ms(ms));
+    for (auto& a : core.take_actions())
+      actions.push_back(std::move(a));
+  }
+  ASSERT_EQ(actions.size(), 2u);
+  EXPECT_EQ(protocol::to_hex(actions[0].bytes), "2A 2B 2C 2D 05 16 12 64 96 C8 77");
+  EXPECT_EQ(protocol::to_hex(actions[1].bytes), "2A 2B 2C 2D 01 70 F0");
+  // The ear range exists only there; the README's profile refuses it.
+  EXPECT_TRUE(core.send(at_ms(30), GroupBuilder{}.ear_range(0, 1, {255, 0, 0})).ok());
+  LekaClientCore readme;
+  readme.on_connected(at_ms(0));
+  const BuildResult refused = readme.send(at_ms(0), GroupBuilder{}.ear_range(0, 1, {255, 0, 0}));
+  EXPECT_EQ(refused.error, BuildError::not_in_profile);
+  EXPECT_EQ(refused.field, "led.ear.range");
+  EXPECT_TRUE(readme.take_actions().empty());
+}
+
 TEST(LekaFrames, ALargeGroupIsSplitAtCommandBoundaries) {
   // 58 group bytes per frame: 11 five-byte commands, then the rest.
   GroupBuilder b = burst();

@@ -754,6 +754,10 @@ struct Expected {
                    [&](const leka::EarAll& c) {
                      ears = {c.color, c.color};
                    },
+                   [&](const leka::EarRange& c) {
+                     for (std::size_t i = c.first; i <= c.last; ++i)
+                       ears.at(i) = c.color;
+                   },
                    [&](const leka::EarSingle& c) { ears.at(c.led) = c.color; },
                    [&](const leka::BeltAll& c) { belt.fill(c.color); },
                    [&](const leka::BeltRange& c) {

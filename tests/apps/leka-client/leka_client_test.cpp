@@ -136,6 +136,43 @@ TEST(LekaClientBatch, ScriptFromStdinAndAnInterruptSendsStopRobot) {
   EXPECT_EQ(mock.car.stop(), 0);
 }
 
+// Both ends in profile comspecs-v3: the client sends the spec's YAML ids
+// with the 8-bit checksum, the mock runs them and answers info; the wire
+// log records the profile. The README's client against that mock gets no
+// answer to its info.
+TEST(LekaClientBatch, TheComspecsProfileOnBothEndsTalks) {
+  TempDir dir("hil-leka-client");
+  MockLeka mock(dir, {"--profile", "comspecs-v3"});
+  ASSERT_TRUE(mock.ready) << mock.process->output();
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", mock.device, kInfoTimeout, "--profile",
+                                         "comspecs-v3", "belt single 0x12 100 150 200", "info"});
+  ASSERT_EQ(client.wait_exit(std::chrono::seconds(20)), 0) << client.output();
+  EXPECT_NE(client.output().find("arg:2: ok, 1 command, 1 frame, 7 bytes sent; info name=leka"),
+            std::string::npos)
+      << client.output();
+  const auto received = delivered_to_car_of(mock.wire_log);
+  EXPECT_TRUE(any_contains(received, "2A 2B 2C 2D 05 16 12 64 96 C8 77"))
+      << read_file(mock.wire_log);
+  EXPECT_TRUE(any_contains(received, "led.belt.single led=18 rgb=(100,150,200)"));
+  EXPECT_TRUE(any_contains(received, "2A 2B 2C 2D 01 70 F0"));
+  EXPECT_NE(read_file(mock.wire_log).find("\"profile\":\"comspecs-v3\""), std::string::npos)
+      << read_file(mock.wire_log);
+
+  HilProcess readme(LEKA_CLIENT_BINARY, {"--port", mock.device, "--info-timeout-ms=500", "info"});
+  EXPECT_EQ(readme.wait_exit(std::chrono::seconds(20)), 1) << readme.output();
+  EXPECT_EQ(mock.car.stop(), 0);
+}
+
+TEST(LekaClientBatch, AnUnknownProfileIsAUsageErrorListingTheValidOnes) {
+  HilProcess client(LEKA_CLIENT_BINARY, {"--dry-run", "--profile", "yaml", "info"});
+  EXPECT_EQ(client.wait_exit(), 2);
+  EXPECT_NE(
+      client.output().find(
+          "leka has no profile 'yaml'; its profiles are readme (the default) and comspecs-v3"),
+      std::string::npos)
+      << client.output();
+}
+
 TEST(LekaClientBatch, DryRunPrintsTheSeedsExampleFramesByteForByte) {
   HilProcess client(LEKA_CLIENT_BINARY, {"--dry-run", "--frame-bytes", "128", "--script",
                                          "scenarios/clients/leka-client/seed-examples.leka"});

@@ -107,7 +107,8 @@ TEST(LekaVectors, EveryCommandHasItsTableIdAndSize) {
       {Motivator{0x53}, "50 53"},
       {Guidance{0x4F}, "40 4F"},
   };
-  EXPECT_EQ(std::size(cases), kCommandSpecs.size());
+  // Every command of the README's table (led.ear.range is not one).
+  EXPECT_EQ(std::size(cases), kCommandSpecs.size() - 1);
   for (const auto& c : cases) {
     const Bytes group = group_bytes(CommandGroup{{c.command}});
     EXPECT_EQ(to_hex(group), to_hex(hex(c.bytes))) << describe(c.command);
