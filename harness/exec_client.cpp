@@ -439,8 +439,8 @@ class ExecSession final : public ReferenceSession {
 }  // namespace
 
 const std::vector<std::string>& placeholder_names() {
-  static const std::vector<std::string> kNames = {"host", "port",    "endpoint",
-                                                  "pty",  "actions", "scenario"};
+  static const std::vector<std::string> kNames = {"host",    "port",     "endpoint", "pty",
+                                                  "actions", "scenario", "profile"};
   return kNames;
 }
 

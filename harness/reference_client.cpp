@@ -1,5 +1,7 @@
 #include "harness/reference_client.hpp"
 
+#include "protocol/common/car_profile.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <map>
@@ -683,11 +685,10 @@ std::optional<std::string> reference_setting_problem(mocks::CarKind car, const s
   return "unknown car";
 }
 
-std::unique_ptr<ReferenceSession> make_reference_session(mocks::CarKind car,
-                                                         link::TransportContext& context,
-                                                         link::Endpoint endpoint,
-                                                         RunTimeline& timeline,
-                                                         const nlohmann::json& settings) {
+std::unique_ptr<ReferenceSession> make_reference_session(
+    mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
+    RunTimeline& timeline, const nlohmann::json& settings, std::string_view profile) {
+  const protocol::CarProfile& named = protocol::find_car_profile(mocks::to_string(car), profile);
   switch (car) {
     case mocks::CarKind::logi:
       return std::make_unique<LogiReference>(context, std::move(endpoint), timeline,
@@ -695,12 +696,16 @@ std::unique_ptr<ReferenceSession> make_reference_session(mocks::CarKind car,
     case mocks::CarKind::wr8:
       return std::make_unique<Wr8Reference>(context, std::move(endpoint), timeline,
                                             configured(wr8_options(), settings));
-    case mocks::CarKind::arduino:
-      return std::make_unique<ArduinoReference>(context, std::move(endpoint), timeline,
-                                                configured(arduino_options(), settings));
-    case mocks::CarKind::leka:
-      return std::make_unique<LekaReference>(context, std::move(endpoint), timeline,
-                                             configured(leka_options(), settings));
+    case mocks::CarKind::arduino: {
+      auto config = configured(arduino_options(), settings);
+      config.dialect = protocol::arduino::dialect_named(named.name);
+      return std::make_unique<ArduinoReference>(context, std::move(endpoint), timeline, config);
+    }
+    case mocks::CarKind::leka: {
+      auto config = configured(leka_options(), settings);
+      config.dialect = protocol::leka::dialect_named(named.name);
+      return std::make_unique<LekaReference>(context, std::move(endpoint), timeline, config);
+    }
   }
   return nullptr;
 }

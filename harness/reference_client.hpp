@@ -72,11 +72,13 @@ std::optional<std::string> reference_setting_problem(mocks::CarKind car, const s
 /// The car's reference client on `endpoint`, writing client records to
 /// `timeline`, its library's defaults changed by `settings` (names to values
 /// that reference_setting_problem() accepts; a bad one is a programmer
-/// error and throws std::invalid_argument). `context` and `timeline` must
-/// outlive it.
+/// error and throws std::invalid_argument), speaking the car's profile
+/// `profile` (empty: the default; an unknown one throws
+/// protocol::ProfileError). `context` and `timeline` must outlive it.
 std::unique_ptr<ReferenceSession> make_reference_session(
     mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
-    RunTimeline& timeline, const nlohmann::json& settings = nlohmann::json::object());
+    RunTimeline& timeline, const nlohmann::json& settings = nlohmann::json::object(),
+    std::string_view profile = {});
 
 /// Why `text` is not an operator action of the car's vocabulary, or nullopt
 /// when it is one ("1:7: unknown direction 'UP'").

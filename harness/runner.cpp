@@ -1,5 +1,7 @@
 #include "harness/runner.hpp"
 
+#include "protocol/common/car_profile.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -270,6 +272,7 @@ bool ReferenceRun::build() {
   car.seed = mocks::car_seed(seed_, 0);
   car.name = "car0";
   try {
+    mocks::apply_profile(car.configs, scenario_.car, scenario_.profile);
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));
     car_ = std::make_unique<mocks::MockCar>(std::move(car));
   } catch (const std::exception& e) {
@@ -329,12 +332,15 @@ bool ReferenceRun::make_client(const link::Endpoint& endpoint) {
     client_ = make_reference_session(scenario_.car, context_, endpoint, timeline_,
                                      std::holds_alternative<ReferenceClient>(scenario_.client)
                                          ? std::get<ReferenceClient>(scenario_.client).settings
-                                         : nlohmann::json::object());
+                                         : nlohmann::json::object(),
+                                     scenario_.profile);
     return true;
   }
   external_ = true;
   Placeholders values;
   values["endpoint"] = link::to_uri(endpoint);
+  values["profile"] = std::string(
+      protocol::find_car_profile(mocks::to_string(scenario_.car), scenario_.profile).name);
   if (const auto* tcp = std::get_if<link::TcpEndpoint>(&endpoint)) {
     values["host"] = tcp->host;
     values["port"] = std::to_string(tcp->port);

@@ -191,6 +191,9 @@ struct Scenario {
   std::string description;
   std::vector<std::string> tags;
   mocks::CarKind car = mocks::CarKind::logi;
+  /// The car's profile (protocol/common/car_profile.hpp), mock and
+  /// reference client alike; empty: the car's default.
+  std::string profile;
   std::string world;                  ///< a world file; empty: the built-in arena for the car
   std::optional<std::uint64_t> seed;  ///< none: chosen per run and printed
   std::map<std::string, std::string> variables;  ///< ${name} in texts, already substituted

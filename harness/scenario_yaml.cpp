@@ -1,5 +1,7 @@
 #include "harness/scenario_yaml.hpp"
 
+#include "protocol/common/car_profile.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -159,9 +161,9 @@ std::string format_duration(Duration d) {
   return std::to_string(ns) + "ns";
 }
 
-const Keys kTopKeys = {"name",    "description", "tags",      "car",    "world",  "seed",
-                       "timeout", "settle",      "variables", "faults", "client", "setup",
-                       "steps",   "teardown",    "schedule",  "expect"};
+const Keys kTopKeys = {"name",  "description", "tags",     "car",       "profile", "world",
+                       "seed",  "timeout",     "settle",   "variables", "faults",  "client",
+                       "setup", "steps",       "teardown", "schedule",  "expect"};
 const Keys kStepKeys = {"do", "wait", "wait_until", "car", "faults", "obstacle"};
 const Keys kMatcherSources = {"wire", "client", "sim", "step", "fault", "car"};
 const Keys kWireDirections = {"received", "sent_by_client", "sent_by_car", "received_by_client"};
@@ -246,6 +248,13 @@ class Loader {
                     suggestion(car_text, cars));
     }
     scenario_.car = *kind;
+    if (auto n = root["profile"]) {
+      scenario_.profile = scalar(n, "'profile'");
+      if (const auto problem = protocol::car_profile_problem(car_text, scenario_.profile);
+          !problem.empty()) {
+        fail(n, "'profile': " + problem);
+      }
+    }
     if (auto n = root["world"]) {
       scenario_.world = existing_file(n, "world file");
     }

@@ -6,7 +6,10 @@
 #include <variant>
 
 #include "protocol/arduino/codec.hpp"
+#include "protocol/arduino/sketch.hpp"
+#include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
+#include "protocol/common/text.hpp"
 #include "protocol/leka/codec.hpp"
 #include "protocol/logi/codec.hpp"
 #include "protocol/wr8/codec.hpp"
@@ -105,6 +108,7 @@ class RawSplitter final : public FrameSplitter {
 class RawAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "raw"; }
+  std::string_view profile() const override { return {}; }
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     return std::make_unique<RawSplitter>(with_text);
   }
@@ -123,7 +127,12 @@ class RawAdapter final : public ProtocolAdapter {
 
 class LogiAdapter final : public ProtocolAdapter {
  public:
+  explicit LogiAdapter(protocol::logi::Dialect dialect = protocol::logi::Dialect::guide)
+      : dialect_(dialect) {}
   std::string_view name() const override { return "logi"; }
+  /// Both profiles frame the stream alike; they differ in what the car
+  /// does with each delivery (mocks/logi.hpp).
+  std::string_view profile() const override { return protocol::logi::to_string(dialect_); }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace logi = protocol::logi;
@@ -166,14 +175,86 @@ class LogiAdapter final : public ProtocolAdapter {
     if (!std::equal(header.begin(), header.end(), f.begin())) return false;
     return f.back() == protocol::logi::kTail && f[f.size() - 4] == ':';
   }
+
+  protocol::logi::Dialect dialect_;
 };
 
 // ---------------------------------------------------------------- Arduino
 // ^SEQ|CMD|PAYLOAD*CS$
 
+// Profile `firmware` towards the board: frames are cut by '^' .. '$' as the
+// README decoder cuts them (so every byte is still forwarded once), then
+// judged as the real sketch judges them: a frame it acts on is valid (the
+// one-space payload of argument-less requests included), one it refuses
+// with a NACK or drops is not (docs/protocols/arduino.md, "Profiles").
+class SketchJudgedSplitter final : public FrameSplitter {
+ public:
+  SketchJudgedSplitter(std::unique_ptr<FrameSplitter> inner, bool with_text)
+      : inner_(std::move(inner)), with_text_(with_text) {}
+
+  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
+    const std::size_t first = out.size();
+    inner_->feed(bytes, out);
+    judge(out, first);
+  }
+  void finish(std::vector<WireFrame>& out) override {
+    const std::size_t first = out.size();
+    inner_->finish(out);
+    judge(out, first);
+  }
+  std::size_t buffered() const override { return inner_->buffered(); }
+
+ private:
+  void judge(std::vector<WireFrame>& out, std::size_t first) const {
+    namespace arduino = protocol::arduino;
+    for (std::size_t i = first; i < out.size(); ++i) {
+      WireFrame& f = out[i];
+      if (f.raw.empty() || f.raw.front() != '^' || f.raw.back() != '$') continue;
+      if (f.raw.size() > arduino::kSketchFrameBytes) {
+        f.valid = false;
+        f.text = "dropped by the firmware: " + std::to_string(f.raw.size()) + " bytes pass its " +
+                 std::to_string(arduino::kSketchFrameBytes) + "-byte buffer";
+        continue;
+      }
+      const std::string_view text(reinterpret_cast<const char*>(f.raw.data()), f.raw.size());
+      std::visit(protocol::Overloaded{[&](const arduino::SketchRequest& r) {
+                                        if (!f.valid && with_text_) {
+                                          f.text =
+                                              "request " + r.seq + "|" + r.cmd + "|" + r.payload;
+                                        }
+                                        f.valid = true;
+                                        f.kind = protocol::ascii_upper(r.cmd);
+                                      },
+                                      [&](const arduino::SketchRefusal& r) {
+                                        f.valid = false;
+                                        f.text = "refused by the firmware: NACK " +
+                                                 std::string(arduino::to_string(r.code));
+                                      },
+                                      [&](const arduino::SketchDrop& d) {
+                                        f.valid = false;
+                                        f.text = "dropped by the firmware: " + d.reason;
+                                      }},
+                 arduino::judge_sketch_frame(text));
+    }
+  }
+
+  std::unique_ptr<FrameSplitter> inner_;
+  bool with_text_;
+};
+
 class ArduinoAdapter final : public ProtocolAdapter {
  public:
+  explicit ArduinoAdapter(protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme)
+      : dialect_(dialect) {}
   std::string_view name() const override { return "arduino"; }
+  std::string_view profile() const override { return protocol::arduino::to_string(dialect_); }
+
+  std::unique_ptr<FrameSplitter> splitter_for(Direction direction, bool with_text) const override {
+    if (direction == Direction::to_car && dialect_ == protocol::arduino::Dialect::firmware) {
+      return std::make_unique<SketchJudgedSplitter>(splitter(with_text), with_text);
+    }
+    return splitter(with_text);
+  }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace arduino = protocol::arduino;
@@ -214,6 +295,9 @@ class ArduinoAdapter final : public ProtocolAdapter {
   }
 
  private:
+  protocol::arduino::Dialect dialect_;
+
+ private:
   static bool framed(ByteView f) {
     namespace arduino = protocol::arduino;
     return f.size() >= 5 && f.front() == arduino::kStart && f.back() == arduino::kEnd &&
@@ -230,6 +314,7 @@ class Wr8Adapter final : public ProtocolAdapter {
       : profile_(std::make_shared<const protocol::wr8::Profile>(std::move(profile))) {}
 
   std::string_view name() const override { return "wr8"; }
+  std::string_view profile() const override { return protocol::default_car_profile("wr8").name; }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace wr8 = protocol::wr8;
@@ -317,7 +402,10 @@ class LineSplitter final : public FrameSplitter {
 
 class LekaAdapter final : public ProtocolAdapter {
  public:
+  explicit LekaAdapter(protocol::leka::Dialect dialect = protocol::leka::Dialect::readme)
+      : dialect_(dialect) {}
   std::string_view name() const override { return "leka"; }
+  std::string_view profile() const override { return protocol::leka::to_string(dialect_); }
 
   std::unique_ptr<FrameSplitter> splitter_for(Direction direction, bool with_text) const override {
     if (direction == Direction::to_client) return std::make_unique<LineSplitter>(with_text);
@@ -326,8 +414,10 @@ class LekaAdapter final : public ProtocolAdapter {
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace leka = protocol::leka;
+    leka::DecoderOptions options;
+    options.dialect = dialect_;
     return make_splitter<leka::Message>(
-        leka::Decoder{},
+        leka::Decoder{options},
         [](const leka::Message& m, bool text) {
           std::string kind = m.commands.empty()
                                  ? std::string{}
@@ -366,6 +456,8 @@ class LekaAdapter final : public ProtocolAdapter {
     }
     return f[leka::kStartSequence.size()] == f.size() - leka::kOverheadBytes;
   }
+
+  protocol::leka::Dialect dialect_;
 };
 
 }  // namespace
@@ -382,6 +474,22 @@ std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name) {
   if (name == "raw") return std::make_shared<RawAdapter>();
   throw std::invalid_argument("unknown protocol '" + std::string(name) +
                               "' (known: logi, wr8, arduino, leka, raw)");
+}
+
+std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name,
+                                                        std::string_view profile) {
+  if (profile.empty()) return protocol_adapter(name);
+  if (name == "raw") {
+    throw protocol::ProfileError("protocol raw has no profiles; '" + std::string(profile) +
+                                 "' names one");
+  }
+  const protocol::CarProfile& p = protocol::find_car_profile(name, profile);
+  if (name == "arduino") {
+    return std::make_shared<ArduinoAdapter>(protocol::arduino::dialect_named(p.name));
+  }
+  if (name == "leka") return std::make_shared<LekaAdapter>(protocol::leka::dialect_named(p.name));
+  if (name == "logi") return std::make_shared<LogiAdapter>(protocol::logi::dialect_named(p.name));
+  return protocol_adapter(name);  // WR8: one profile
 }
 
 }  // namespace hil::link

@@ -47,6 +47,9 @@ class ProtocolAdapter {
   virtual ~ProtocolAdapter() = default;
   /// "logi", "wr8", "arduino", "leka" or "raw".
   virtual std::string_view name() const = 0;
+  /// The car's profile the adapter frames by ("firmware", "comspecs-v3",
+  /// ...; protocol/common/car_profile.hpp); empty for raw.
+  virtual std::string_view profile() const = 0;
   /// `with_text` false leaves WireFrame::text empty for valid frames: the
   /// fault injector needs kinds, not descriptions, and skipping them is most
   /// of the cost of splitting a fast stream.
@@ -70,6 +73,14 @@ class ProtocolAdapter {
 /// The adapter for a protocol name; throws std::invalid_argument naming the
 /// known protocols for an unknown one.
 std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name);
+
+/// The adapter for a car's profile (protocol/common/car_profile.hpp); an
+/// empty profile is the car's default. Arduino `firmware` judges the frames
+/// towards the board as the real sketch does; Leka `comspecs-v3` decodes by
+/// the spec's YAML ids and checksum. Throws protocol::ProfileError for a
+/// profile the car does not have (or any profile for "raw").
+std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name,
+                                                        std::string_view profile);
 
 /// The WR8 adapter for a firmware whose byte order, block sizes or DATA
 /// table differ from the default profile (protocol_adapter("wr8") uses the

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "link/protocol_adapter.hpp"
 #include "mocks/firmware.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/message.hpp"
@@ -93,6 +94,10 @@ class ArduinoFirmware final : public Firmware {
   ArduinoFirmware(sim::World& world, sim::Vehicle& vehicle, ArduinoConfig config = {});
 
   std::string_view protocol() const override { return "arduino"; }
+  /// Frames the link by this robot's profile (its dialect).
+  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
+    return link::protocol_adapter("arduino", hil::protocol::arduino::to_string(config_.dialect));
+  }
   std::string summary() const override;
 
   const ArduinoState& state() const { return state_; }

@@ -1,5 +1,7 @@
 #include "mocks/car.hpp"
 
+#include "protocol/common/car_profile.hpp"
+
 #include <stdexcept>
 
 #include "sim/presets.hpp"
@@ -40,6 +42,23 @@ sim::VehicleDef vehicle_preset(CarKind kind) {
       return sim::leka_robot();
   }
   throw std::invalid_argument("unknown car kind");
+}
+
+void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view profile) {
+  const protocol::CarProfile& p = protocol::find_car_profile(to_string(kind), profile);
+  switch (kind) {
+    case CarKind::arduino:
+      configs.arduino.dialect = protocol::arduino::dialect_named(p.name);
+      break;
+    case CarKind::leka:
+      configs.leka.dialect = protocol::leka::dialect_named(p.name);
+      break;
+    case CarKind::logi:
+      configs.logi.dialect = protocol::logi::dialect_named(p.name);
+      break;
+    case CarKind::wr8:
+      break;  // one profile
+  }
 }
 
 std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,

@@ -37,6 +37,11 @@ struct FirmwareConfigs {
   LekaConfig leka;
 };
 
+/// Sets the car's firmware config to play profile `profile` of `kind`
+/// (protocol/common/car_profile.hpp; empty: the default). Throws
+/// protocol::ProfileError, with the valid names, for another name.
+void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view profile);
+
 /// The firmware of `kind` for a vehicle already in `world` (a scenario's
 /// shared world, or a MockCar's own).
 std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,

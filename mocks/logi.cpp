@@ -169,8 +169,17 @@ void LogiFirmware::on_disconnect(Time) {
 // ---------------------------------------------------------------- input
 
 void LogiFirmware::on_bytes(Time now, ByteView bytes) {
+  if (bytes.empty()) return;
   items_.clear();
-  decoder_.feed(bytes, items_);
+  if (config_.dialect == logi::Dialect::firmware) {
+    // The STM32 takes what the Wi-Fi module hands it in one piece as one
+    // message: here, one delivery from the link.
+    items_.push_back(logi::decode_handover(
+        bytes,
+        logi::DecoderOptions{logi::kDefaultMaxFrameBytes, config_.accept_lowercase_checksum}));
+  } else {
+    decoder_.feed(bytes, items_);
+  }
   for (const auto& item : items_) {
     if (const auto* frame = std::get_if<protocol::Frame<Message>>(&item)) {
       handle_frame(now, *frame);

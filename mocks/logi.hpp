@@ -19,6 +19,10 @@ namespace hil::mocks {
 /// How the mock LOGI firmware behaves where real firmwares could differ.
 /// The defaults work on the built-in warehouse with sim::logi_car().
 struct LogiConfig {
+  /// How the car reads its input: the guide's stream rule (guide, the
+  /// default), or the STM32 parser, one hand-over (one delivery from the
+  /// link) at a time (firmware); docs/protocols/logi.md, "Profiles".
+  protocol::logi::Dialect dialect = protocol::logi::Dialect::guide;
   /// Stations GS accepts (the tags read "001", "002", ...); each 0..999.
   std::vector<int> stations = {1, 2};
   /// The SP setting after power-on, 0..100.
@@ -100,6 +104,10 @@ class LogiFirmware final : public Firmware {
   LogiFirmware(sim::World& world, sim::Vehicle& vehicle, LogiConfig config = {});
 
   std::string_view protocol() const override { return "logi"; }
+  /// Frames the link by this car's profile.
+  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
+    return link::protocol_adapter("logi", hil::protocol::logi::to_string(config_.dialect));
+  }
   std::string summary() const override;
 
   const LogiState& state() const { return state_; }

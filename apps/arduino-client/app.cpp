@@ -132,11 +132,9 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
   add_log_and_script_options(app, o.log_path,
                              "Write the frame log here at exit: .txt, .csv, .json or .ndjson",
                              o.script, "Run the commands of this file, one per line");
-  app.add_option("--profile", o.profile,
-                 "The board's dialect: firmware (the real sketch) or readme (the README's "
-                 "examples); the default is hil mock arduino's")
-      ->check(
-          [](const std::string& name) { return protocol::car_profile_problem("arduino", name); });
+  add_profile_option(app, o.profile, "arduino",
+                     "The board's dialect: firmware (the real sketch) or readme (the README's "
+                     "examples); the default is hil mock arduino's");
   app.add_flag("--keep-going", o.keep_going,
                "Tokens and scripts: run every command even after one failed (exit 1 at the end)");
   app.add_option("tokens", o.tokens,

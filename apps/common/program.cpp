@@ -1,5 +1,7 @@
 #include "apps/common/program.hpp"
 
+#include "protocol/common/car_profile.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <csignal>
@@ -30,6 +32,13 @@ void add_log_and_script_options(CLI::App& app, std::string& log_path, const std:
                                 std::string& script, const std::string& script_help) {
   app.add_option("--log", log_path, log_help);
   app.add_option("--script", script, script_help);
+}
+
+CLI::Option* add_profile_option(CLI::App& app, std::string& profile, const std::string& car,
+                                const std::string& help) {
+  return app.add_option("--profile", profile, help)->check([car](const std::string& name) {
+    return protocol::car_profile_problem(car, name);
+  });
 }
 
 link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {

@@ -38,6 +38,12 @@ CLI::Option* add_serial_options(CLI::App& app, std::string& port, unsigned& baud
 void add_log_and_script_options(CLI::App& app, std::string& log_path, const std::string& log_help,
                                 std::string& script, const std::string& script_help);
 
+/// --profile NAME for one car: a name the profile registry does not know
+/// for `car` is a usage error listing the valid ones
+/// (protocol/common/car_profile.hpp).
+CLI::Option* add_profile_option(CLI::App& app, std::string& profile, const std::string& car,
+                                const std::string& help);
+
 /// Parses the command line; when it ends the program (--help, --version or
 /// a usage error, already printed) the exit status: 0 or kExitUsage.
 std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv);

@@ -7,6 +7,7 @@
 #include <variant>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "apps/hil/cli_common.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/sketch.hpp"
@@ -259,10 +260,6 @@ int run_decode(const DecodeArgs& args) {
   return status;
 }
 
-std::string profile_check(const std::string& name) {
-  return protocol::car_profile_problem("arduino", name);
-}
-
 }  // namespace
 
 void register_arduino(CommandSet& commands) {
@@ -271,10 +268,9 @@ void register_arduino(CommandSet& commands) {
 
   auto* enc = commands.encode.add_subcommand(
       "arduino", "Arduino robot frame ^SEQ|CMD|PAYLOAD*CS$, e.g. --seq 2 V 160 or ACK OK");
-  enc->add_option("--profile", encode_args->profile,
-                  "readme (the default) or firmware: argument-less requests with the one-space "
-                  "payload the real sketch needs")
-      ->check(profile_check);
+  add_profile_option(*enc, encode_args->profile, "arduino",
+                     "readme (the default) or firmware: argument-less requests with the one-space "
+                     "payload the real sketch needs");
   enc->add_option("words", encode_args->words,
                   "CMD then PAYLOAD words (V 160), or one CMD:PAYLOAD token (V:160)");
   auto* seq = enc->add_option("--seq", encode_args->seq,
@@ -295,10 +291,9 @@ void register_arduino(CommandSet& commands) {
   auto* dec =
       commands.decode.add_subcommand("arduino", "Decode Arduino robot frames or a byte stream");
   add_decode_input(*dec, decode_args->input, false);
-  dec->add_option("--profile", decode_args->profile,
-                  "readme (the default: the README's rules) or firmware: what the real sketch "
-                  "does with each frame (acted on, refused with a NACK, or dropped)")
-      ->check(profile_check);
+  add_profile_option(*dec, decode_args->profile, "arduino",
+                     "readme (the default: the README's rules) or firmware: what the real sketch "
+                     "does with each frame (acted on, refused with a NACK, or dropped)");
   dec->add_flag("--firmware", decode_args->firmware,
                 "Use the firmware's 96-byte frame bound instead of the PC's 256-byte guard");
   dec->add_option("--max-frame-bytes", decode_args->max_frame_bytes,

@@ -408,10 +408,7 @@ int run_mock(const MockArgs& args) {
     return 1;
   }
   try {
-    const protocol::CarProfile& profile = protocol::find_car_profile(args.car, args.profile);
-    if (*kind == mocks::CarKind::arduino) {
-      base.configs.arduino.dialect = protocol::arduino::dialect_named(profile.name);
-    }
+    mocks::apply_profile(base.configs, *kind, args.profile);
   } catch (const protocol::ProfileError& e) {
     std::cerr << "hil mock: --profile: " << e.what() << '\n';
     return 2;

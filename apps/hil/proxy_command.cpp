@@ -11,6 +11,7 @@
 #include "link/asio_executor.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "link/proxy.hpp"
+#include "protocol/common/car_profile.hpp"
 
 namespace hil::apps {
 
@@ -19,6 +20,7 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
     std::string protocol = "raw";
     std::string listen;
     std::string upstream;
+    std::string profile;
     std::string faults;
     std::string wire_log;
     std::string pcap;
@@ -31,6 +33,9 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--protocol", args->protocol,
                   "Frame-aware faults and decoded logs for: logi, wr8, arduino, leka, raw")
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka", "raw"}));
+  cmd->add_option("--profile", args->profile,
+                  "The car's profile the frames are judged by (hil profiles CAR lists them; "
+                  "default: the car's default), e.g. arduino --profile firmware");
   cmd->add_option("--listen", args->listen,
                   "Where the client connects: tcp://127.0.0.1:PORT or pty:///PATH[?baud=9600]")
       ->required();
@@ -64,7 +69,12 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
         std::cerr << "hil proxy: " << e.what() << '\n';
         return 1;
       }
-      options.protocol = link::protocol_adapter(args->protocol);
+      try {
+        options.protocol = link::protocol_adapter(args->protocol, args->profile);
+      } catch (const protocol::ProfileError& e) {
+        std::cerr << "hil proxy: --profile: " << e.what() << '\n';
+        return 2;
+      }
       options.seed = args->seed ? *args->seed : std::random_device{}();
       options.wire_log_path = args->wire_log;
       options.pcap_path = args->pcap;
@@ -90,8 +100,11 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
         std::cerr << "warning: listening on " << tcp->host << ", reachable from other machines\n";
       }
       std::cout << "hil proxy: clients connect to " << proxy.address() << ", car at "
-                << link::to_uri(options.upstream) << ", protocol " << args->protocol << ", "
-                << options.faults.rules.size() << " fault rule(s), seed " << options.seed
+                << link::to_uri(options.upstream) << ", protocol " << args->protocol
+                << (options.protocol->profile().empty()
+                        ? std::string()
+                        : " (profile " + std::string(options.protocol->profile()) + ")")
+                << ", " << options.faults.rules.size() << " fault rule(s), seed " << options.seed
                 << " (replay with --seed " << options.seed << ")" << std::endl;
       signals.async_wait([&](const std::error_code& ec, int) {
         if (ec) return;

@@ -129,6 +129,9 @@ void WireLog::on_open(Time at, const std::string& client, const std::string& car
   r["client"] = client;
   r["car"] = car;
   r["protocol"] = options_.protocol ? std::string(options_.protocol->name()) : std::string("raw");
+  if (options_.protocol && !options_.protocol->profile().empty()) {
+    r["profile"] = std::string(options_.protocol->profile());
+  }
   write_line(r);
 }
 

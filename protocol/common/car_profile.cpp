@@ -12,8 +12,13 @@ constexpr std::array kProfiles{
     CarProfile{"logi", "firmware",
                "car_stm32f103vet6 firmware: docs/upper_computer_ai_guide.md and the frame parser "
                "of Core/Bsp/protocol.c",
-               "the guide's frames; the checksum field is found from the last ':', as the STM32 "
-               "parser finds it",
+               "the STM32 parser: each hand-over from the Wi-Fi module is one message of 10 bytes "
+               "or more ending in '#', its checksum field after the last ':'",
+               false},
+    CarProfile{"logi", "guide",
+               "car_stm32f103vet6 docs/upper_computer_ai_guide.md, section 8 (the stream rule)",
+               "the guide's stream rule on the car's input: a frame from the first LOGI: to the "
+               "first '#', wherever the writes and reads cut the stream",
                true},
     CarProfile{"wr8", "document", "the WR8 protocol document of 2019-01-06 (smart_vehicle_gui)",
                "packets exactly as the document gives them: no length byte before a packet", true},
@@ -33,6 +38,12 @@ constexpr std::array kProfiles{
                "the README's command ids (belt single 0x15) and its worked examples' checksum: "
                "the low byte of a 16-bit BSD sum over the command group",
                true},
+    CarProfile{"leka", "comspecs-v3",
+               "leka/LKAlphaComSpecs v3.0.0 (381046f): Specs/LKAlphaComSpecs.yml and its Swift "
+               "and C++ tables; MMyster/Leka-Command-Generator's checksum",
+               "the YAML's command ids (led.ear.range 0x12, then ear single 0x13 .. belt single "
+               "0x16) and an 8-bit BSD checksum over the length byte and the group",
+               false},
 };
 
 std::string spoken_list(const std::vector<std::string_view>& names) {

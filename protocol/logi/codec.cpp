@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
@@ -327,6 +328,35 @@ Item decode_frame(ByteView raw, const DecoderOptions& options) {
   }
   return Item{Frame<Message>{std::get<Message>(std::move(parsed)), Bytes(raw.begin(), raw.end()),
                              tolerated}};
+}
+
+std::string_view to_string(Dialect dialect) {
+  return dialect == Dialect::firmware ? "firmware" : "guide";
+}
+
+Dialect dialect_named(std::string_view profile) {
+  const CarProfile& p = find_car_profile("logi", profile);
+  return p.name == "guide" ? Dialect::guide : Dialect::firmware;
+}
+
+Item decode_handover(ByteView raw, const DecoderOptions& options) {
+  const auto error = [&](ErrorKind kind, std::string detail) {
+    return Item{DecodeError{kind, Bytes(raw.begin(), raw.end()), std::move(detail), {}}};
+  };
+  if (raw.size() > options.max_frame_bytes) {
+    return error(ErrorKind::oversized, "a hand-over of " + std::to_string(raw.size()) +
+                                           " bytes, over the " +
+                                           std::to_string(options.max_frame_bytes) + "-byte bound");
+  }
+  if (raw.size() < kFirmwareMinBytes) {
+    return error(ErrorKind::bad_format, "a hand-over of " + std::to_string(raw.size()) +
+                                            " bytes; the firmware takes 10 or more");
+  }
+  if (raw.back() != kTail) {
+    return error(ErrorKind::bad_format,
+                 "the hand-over ends with " + hex_literal(raw.back()) + ", not '#'");
+  }
+  return decode_frame(raw, options);
 }
 
 Decoder::Decoder(DecoderOptions options)

@@ -273,5 +273,37 @@ TEST(HilCli, ArduinoFirmwareProfileEncodesAndJudgesAsTheRealBoard) {
                                       "(the default) and firmware"));
 }
 
+// The third-party generator's documented frame (MMyster/Leka-Command-
+// Generator) decodes in profile comspecs-v3 and is given back by encode;
+// the README profile refuses it and names the one it matches.
+TEST(HilCli, LekaComspecsProfileDecodesAndEncodesTheGeneratorsFrame) {
+  const auto decoded =
+      run_hil("decode leka --profile comspecs-v3 2A 2B 2C 2D 05 16 12 64 96 C8 77");
+  EXPECT_EQ(decoded.exit_code, 0) << decoded.output;
+  EXPECT_THAT(decoded.output, HasSubstr("led.belt.single led=18 rgb=(100,150,200)"));
+  const auto encoded =
+      run_hil("encode leka --profile comspecs-v3 led.belt.single 0x12 100 150 200");
+  EXPECT_EQ(encoded.exit_code, 0) << encoded.output;
+  EXPECT_EQ(encoded.output, "2A 2B 2C 2D 05 16 12 64 96 C8 77\n");
+  EXPECT_EQ(run_hil("encode leka led.belt.single 0x12 100 150 200").output,
+            "2A 2B 2C 2D 05 15 12 64 96 C8 2F\n");
+
+  const auto readme = run_hil("decode leka 2A 2B 2C 2D 05 16 12 64 96 C8 77");
+  EXPECT_EQ(readme.exit_code, 1) << readme.output;
+  EXPECT_THAT(readme.output, HasSubstr("does not match 0x2F"));
+  EXPECT_THAT(readme.output, HasSubstr("it matches profile comspecs-v3"));
+
+  const auto range = run_hil("encode leka led.ear.range 0 1 255 0 0");
+  EXPECT_EQ(range.exit_code, 1) << range.output;
+  EXPECT_THAT(range.output, HasSubstr("led.ear.range is not a command of profile readme"));
+  EXPECT_EQ(run_hil("encode leka --profile comspecs-v3 led.ear.range 0 1 255 0 0").output,
+            "2A 2B 2C 2D 06 12 00 01 FF 00 00 88\n");
+
+  const auto wrong = run_hil("decode leka --profile yaml 2A");
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_THAT(wrong.output, HasSubstr("leka has no profile 'yaml'; its profiles are readme (the "
+                                      "default) and comspecs-v3"));
+}
+
 }  // namespace
 }  // namespace hil::test

@@ -110,7 +110,7 @@ TEST(Placeholders, AnUnknownOneIsAnErrorWithItsColumn) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
                  "column 8: unknown placeholder '{hots}' (known: {host}, {port}, {endpoint}, "
-                 "{pty}, {actions}, {scenario})");
+                 "{pty}, {actions}, {scenario}, {profile})");
   }
 }
 

@@ -288,7 +288,7 @@ TEST(ExternalClient, AnUnknownPlaceholderIsAnErrorBeforeAnythingStarts) {
   const ScenarioOutcome o = run_scenario(s, options);
   EXPECT_EQ(o.error,
             "the client command 'client --host {hots}': column 15: unknown placeholder '{hots}' "
-            "(known: {host}, {port}, {endpoint}, {pty}, {actions}, {scenario})");
+            "(known: {host}, {port}, {endpoint}, {pty}, {actions}, {scenario}, {profile})");
   EXPECT_FALSE(o.passed());
 }
 

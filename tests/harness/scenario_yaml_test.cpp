@@ -823,7 +823,7 @@ TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
   // Unknown key, with the allowed ones and the likely one.
   EXPECT_EQ(error_of("name: t\ncar: logi\nstpes: [connect]\n"),
             "t.yaml:3:1: the scenario: unknown key 'stpes' (allowed: name, description, tags, "
-            "car, world, seed, timeout, settle, variables, faults, client, setup, steps, "
+            "car, profile, world, seed, timeout, settle, variables, faults, client, setup, steps, "
             "teardown, schedule, expect); did you mean 'steps'?");
   EXPECT_EQ(error_of("name: t\ncar: logi\n"), "t.yaml:1:1: the scenario: 'steps' is missing");
   EXPECT_EQ(error_of("name: t\ncar: tesla\nsteps: [connect]\n"),

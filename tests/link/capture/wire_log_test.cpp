@@ -48,6 +48,7 @@ TEST_F(WireLogTest, OpenRecordCarriesTimesSidesAndProtocol) {
   EXPECT_EQ(r[0]["client"], "tcp 127.0.0.1:9000 <- 127.0.0.1:53422");
   EXPECT_EQ(r[0]["car"], "mem car0");
   EXPECT_EQ(r[0]["protocol"], "logi");
+  EXPECT_EQ(r[0]["profile"], "guide");
   // A person reading the file sees which link, what and when first.
   EXPECT_EQ(file.contents().rfind(R"({"link":"car0","event":"open","t_ms":5.0,"wall_us":)", 0), 0u)
       << file.contents();

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "protocol/arduino/codec.hpp"
+#include "protocol/common/car_profile.hpp"
 #include "protocol/leka/codec.hpp"
 #include "protocol/logi/codec.hpp"
 #include "protocol/wr8/codec.hpp"
@@ -117,6 +118,72 @@ TEST(ProtocolAdapter, LekaKindIsTheFirstCommandAndTheChecksumTheLastByte) {
   EXPECT_EQ(l->field(frame, "length"), (ByteRange{4, 5}));
   EXPECT_EQ(l->field(frame, "group"), (ByteRange{5, 10}));
   EXPECT_FALSE(l->checksum_field(*protocol::parse_hex("2A 2B 2C 2D 09 15 00 FF 00 00 41")));
+}
+
+// Profiles (protocol/common/car_profile.hpp): the adapter frames and judges
+// by the car's profile, and says which one it is.
+TEST(ProtocolAdapter, EachAdapterNamesItsProfile) {
+  EXPECT_EQ(protocol_adapter("logi")->profile(), "guide");
+  EXPECT_EQ(protocol_adapter("logi", "firmware")->profile(), "firmware");
+  EXPECT_EQ(protocol_adapter("wr8")->profile(), "document");
+  EXPECT_EQ(protocol_adapter("arduino")->profile(), "readme");
+  EXPECT_EQ(protocol_adapter("leka")->profile(), "readme");
+  EXPECT_EQ(protocol_adapter("raw")->profile(), "");
+  EXPECT_EQ(protocol_adapter("arduino", "firmware")->profile(), "firmware");
+  EXPECT_EQ(protocol_adapter("leka", "comspecs-v3")->profile(), "comspecs-v3");
+  EXPECT_EQ(protocol_adapter("leka", "")->profile(), "readme");
+  try {
+    protocol_adapter("leka", "yaml");
+    FAIL() << "no exception";
+  } catch (const protocol::ProfileError& e) {
+    EXPECT_STREQ(
+        e.what(),
+        "leka has no profile 'yaml'; its profiles are readme (the default) and comspecs-v3");
+  }
+  EXPECT_THROW(protocol_adapter("raw", "firmware"), protocol::ProfileError);
+}
+
+TEST(ProtocolAdapter, LekaComspecsProfileFramesTheGeneratorsDemo) {
+  const Bytes demo = *protocol::parse_hex("2A 2B 2C 2D 05 16 12 64 96 C8 77");
+  std::vector<WireFrame> frames;
+  protocol_adapter("leka", "comspecs-v3")->splitter()->feed(demo, frames);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_TRUE(frames[0].valid) << frames[0].text;
+  EXPECT_EQ(frames[0].kind, "led.belt.single");
+  EXPECT_EQ(frames[0].text, "led.belt.single led=18 rgb=(100,150,200)");
+  const auto readme = decode("leka", demo);
+  ASSERT_EQ(readme.size(), 1U);
+  EXPECT_FALSE(readme[0].valid);
+}
+
+// Towards the board, profile firmware judges each frame as the real sketch
+// (arduino.ino at 8dcfab0) does; every byte is still in exactly one frame.
+TEST(ProtocolAdapter, ArduinoFirmwareProfileJudgesFramesAsTheSketch) {
+  const auto adapter = protocol_adapter("arduino", "firmware");
+  const Bytes stream = to_bytes("^01|PING| *31$^01|PING|*11$xx^05|B| *67$");
+  std::vector<WireFrame> frames;
+  const auto splitter = adapter->splitter_for(Direction::to_car);
+  splitter->feed(stream, frames);
+  splitter->finish(frames);
+  Bytes joined;
+  for (const auto& f : frames)
+    joined.insert(joined.end(), f.raw.begin(), f.raw.end());
+  EXPECT_EQ(joined, stream);
+  ASSERT_EQ(frames.size(), 4U);
+  // The real client's PING: one space of payload, taken.
+  EXPECT_TRUE(frames[0].valid) << frames[0].text;
+  EXPECT_EQ(frames[0].kind, "PING");
+  // The README's PING: an empty payload, refused with BAD_FMT.
+  EXPECT_FALSE(frames[1].valid);
+  EXPECT_EQ(frames[1].text, "refused by the firmware: NACK BAD_FMT");
+  EXPECT_FALSE(frames[2].valid);  // garbage
+  EXPECT_TRUE(frames[3].valid) << frames[3].text;
+  EXPECT_EQ(frames[3].kind, "B");
+  // The readme profile judges the same two PINGs the other way round.
+  const auto readme = decode("arduino", to_bytes("^01|PING| *31$^01|PING|*11$"));
+  ASSERT_EQ(readme.size(), 2U);
+  EXPECT_FALSE(readme[0].valid);
+  EXPECT_TRUE(readme[1].valid);
 }
 
 TEST(ProtocolAdapter, InvalidBytesBecomeInvalidFramesWithTheDecoderError) {

@@ -47,7 +47,8 @@ TEST(CarProfiles, AWrongNameIsRefusedWithTheValidOnes) {
   EXPECT_EQ(car_profile_problem("arduino", "firmware"), "");
   EXPECT_EQ(car_profile_problem("arduino", ""), "");
   EXPECT_EQ(car_profile_problem("leka", "firmware"),
-            "leka has no profile 'firmware'; its profiles are readme (the default)");
+            "leka has no profile 'firmware'; its profiles are readme (the default) and "
+            "comspecs-v3");
   try {
     find_car_profile("tank", "firmware");
     FAIL() << "no error";
@@ -55,7 +56,7 @@ TEST(CarProfiles, AWrongNameIsRefusedWithTheValidOnes) {
     EXPECT_STREQ(e.what(), "unknown car 'tank'; the cars are logi, wr8, arduino and leka");
   }
   EXPECT_THROW(car_profiles_of("tank"), ProfileError);
-  EXPECT_EQ(car_profile_names("leka"), "readme (the default)");
+  EXPECT_EQ(car_profile_names("leka"), "readme (the default) and comspecs-v3");
   EXPECT_EQ(car_profile_names("arduino"), "readme (the default) and firmware");
 }
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/logi/codec.hpp"
 
 namespace hil::protocol::logi {
@@ -96,6 +97,55 @@ TEST(LogiVectors, EncodeRefusesValuesTheProtocolCannotCarry) {
   Status s;
   s.extra = {{"BAT", "7,4"}};
   EXPECT_THROW(encode(s), std::invalid_argument);
+}
+
+// The STM32 parser (car_stm32f103vet6, Core/Bsp/protocol.c) takes one
+// hand-over as one message: 10 bytes or more, '#' last, the checksum field
+// after the last ':', the sum from index 0.
+Item handover(std::string_view text) {
+  return decode_handover(ByteView(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+TEST(LogiHandover, TheGuidesFramesAreTakenWhole) {
+  for (const char* f : {"LOGI:MD:MAN:0C#", "LOGI:MD:AUTO:69#", "LOGI:SP:030:D5#", "LOGI:GS:001:CA#",
+                        "LOGI:ST:RUN:3B#", "LOGI:MV:CCW:1F#", "LOGI:MV:STOP:88#"}) {
+    EXPECT_TRUE(std::holds_alternative<Frame<Message>>(handover(f))) << f;
+  }
+  // The checksum field is found from the last ':': FB:SP:1 is one payload.
+  const auto fb = handover("LOGI:FB:SP:1:35#");
+  ASSERT_TRUE(std::holds_alternative<Frame<Message>>(fb));
+  EXPECT_EQ(std::get<Frame<Message>>(fb).message, (Message{Feedback{Command::sp, true}}));
+}
+
+TEST(LogiHandover, WhatTheFirmwareRefuses) {
+  struct Case {
+    const char* text;
+    ErrorKind kind;
+    const char* detail;
+  };
+  const Case cases[] = {
+      {"LOGI::65#", ErrorKind::bad_format, "a hand-over of 9 bytes; the firmware takes 10 or more"},
+      {"LOGI:SP:050:D7#\r\n", ErrorKind::bad_format, "the hand-over ends with 0x0A, not '#'"},
+      {"LOGI:SP:050:D7#LOGI:MD:MAN:0C#", ErrorKind::bad_checksum, "checksum 0C, computed"},
+      {"xxLOGI:SP:050:D7#", ErrorKind::bad_format, "not a LOGI:...# frame"},
+      {"LOGI:SP:050:D7", ErrorKind::bad_format, "not '#'"},
+      {"LOGI:SPxx050xD7#", ErrorKind::bad_format, "no ':' before the checksum"},
+  };
+  for (const auto& c : cases) {
+    const auto item = handover(c.text);
+    ASSERT_TRUE(std::holds_alternative<DecodeError>(item)) << c.text;
+    EXPECT_EQ(std::get<DecodeError>(item).kind, c.kind) << c.text;
+    EXPECT_NE(std::get<DecodeError>(item).detail.find(c.detail), std::string::npos)
+        << c.text << ": " << std::get<DecodeError>(item).detail;
+  }
+}
+
+TEST(LogiHandover, ProfileNamesMapToDialects) {
+  EXPECT_EQ(dialect_named(""), Dialect::guide);
+  EXPECT_EQ(dialect_named("firmware"), Dialect::firmware);
+  EXPECT_EQ(dialect_named("guide"), Dialect::guide);
+  EXPECT_EQ(to_string(Dialect::guide), "guide");
+  EXPECT_THROW(dialect_named("stream"), ProfileError);
 }
 
 }  // namespace
