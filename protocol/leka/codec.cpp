@@ -85,24 +85,27 @@ std::string checksum_detail(ByteView candidate, Dialect dialect) {
          "-byte command group" + other_profile_hint(candidate, dialect);
 }
 
-}  // namespace
-
-std::uint16_t bsd_checksum16(ByteView bytes) {
-  std::uint16_t sum = 0;
+// The BSD checksum in a sum of `Sum`'s width: per byte, rotate right by one
+// bit within that width, then add the byte (mod 2^width).
+template <class Sum>
+Sum bsd_sum(ByteView bytes) {
+  constexpr unsigned kTopBit = sizeof(Sum) * 8 - 1;
+  Sum sum = 0;
   for (const std::uint8_t b : bytes) {
-    sum = static_cast<std::uint16_t>((sum >> 1) | ((sum & 1u) << 15));
-    sum = static_cast<std::uint16_t>(sum + b);
+    sum = static_cast<Sum>((sum >> 1) | ((sum & 1u) << kTopBit));
+    sum = static_cast<Sum>(sum + b);
   }
   return sum;
 }
 
+}  // namespace
+
+std::uint16_t bsd_checksum16(ByteView bytes) {
+  return bsd_sum<std::uint16_t>(bytes);
+}
+
 std::uint8_t bsd_checksum8(ByteView bytes) {
-  std::uint8_t sum = 0;
-  for (const std::uint8_t b : bytes) {
-    sum = static_cast<std::uint8_t>((sum >> 1) | ((sum & 1u) << 7));
-    sum = static_cast<std::uint8_t>(sum + b);
-  }
-  return sum;
+  return bsd_sum<std::uint8_t>(bytes);
 }
 
 std::uint8_t checksum(ByteView group, Dialect dialect) {
