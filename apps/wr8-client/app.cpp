@@ -137,6 +137,7 @@ int run(const AppOptions& options) {
   console_options.interactive = interactive;
   console_options.prompt = interactive && ::isatty(STDIN_FILENO) != 0;
   console_options.print_data = options.data;
+  console_options.keep_going = options.keep_going;
   console_options.log_path = options.log_path;
   Wr8Console console(executor, session, runner, std::cout, console_options, [&](int code) {
     exit_code = code;

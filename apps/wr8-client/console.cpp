@@ -170,7 +170,7 @@ void Wr8Console::result(const wr8::ActionResult& r) {
 
 void Wr8Console::run_batch(std::vector<wr8::OperatorAction> actions) {
   runner_.run(
-      std::move(actions), false, [this](const wr8::ActionResult& r) { result(r); },
+      std::move(actions), options_.keep_going, [this](const wr8::ActionResult& r) { result(r); },
       [this](bool all_ok) { exit(all_ok ? kExitOk : kExitFailed); });
 }
 

@@ -27,6 +27,7 @@ struct ConsoleOptions {
   bool interactive = false;
   bool prompt = false;      ///< print "wr8> " (stdin is a terminal)
   bool print_data = false;  ///< batch: print DATA (on change, else once a second)
+  bool keep_going = false;  ///< batch: run every action after a failure (exit 1 at the end)
   std::string log_path;     ///< written at exit when not empty
 };
 

@@ -91,6 +91,16 @@ TEST_F(Wr8ClientCli, AWrongLoginStringFailsConnectWithTheReason) {
   EXPECT_FALSE(contains(r.output, "drive 10")) << r.output;  // the batch stopped
 }
 
+TEST_F(Wr8ClientCli, KeepGoingRunsTheRestOfTheBatchAfterAFailureAndStillExits1) {
+  start_mock();
+  const auto r = client({"--keep-going", "--auth", "WRONG-AUTH", "connect", "drive 10"});
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +FAIL +closed before AUTH-REPLY")))
+      << r.output;
+  // The batch went on: the drive ran (and failed, there being no session).
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("drive 10 +FAIL"))) << r.output;
+}
+
 TEST_F(Wr8ClientCli, InteractiveThroughAPipeDrivesShowsStateAndSavesTheLog) {
   start_mock();
   const auto csv = dir / "session.csv";
