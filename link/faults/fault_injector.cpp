@@ -115,6 +115,8 @@ struct FaultInjector::State {
   std::uint64_t pushes = 0;           // push() calls so far
   std::uint64_t faults_at_frame = 0;  // `faults` when the current frame began
   Time last_now{0};
+  // The last write that left the splitter holding an incomplete frame.
+  std::optional<Time> held_since;
   bool finished = false;
   bool broken = false;
 
@@ -336,6 +338,10 @@ struct FaultInjector::State {
       std::optional<Time> when;
       std::size_t which = profile.rules.size();  // == size: the batch deadline
       if (batch && batch->deadline && *batch->deadline <= now) when = batch->deadline;
+      if (const auto hold = partial_release(); hold && *hold <= now && (!when || *hold < *when)) {
+        release_partial(*hold);
+        continue;
+      }
       for (std::size_t i = 0; i < profile.rules.size(); ++i) {
         if (!rule_state[i].armed) continue;
         const Time at = *profile.rules[i].trigger.at;
@@ -526,6 +532,26 @@ struct FaultInjector::State {
     if (batch->limit != 0 && batch->frames >= batch->limit) release_batch(now, "count reached");
   }
 
+  // When the incomplete frame the splitter holds goes out as it is.
+  std::optional<Time> partial_release() const {
+    if (!held_since || finished || broken) return std::nullopt;
+    return *held_since + kPartialFrameHold;
+  }
+
+  void release_partial(Time at) {
+    held_since.reset();
+    splitter->finish(frames);
+    take_frames(at);
+  }
+
+  void note_held(Time now) {
+    if (splitter->buffered() > 0) {
+      held_since = now;
+    } else {
+      held_since.reset();
+    }
+  }
+
   void take_frames(Time now) {
     auto pending = std::move(frames);
     frames.clear();
@@ -557,6 +583,7 @@ void FaultInjector::push(Time now, protocol::ByteView bytes) {
   ++s.pushes;
   s.splitter->feed(bytes, s.frames);
   s.take_frames(now);
+  s.note_held(now);
 }
 
 void FaultInjector::finish(Time now) {
@@ -564,6 +591,7 @@ void FaultInjector::finish(Time now) {
   s.advance(now);
   if (s.broken || s.finished) return;
   ++s.pushes;
+  s.held_since.reset();
   s.splitter->finish(s.frames);
   s.take_frames(now);
   if (s.batch && !s.broken) s.release_batch(now, "sender closed");
@@ -591,6 +619,7 @@ std::optional<Time> FaultInjector::next_due() const {
     if (!next || t < *next) next = t;
   };
   if (!s.queue.empty()) consider(s.queue.front().due);
+  if (const auto hold = s.partial_release()) consider(*hold);
   if (s.batch && s.batch->deadline) consider(*s.batch->deadline);
   // Once the sender has closed, timed rules no longer keep the link alive.
   if (!s.broken && !s.finished) {

@@ -45,6 +45,13 @@ struct LinkBreak {
 };
 using InjectorOutput = std::variant<Delivery, LinkBreak>;
 
+/// How long an incomplete frame waits for the rest of its bytes after the
+/// sender's last write. Then its bytes go out as they were written: a car
+/// (or a `send` behaviour) that writes part of a frame is heard as it is,
+/// not held back until a frame that may never come. 100 ms spans the gaps
+/// between the pieces of one frame on a 9600 baud line or a Wi-Fi hop.
+inline constexpr Duration kPartialFrameHold = std::chrono::milliseconds(100);
+
 class FaultInjector {
  public:
   /// `protocol` may be the raw adapter (every write is one frame). `start`
@@ -57,7 +64,9 @@ class FaultInjector {
   FaultInjector(FaultInjector&&) noexcept;
   FaultInjector& operator=(FaultInjector&&) noexcept;
 
-  /// Bytes the sender wrote at `now`.
+  /// Bytes the sender wrote at `now`. A frame they leave incomplete is
+  /// completed by later writes, or released kPartialFrameHold after the
+  /// last one.
   void push(Time now, protocol::ByteView bytes);
   /// The sender closed: whatever is held (a partial frame) is released.
   void finish(Time now);

@@ -382,12 +382,54 @@ TEST(FaultInjector, IncompleteFramesAreHeldUntilTheyComplete) {
   const Bytes frame = sp(77);
   const auto half = static_cast<std::ptrdiff_t>(frame.size() / 2);
   injector->push(0ms, Bytes(frame.begin(), frame.begin() + half));
-  EXPECT_FALSE(injector->next_due()) << "half a frame is held, nothing to deliver";
-  injector->push(5ms, Bytes(frame.begin() + half, frame.end()));
+  EXPECT_EQ(injector->next_due(), Time{0ms} + kPartialFrameHold) << "half a frame is held";
   std::vector<InjectorOutput> out;
+  injector->poll(5ms, out);
+  EXPECT_TRUE(out.empty());
+  injector->push(5ms, Bytes(frame.begin() + half, frame.end()));
   injector->poll(5ms, out);
   ASSERT_EQ(out.size(), 1U);
   EXPECT_EQ(std::get<Delivery>(out[0]).bytes, frame);
+  EXPECT_FALSE(injector->next_due());
+}
+
+TEST(FaultInjector, APartialFrameGoesOutAsWrittenOnceItsHoldEndsAfterTheLastWrite) {
+  std::vector<FaultEvent> events;
+  auto injector = make_injector("logi", {}, events);
+  injector->push(0ms, to_bytes("LOGI:SP"));
+  injector->push(60ms, to_bytes(":0"));  // a later piece restarts the hold
+  EXPECT_EQ(injector->next_due(), Time{60ms} + kPartialFrameHold);
+  std::vector<InjectorOutput> out;
+  injector->poll(159ms, out);
+  EXPECT_TRUE(out.empty());
+  injector->poll(160ms, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_EQ(std::get<Delivery>(out[0]).bytes, to_bytes("LOGI:SP:0"));
+  EXPECT_FALSE(injector->next_due());
+  // The stream goes on framing from the next byte.
+  injector->push(200ms, sp(40));
+  out.clear();
+  injector->poll(200ms, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_EQ(std::get<Delivery>(out[0]).bytes, sp(40));
+}
+
+TEST(FaultInjector, AWr8PacketAndAStrayTrailingByteAreBothDelivered) {
+  // A mock `send` behaviour writes bytes as given: a whole AUTH-REPLY and
+  // one byte that starts no packet the car knows how to finish.
+  std::vector<FaultEvent> events;
+  auto injector = make_injector("wr8", {}, events, 1, Direction::to_client);
+  const Bytes written{0x02, 0x08, 0x01, 0x02, 0x06};
+  injector->push(0ms, written);
+  std::vector<InjectorOutput> out;
+  injector->poll(0ms + kPartialFrameHold, out);
+  Bytes delivered;
+  for (const auto& o : out) {
+    const auto& b = std::get<Delivery>(o).bytes;
+    delivered.insert(delivered.end(), b.begin(), b.end());
+  }
+  EXPECT_EQ(delivered, written);
+  EXPECT_FALSE(injector->next_due());
 }
 
 TEST(FaultInjector, FinishReleasesAPartialFrame) {
