@@ -101,6 +101,7 @@ struct FaultInjector::State {
   FaultRandom rng;
   std::unique_ptr<FrameSplitter> splitter;
   bool text_protocol;
+  bool transparent = false;  // no rule applies to this direction
 
   std::vector<RuleState> rule_state;
   std::deque<Pending> queue;  // due times never decrease: it is a stream
@@ -146,6 +147,24 @@ struct FaultInjector::State {
         st.armed = true;
       }
     }
+    const bool was_transparent = transparent;
+    transparent = std::none_of(rule_state.begin(), rule_state.end(),
+                               [](const RuleState& r) { return r.applies; });
+    if (transparent && !was_transparent && held_since) {
+      release_partial(last_now);  // nothing will complete it under rules now
+    } else if (!transparent && was_transparent && splitter->buffered() > 0) {
+      // The start of that frame went out as written: frame afresh.
+      splitter = protocol->splitter_for(direction, false);
+    }
+  }
+
+  /// Without rules for this direction the link passes bytes exactly as
+  /// written, when written; the splitter only counts the frames.
+  void pass_through(Time now, protocol::ByteView bytes) {
+    splitter->feed(bytes, frames);
+    frames_seen += frames.size();
+    frames.clear();
+    schedule(now, 0, now, Bytes(bytes.begin(), bytes.end()), true);
   }
 
   std::string rule_name(std::size_t i) const {
@@ -581,6 +600,10 @@ void FaultInjector::push(Time now, protocol::ByteView bytes) {
   s.advance(now);
   if (s.broken || s.finished) return;
   ++s.pushes;
+  if (s.transparent) {
+    s.pass_through(now, bytes);
+    return;
+  }
   s.splitter->feed(bytes, s.frames);
   s.take_frames(now);
   s.note_held(now);
@@ -593,6 +616,10 @@ void FaultInjector::finish(Time now) {
   ++s.pushes;
   s.held_since.reset();
   s.splitter->finish(s.frames);
+  if (s.transparent) {
+    s.frames_seen += s.frames.size();  // its bytes went out as they came
+    s.frames.clear();
+  }
   s.take_frames(now);
   if (s.batch && !s.broken) s.release_batch(now, "sender closed");
   s.finished = true;

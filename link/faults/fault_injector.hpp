@@ -45,11 +45,13 @@ struct LinkBreak {
 };
 using InjectorOutput = std::variant<Delivery, LinkBreak>;
 
-/// How long an incomplete frame waits for the rest of its bytes after the
-/// sender's last write. Then its bytes go out as they were written: a car
-/// (or a `send` behaviour) that writes part of a frame is heard as it is,
-/// not held back until a frame that may never come. 100 ms spans the gaps
-/// between the pieces of one frame on a 9600 baud line or a Wi-Fi hop.
+/// With no rule for its direction an injector passes every write through
+/// as it is, at once. Under rules, which act on whole frames, an incomplete
+/// frame waits this long after the sender's last write for the rest of its
+/// bytes; then its bytes go out as they were written: a car (or a `send`
+/// behaviour) that writes part of a frame is heard as it is, not held back
+/// until a frame that may never come. 100 ms spans the gaps between the
+/// pieces of one frame on a 9600 baud line or a Wi-Fi hop.
 inline constexpr Duration kPartialFrameHold = std::chrono::milliseconds(100);
 
 class FaultInjector {

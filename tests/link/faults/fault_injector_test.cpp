@@ -376,9 +376,58 @@ TEST(FaultInjector, RefuseIsActiveForItsDurationAndRecordsEachRefusal) {
   EXPECT_EQ(injector->faults_injected(), 2U);
 }
 
-TEST(FaultInjector, IncompleteFramesAreHeldUntilTheyComplete) {
+/// Every delivered byte, in order.
+Bytes joined(const std::vector<InjectorOutput>& out) {
+  Bytes all;
+  for (const auto& o : out) {
+    const auto& b = std::get<Delivery>(o).bytes;
+    all.insert(all.end(), b.begin(), b.end());
+  }
+  return all;
+}
+
+/// A rule that acts on every frame and changes nothing: the injector
+/// frames the stream, as under any rule.
+FaultProfile framing_rules() {
+  return profile_of({rule(Delay{0ms, 0ms})});
+}
+
+TEST(FaultInjector, WithoutRulesAPartialFrameGoesOutAtOnceAsWritten) {
   std::vector<FaultEvent> events;
   auto injector = make_injector("logi", {}, events);
+  injector->push(0ms, to_bytes("LOGI:SP"));
+  std::vector<InjectorOutput> out;
+  injector->poll(0ms, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_EQ(std::get<Delivery>(out[0]).bytes, to_bytes("LOGI:SP"));
+  injector->push(3ms, to_bytes(":0"));
+  injector->poll(3ms, out);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_EQ(std::get<Delivery>(out[1]).bytes, to_bytes(":0"));
+  EXPECT_FALSE(injector->next_due());
+}
+
+TEST(FaultInjector, RulesArrivingInsideAFrameFrameAfreshAndSendNothingTwice) {
+  std::vector<FaultEvent> events;
+  auto injector = make_injector("logi", {}, events);
+  const Bytes frame = sp(77);
+  const auto half = static_cast<std::ptrdiff_t>(frame.size() / 2);
+  injector->push(0ms, Bytes(frame.begin(), frame.begin() + half));
+  injector->set_profile(framing_rules());
+  injector->push(1ms, Bytes(frame.begin() + half, frame.end()));
+  injector->push(2ms, sp(40));
+  std::vector<InjectorOutput> out;
+  injector->poll(1s, out);
+  const Bytes delivered = joined(out);
+  Bytes written = frame;
+  const Bytes next = sp(40);
+  written.insert(written.end(), next.begin(), next.end());
+  EXPECT_EQ(delivered, written);
+}
+
+TEST(FaultInjector, IncompleteFramesAreHeldUntilTheyComplete) {
+  std::vector<FaultEvent> events;
+  auto injector = make_injector("logi", framing_rules(), events);
   const Bytes frame = sp(77);
   const auto half = static_cast<std::ptrdiff_t>(frame.size() / 2);
   injector->push(0ms, Bytes(frame.begin(), frame.begin() + half));
@@ -395,7 +444,7 @@ TEST(FaultInjector, IncompleteFramesAreHeldUntilTheyComplete) {
 
 TEST(FaultInjector, APartialFrameGoesOutAsWrittenOnceItsHoldEndsAfterTheLastWrite) {
   std::vector<FaultEvent> events;
-  auto injector = make_injector("logi", {}, events);
+  auto injector = make_injector("logi", framing_rules(), events);
   injector->push(0ms, to_bytes("LOGI:SP"));
   injector->push(60ms, to_bytes(":0"));  // a later piece restarts the hold
   EXPECT_EQ(injector->next_due(), Time{60ms} + kPartialFrameHold);
@@ -416,18 +465,14 @@ TEST(FaultInjector, APartialFrameGoesOutAsWrittenOnceItsHoldEndsAfterTheLastWrit
 
 TEST(FaultInjector, AWr8PacketAndAStrayTrailingByteAreBothDelivered) {
   // A mock `send` behaviour writes bytes as given: a whole AUTH-REPLY and
-  // one byte that starts no packet the car knows how to finish.
+  // one byte that starts a packet it never finishes. Both go out at once.
   std::vector<FaultEvent> events;
   auto injector = make_injector("wr8", {}, events, 1, Direction::to_client);
   const Bytes written{0x02, 0x08, 0x01, 0x02, 0x06};
   injector->push(0ms, written);
   std::vector<InjectorOutput> out;
-  injector->poll(0ms + kPartialFrameHold, out);
-  Bytes delivered;
-  for (const auto& o : out) {
-    const auto& b = std::get<Delivery>(o).bytes;
-    delivered.insert(delivered.end(), b.begin(), b.end());
-  }
+  injector->poll(0ms, out);
+  const Bytes delivered = joined(out);
   EXPECT_EQ(delivered, written);
   EXPECT_FALSE(injector->next_due());
 }
