@@ -271,6 +271,7 @@ bool ReferenceRun::build() {
   car.kind = scenario_.car;
   car.seed = mocks::car_seed(seed_, 0);
   car.name = "car0";
+  car.reply_latency = scenario_.reply_latency;
   try {
     mocks::apply_profile(car.configs, scenario_.car, scenario_.profile);
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));

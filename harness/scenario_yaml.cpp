@@ -161,9 +161,10 @@ std::string format_duration(Duration d) {
   return std::to_string(ns) + "ns";
 }
 
-const Keys kTopKeys = {"name",  "description", "tags",     "car",       "profile", "world",
-                       "seed",  "timeout",     "settle",   "variables", "faults",  "client",
-                       "setup", "steps",       "teardown", "schedule",  "expect"};
+const Keys kTopKeys = {"name",     "description",   "tags",     "car",     "profile",
+                       "reply_latency", "world", "seed",   "timeout", "settle",
+                       "variables", "faults",  "client",   "setup",   "steps",
+                       "teardown",  "schedule", "expect"};
 const Keys kStepKeys = {"do", "wait", "wait_until", "car", "faults", "obstacle"};
 const Keys kMatcherSources = {"wire", "client", "sim", "step", "fault", "car"};
 const Keys kWireDirections = {"received", "sent_by_client", "sent_by_car", "received_by_client"};
@@ -264,6 +265,7 @@ class Loader {
       if (scenario_.timeout.count() == 0) fail(n, "'timeout' must be more than 0s");
     }
     if (auto n = root["settle"]) scenario_.settle = duration(n, "'settle'");
+    if (auto n = root["reply_latency"]) scenario_.reply_latency = duration(n, "'reply_latency'");
     if (auto n = root["faults"]) scenario_.faults = faults(n, "'faults'");
     if (auto n = root["client"]) scenario_.client = client(n);
 

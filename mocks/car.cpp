@@ -82,6 +82,7 @@ MockCar::MockCar(CarOptions options) : kind_(options.kind), name_(options.name) 
   def.name = name_;
   vehicle_ = &world_->add_vehicle(std::move(def));
   firmware_ = make_firmware(kind_, *world_, *vehicle_, options.configs);
+  firmware_->set_reply_latency(options.reply_latency);
 }
 
 MockCar::~MockCar() = default;

@@ -53,6 +53,9 @@ struct CarOptions {
   std::uint64_t seed = 1;  ///< sensor noise and sensor faults
   std::string name = "car0";
   FirmwareConfigs configs;
+  /// The firmware's processing time before each answer (Firmware::
+  /// set_reply_latency); zero: in the same instant.
+  Duration reply_latency{0};
 };
 
 class MockCar {

@@ -33,8 +33,18 @@ std::shared_ptr<const link::ProtocolAdapter> Firmware::adapter() const {
 }
 
 void Firmware::advance(Time now) {
+  now_ = std::max(now_, now);
   world_.advance_to(now);
+  release_delayed(now);
   run_actions(now, script_.take_due(now));
+}
+
+void Firmware::release_delayed(Time now) {
+  while (!delayed_.empty() && delayed_.front().due <= now) {
+    const Bytes& bytes = delayed_.front().bytes;
+    output_.insert(output_.end(), bytes.begin(), bytes.end());
+    delayed_.pop_front();
+  }
 }
 
 void Firmware::connect(Time now) {
@@ -42,6 +52,7 @@ void Firmware::connect(Time now) {
   connected_ = true;
   ++stats_.connections;
   output_.clear();
+  delayed_.clear();
   close_.reset();
   on_connect(now);
   on_tick(now);
@@ -52,6 +63,7 @@ void Firmware::disconnect(Time now) {
   if (!connected_) return;
   connected_ = false;
   output_.clear();
+  delayed_.clear();  // answers still being worked out have no one to go to
   close_.reset();
   on_disconnect(now);
   on_tick(now);
@@ -73,6 +85,7 @@ std::optional<Time> Firmware::next_wakeup() const {
   std::optional<Time> next = next_tick();
   if (const auto due = script_.next_due(); due && (!next || *due < *next)) next = due;
   if (muted_until_ && (!next || *muted_until_ < *next)) next = muted_until_;
+  if (!delayed_.empty() && (!next || delayed_.front().due < *next)) next = delayed_.front().due;
   return next;
 }
 
@@ -93,6 +106,7 @@ Bytes Firmware::take_output() {
 }
 
 std::optional<link::CloseMode> Firmware::take_close() {
+  if (!delayed_.empty() && close_ != link::CloseMode::reset) return std::nullopt;
   auto mode = close_;
   close_.reset();
   return mode;
@@ -100,7 +114,15 @@ std::optional<link::CloseMode> Firmware::take_close() {
 
 void Firmware::send(ByteView frame) {
   if (!connected_) return;
-  output_.insert(output_.end(), frame.begin(), frame.end());
+  if (reply_latency_ > Duration{0}) {
+    Time due = now_ + reply_latency_;
+    if (!delayed_.empty()) due = std::max(due, delayed_.back().due);
+    delayed_.push_back({due, Bytes(frame.begin(), frame.end())});
+  } else if (!delayed_.empty()) {
+    delayed_.push_back({delayed_.back().due, Bytes(frame.begin(), frame.end())});
+  } else {
+    output_.insert(output_.end(), frame.begin(), frame.end());
+  }
   stats_.bytes_out += frame.size();
   ++stats_.frames_out;
 }

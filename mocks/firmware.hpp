@@ -5,6 +5,7 @@
 // virtual-time driver and the real-time driver (mocks/server.hpp).
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -72,11 +73,21 @@ class Firmware {
   /// When the firmware next wants wake(); nullopt: only on input.
   std::optional<Time> next_wakeup() const;
 
-  /// Bytes to send to the client since the last call.
+  /// Bytes to send to the client since the last call: what the firmware
+  /// sent at least reply_latency() before the driver's latest call.
   Bytes take_output();
   /// Set when the firmware (or a behaviour) wants the connection closed;
-  /// the driver closes it after sending what take_output() returned.
+  /// the driver closes it after sending what take_output() returned (a
+  /// close waits for the bytes sent before it that are still delayed).
   std::optional<link::CloseMode> take_close();
+
+  /// The firmware's processing time: every byte it sends leaves this long
+  /// after the input or tick that made it, in order (a client may send
+  /// its next command before the answer to the last one). Zero: in the
+  /// same instant. The line's own time per byte (a serial car's baud) is
+  /// the link's, not this.
+  void set_reply_latency(Duration latency) { reply_latency_ = latency; }
+  Duration reply_latency() const { return reply_latency_; }
 
   // ---- harness side ----
 
@@ -140,10 +151,19 @@ class Firmware {
   void run_actions(Time now, const std::vector<Behaviour>& fired);
   void enter_fault(Time now, bool entered);
 
+  struct Delayed {
+    Time due{0};
+    Bytes bytes;
+  };
+  void release_delayed(Time now);
+
   Script script_;
   std::function<void()> wakeup_changed_;
   FirmwareStats stats_;
   Bytes output_;
+  std::deque<Delayed> delayed_;  // sent, not due yet (due times never decrease)
+  Duration reply_latency_{0};
+  Time now_{0};
   std::optional<link::CloseMode> close_;
   std::optional<Time> muted_until_;
   bool connected_ = false;

@@ -46,6 +46,7 @@ struct MockArgs {
   std::optional<std::uint16_t> port;
   std::string pty;
   std::optional<unsigned> baud;
+  std::string reply_latency;  ///< a duration; empty: none
   unsigned reset_ms = 0;
   std::string world;
   std::string faults;
@@ -421,6 +422,15 @@ int run_mock(const MockArgs& args) {
     }
     std::copy(args.auth.begin(), args.auth.end(), base.configs.wr8.profile.auth_text.begin());
   }
+  if (!args.reply_latency.empty()) {
+    const auto latency = link::parse_duration(args.reply_latency);
+    if (!latency) {
+      std::cerr << "hil mock: --reply-latency must be a duration with a unit (20ms, 1.5s), got '"
+                << args.reply_latency << "'\n";
+      return 2;
+    }
+    base.reply_latency = *latency;
+  }
   if (args.data_hz) {
     base.configs.wr8.data_period = std::chrono::duration_cast<link::Duration>(
         std::chrono::duration<double>(1.0 / *args.data_hz));
@@ -630,6 +640,9 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "Serial cars: symlink to the first pty (default /tmp/hil-<car>0; car N counts up)");
   cmd->add_option("--baud", args->baud,
                   "Serial cars: line rate (default 9600 for arduino, 115200 for leka; 0 unpaced)");
+  cmd->add_option("--reply-latency", args->reply_latency,
+                  "The firmware's processing time before each answer, e.g. 20ms (default 0; a "
+                  "serial car's bytes also take their time on the line at --baud)");
   cmd->add_option("--reset-ms", args->reset_ms,
                   "Serial cars: bytes sent this long after opening the port are lost, as when an "
                   "Arduino resets (default 0)");

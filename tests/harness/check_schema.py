@@ -50,11 +50,13 @@ WRONG = {
     ),
     "an unknown behaviour": "name: t\ncar: logi\nsteps:\n  - car: {rejct: MV}\n",
     "another car's profile": "name: t\ncar: arduino\nprofile: comspecs-v3\nsteps: [connect]\n",
+    "a reply latency without a unit": "name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n",
 }
 
 # And these are right in ways that are easy to get wrong in a schema.
 RIGHT = {
     "the Leka spec's own table": "name: t\ncar: leka\nprofile: comspecs-v3\nsteps: [connect]\n",
+    "a reply latency": "name: t\ncar: arduino\nreply_latency: 20ms\nsteps: [PING]\n",
     "variables in a duration and a count": (
         "name: t\ncar: logi\nvariables: {t: 2s, n: 3}\ntimeout: ${t}\nsteps: [connect]\n"
         "expect:\n  - {received: SP, at_least: '${n}'}\n"

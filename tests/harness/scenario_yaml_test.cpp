@@ -817,14 +817,38 @@ TEST(ScenarioYamlVariables, UndefinedVariableIsAnErrorAtItsPosition) {
   EXPECT_EQ(std::get<ExecClient>(s.client).command, "run ${HOME}/c {port}");
 }
 
+TEST(ScenarioYamlProfiles, AReplyLatencyIsADurationAndNoneIsZero) {
+  EXPECT_EQ(parse("name: t\ncar: arduino\nreply_latency: 20ms\nsteps: [PING]\n").reply_latency,
+            link::milliseconds(20));
+  EXPECT_EQ(parse("name: t\ncar: arduino\nsteps: [PING]\n").reply_latency, Duration{0});
+  EXPECT_EQ(error_of("name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n"),
+            "t.yaml:3:16: 'reply_latency' must be a duration with a unit (500ms, 2s, 1.5s), got "
+            "'20'");
+}
+
+TEST(ScenarioYamlProfiles, TheCarsProfileIsReadAndAWrongOneNamesTheValidOnes) {
+  EXPECT_EQ(parse("name: t\ncar: arduino\nprofile: readme\nsteps: [PING]\n").profile, "readme");
+  EXPECT_EQ(parse("name: t\ncar: leka\nprofile: comspecs-v3\nsteps: [wait: 1s]\n").profile,
+            "comspecs-v3");
+  EXPECT_EQ(parse("name: t\ncar: arduino\nsteps: [PING]\n").profile, "")
+      << "no key: the car's default profile";
+  EXPECT_EQ(error_of("name: t\ncar: arduino\nprofile: sketch\nsteps: [PING]\n"),
+            "t.yaml:3:10: 'profile': arduino has no profile 'sketch'; its profiles are firmware "
+            "(the default) and readme");
+  // A profile of another car is as wrong as a made-up one.
+  EXPECT_EQ(error_of("name: t\ncar: logi\nprofile: comspecs-v3\nsteps: [connect]\n"),
+            "t.yaml:3:10: 'profile': logi has no profile 'comspecs-v3'; its profiles are guide "
+            "(the default) and firmware");
+}
+
 // -------------------------------------------------------------------- errors
 
 TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
   // Unknown key, with the allowed ones and the likely one.
   EXPECT_EQ(error_of("name: t\ncar: logi\nstpes: [connect]\n"),
             "t.yaml:3:1: the scenario: unknown key 'stpes' (allowed: name, description, tags, "
-            "car, profile, world, seed, timeout, settle, variables, faults, client, setup, steps, "
-            "teardown, schedule, expect); did you mean 'steps'?");
+            "car, profile, reply_latency, world, seed, timeout, settle, variables, faults, client, "
+            "setup, steps, teardown, schedule, expect); did you mean 'steps'?");
   EXPECT_EQ(error_of("name: t\ncar: logi\n"), "t.yaml:1:1: the scenario: 'steps' is missing");
   EXPECT_EQ(error_of("name: t\ncar: tesla\nsteps: [connect]\n"),
             "t.yaml:2:6: unknown car 'tesla' (expected logi, wr8, arduino or leka)");

@@ -141,5 +141,27 @@ TEST(ArduinoSketchFirmware, TheSonarTruncatesToWholeCentimetres) {
   EXPECT_EQ(board.ask("^06|B| *64$"), ack("06", "B:40"));
 }
 
+// A firmware's processing time holds each answer back by exactly that
+// long; a client that sends its next request before the answer to the last
+// one gets both answers, in order, each that long after its request.
+TEST(ArduinoSketchFirmware, AReplyLatencyDelaysEachAnswerAndPipelinedRequestsQueueBehind) {
+  Board board;
+  board.firmware().set_reply_latency(milliseconds(5));
+  const Time t0 = board.now();
+  board.client->write("^01|PING| *31$");
+  board.run_for(milliseconds(2));
+  EXPECT_EQ(board.client->take_text(), "") << "still being worked out at 2 ms";
+  board.client->write("^02|PING| *32$");
+  board.run_until(t0 + milliseconds(5) - std::chrono::nanoseconds(1));
+  EXPECT_EQ(board.client->take_text(), "");
+  board.run_until(t0 + milliseconds(5));
+  EXPECT_EQ(board.client->take_text(), ack("01", "PONG"));
+  board.run_until(t0 + milliseconds(7) - std::chrono::nanoseconds(1));
+  EXPECT_EQ(board.client->take_text(), "");
+  board.run_until(t0 + milliseconds(7));
+  EXPECT_EQ(board.client->take_text(), ack("02", "PONG"));
+  EXPECT_EQ(board.firmware().reply_latency(), milliseconds(5));
+}
+
 }  // namespace
 }  // namespace hil::mocks
