@@ -314,7 +314,9 @@ class ArduinoClient final : public Client {
     if (in_flight_ || queue_.empty()) return;
     in_flight_ = queue_.front();
     queue_.pop_front();
-    write(arduino::encode({++seq_, *in_flight_}));
+    // The real client's frames, for the real sketch (the default profile).
+    const arduino::Message request{++seq_, *in_flight_};
+    write(hil::protocol::to_bytes(arduino::encode_text(request, arduino::kDefaultDialect)));
   }
 
   void on_bytes(ByteView bytes) override {
@@ -333,7 +335,7 @@ class ArduinoClient final : public Client {
           moving_ = true;
         } else if (std::holds_alternative<arduino::StatusRequest>(request)) {
           ++statuses_;
-          if (moving_ && ack->info.starts_with("IDLE")) {
+          if (moving_ && ack->info.ends_with("MOT:IDLE")) {
             moving_ = false;
             ++moves_;
             // The robot coasts for up to 0.3 s after its motors stop; a

@@ -20,6 +20,8 @@ for capture in scenarios/captures/*.txt scenarios/captures/*.hex; do
   protocol=${name%%-*}
   args=(decode "$protocol" --file "$capture" --no-raw --summary)
   case "$name" in *.hex) args+=(--hex) ;; esac
+  # Recorded from the mock in the README's dialect (scenarios/captures/README.md).
+  case "$name" in arduino-session.txt) args+=(--profile readme) ;; esac
   echo "== $name ($protocol)"
   rc=0
   "$hil" "${args[@]}" || rc=$?

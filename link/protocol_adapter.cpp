@@ -212,7 +212,7 @@ class SketchJudgedSplitter final : public FrameSplitter {
       if (f.raw.empty() || f.raw.front() != '^' || f.raw.back() != '$') continue;
       if (f.raw.size() > arduino::kSketchFrameBytes) {
         f.valid = false;
-        f.text = "dropped by the firmware: " + std::to_string(f.raw.size()) + " bytes pass its " +
+        f.text = "oversized: dropped by the firmware: " + std::to_string(f.raw.size()) + " bytes pass its " +
                  std::to_string(arduino::kSketchFrameBytes) + "-byte buffer";
         continue;
       }
@@ -227,15 +227,35 @@ class SketchJudgedSplitter final : public FrameSplitter {
                                       },
                                       [&](const arduino::SketchRefusal& r) {
                                         f.valid = false;
-                                        f.text = "refused by the firmware: NACK " +
+                                        f.text = std::string(error_named_by(r.code)) +
+                                                 ": refused by the firmware: NACK " +
                                                  std::string(arduino::to_string(r.code));
                                       },
                                       [&](const arduino::SketchDrop& d) {
                                         f.valid = false;
-                                        f.text = "dropped by the firmware: " + d.reason;
+                                        f.text = "bad_format: dropped by the firmware: " + d.reason;
                                       }},
                  arduino::judge_sketch_frame(text));
     }
+  }
+
+  // The decode error a sketch's NACK stands for, so that a frame's error
+  // kind (the text before ':') reads the same in both profiles.
+  static std::string_view error_named_by(protocol::arduino::NackCode code) {
+    using protocol::arduino::NackCode;
+    using protocol::ErrorKind;
+    switch (code) {
+      case NackCode::bad_cs:
+        return protocol::to_string(ErrorKind::bad_checksum);
+      case NackCode::bad_cmd:
+        return protocol::to_string(ErrorKind::unknown_code);
+      case NackCode::bad_v:
+        return protocol::to_string(ErrorKind::bad_value);
+      case NackCode::bad_fmt:
+      case NackCode::bad_seq:
+        break;
+    }
+    return protocol::to_string(ErrorKind::bad_format);
   }
 
   std::unique_ptr<FrameSplitter> inner_;
@@ -244,7 +264,7 @@ class SketchJudgedSplitter final : public FrameSplitter {
 
 class ArduinoAdapter final : public ProtocolAdapter {
  public:
-  explicit ArduinoAdapter(protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme)
+  explicit ArduinoAdapter(protocol::arduino::Dialect dialect = protocol::arduino::kDefaultDialect)
       : dialect_(dialect) {}
   std::string_view name() const override { return "arduino"; }
   std::string_view profile() const override { return protocol::arduino::to_string(dialect_); }

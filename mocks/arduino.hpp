@@ -25,7 +25,7 @@ struct ArduinoConfig {
   /// Which board to be: the real sketch (`firmware`: its parser, its reply
   /// texts, malformed frames dropped without an answer) or the README's
   /// examples (`readme`). docs/mocks/arduino.md has both.
-  protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme;
+  protocol::arduino::Dialect dialect = protocol::arduino::kDefaultDialect;
   /// Duty after a boot, and what V sets (the sketch's basePWM), 0..255.
   int base_pwm = 140;
   /// M runs for |cm| * this many milliseconds (MS_PER_CM), > 0 and <= 1000.
@@ -108,7 +108,7 @@ class ArduinoFirmware final : public Firmware {
   std::string status_text(Time now) const;
   /// The HELP answer of a dialect.
   static std::string_view help_text(
-      protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme);
+      protocol::arduino::Dialect dialect = protocol::arduino::kDefaultDialect);
 
  protected:
   void on_connect(Time now) override;

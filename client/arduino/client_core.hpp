@@ -29,7 +29,7 @@ struct ClientConfig {
   /// a request without an argument with a one-space payload and reads the
   /// sketch's replies; `readme` frames and reads the README's examples. The
   /// default is the one `hil mock arduino` plays by default.
-  protocol::arduino::Dialect dialect = protocol::arduino::Dialect::readme;
+  protocol::arduino::Dialect dialect = protocol::arduino::kDefaultDialect;
   /// Timeout of the first attempt; each retry doubles it.
   Duration base_timeout = link::milliseconds(600);
   /// Retries after the first attempt (timeouts 0.6, 1.2, 2.4, 4.8 s by default).

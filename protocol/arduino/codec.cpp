@@ -187,6 +187,16 @@ std::string encode_text(const Message& m, Dialect dialect) {
   return frame_text(e);
 }
 
+std::variant<Message, PayloadError> to_message(const Envelope& envelope, Dialect dialect) {
+  if (dialect == Dialect::firmware && takes_no_payload(envelope.cmd) &&
+      envelope.payload == empty_payload(dialect)) {
+    Envelope bare = envelope;
+    bare.payload.clear();
+    return to_message(bare);
+  }
+  return to_message(envelope);
+}
+
 std::variant<Message, PayloadError> to_message(const Envelope& envelope) {
   const std::string_view cmd = envelope.cmd;
   const std::string_view payload = envelope.payload;
@@ -318,10 +328,14 @@ DecodeItem<Envelope> parse_envelope(ByteView raw, const DecoderOptions& options)
 }
 
 Item decode_frame(ByteView raw, const DecoderOptions& options) {
+  return decode_frame(raw, Dialect::readme, options);
+}
+
+Item decode_frame(ByteView raw, Dialect dialect, const DecoderOptions& options) {
   auto parsed = parse_envelope(raw, options);
   if (auto* e = std::get_if<DecodeError>(&parsed)) return Item{std::move(*e)};
   auto& frame = std::get<Frame<Envelope>>(parsed);
-  auto typed = to_message(frame.message);
+  auto typed = to_message(frame.message, dialect);
   if (auto* e = std::get_if<PayloadError>(&typed)) {
     return Item{
         DecodeError{e->kind, std::move(frame.raw), std::move(e->detail), std::move(e->context)}};

@@ -42,6 +42,10 @@ inline constexpr int kMaxPwm = 255;
 /// board's replies (docs/protocols/arduino.md, "Profiles").
 enum class Dialect : std::uint8_t { firmware, readme };
 
+/// The default profile's dialect: the real sketch, the board people own
+/// (the registry's default, protocol/common/car_profile.cpp, says the same).
+inline constexpr Dialect kDefaultDialect = Dialect::firmware;
+
 /// "firmware" or "readme".
 std::string_view to_string(Dialect dialect);
 /// The dialect of an Arduino profile name; empty is the default profile.
@@ -98,6 +102,10 @@ struct PayloadError {
 
 /// Types an envelope's CMD and PAYLOAD (the SEQ is copied).
 std::variant<Message, PayloadError> to_message(const Envelope& envelope);
+/// to_message as a client of `dialect` means the frame: in `firmware` the
+/// one space of a request without an argument ("^01|PING| *31$", the real
+/// client's PING) types as that request; in `readme` it is to_message.
+std::variant<Message, PayloadError> to_message(const Envelope& envelope, Dialect dialect);
 
 struct DecoderOptions {
   /// Longest frame, markers included; also the most the decoder holds.
@@ -124,6 +132,8 @@ DecodeItem<Envelope> parse_envelope(ByteView raw, const DecoderOptions& options 
 
 /// parse_envelope, then to_message.
 Item decode_frame(ByteView raw, const DecoderOptions& options = {});
+/// parse_envelope, then to_message in `dialect`.
+Item decode_frame(ByteView raw, Dialect dialect, const DecoderOptions& options = {});
 
 /// The NACK code the firmware answers a decode error with; nullopt when there
 /// is no complete frame to answer (garbage, oversized, truncated, or a frame

@@ -28,12 +28,12 @@ constexpr std::array kProfiles{
         "the real sketch: the payload field may not be empty (the real client sends one "
         "space), replies PONG, STATUS:V=..,DIR=..,MOT:.., ACCEPTED, STOPPED, B:<cm>, "
         "I:AL=..; malformed frames dropped without an answer",
-        false},
+        true},
     CarProfile{"arduino", "readme",
                "the README of andrii-mazurchuk/arduino_robot_steering- (hil's protocol document)",
                "the README's examples: argument-less commands with an empty payload, replies OK, "
                "IDLE PWM=.., the bare sonar distance",
-               true},
+               false},
     CarProfile{"leka", "readme", "the README of leka/LKAlphaComSpecs v3.0.0 (381046f)",
                "the README's command ids (belt single 0x15) and its worked examples' checksum: "
                "the low byte of a 16-bit BSD sum over the command group",

@@ -60,8 +60,10 @@ std::string logi_corrupt(int) {
   return "LOGI:SP:050:D8#";
 }
 
+// The real RobotClient's PING: its payload is one space (the sketch refuses
+// an empty one).
 std::string arduino_valid(int i) {
-  return protocol::arduino::frame_text({static_cast<std::uint8_t>(i % 256), "PING", ""});
+  return protocol::arduino::frame_text({static_cast<std::uint8_t>(i % 256), "PING", " "});
 }
 
 std::string arduino_corrupt(int i) {
@@ -106,20 +108,23 @@ std::vector<Car> cars() {
   proxy.name = "proxy";
   all.push_back(proxy);
 
-  Car arduino{"arduino", true, "", arduino_valid, "|ACK|", arduino_corrupt, "xyz!?", 1, {}, "^"};
-  // The firmware takes frames of up to 96 bytes.
+  // The sketch ignores bytes outside a frame: garbage counts no bad frame.
+  Car arduino{"arduino", true, "", arduino_valid, "|ACK|", arduino_corrupt, "xyz!?", 0, {}, "^"};
+  // The sketch takes frames of up to 96 bytes, '^' and '$' included (13 of
+  // them are the frame around a PING's payload): a PING of 96 bytes is
+  // answered, one of 97 dropped without an answer and counted.
   arduino.limit_frames = {
-      {protocol::arduino::frame_text({1, "PING", std::string(96 - 17, 'P')}), 1, 0},
-      {protocol::arduino::frame_text({1, "PING", std::string(97 - 17, 'P')}), 1, 0}};
+      {protocol::arduino::frame_text({1, "PING", std::string(96 - 13, 'P')}), 0, 1},
+      {protocol::arduino::frame_text({1, "PING", std::string(97 - 13, 'P')}), 1, 0}};
   all.push_back(arduino);
 
   Car leka{"leka", true, "", leka_valid, "LEKA name=", leka_corrupt, "xyzxyz!", 1, {}, ""};
-  // 122 bytes of group is the bound (a 128-byte frame); 123 is refused
-  // and counted once. The bytes after its header are then taken as
-  // garbage together with whatever follows (docs/mocks/leka.md), so no
-  // valid frame follows in that session.
+  // 122 bytes of group is the bound (a 128-byte frame); 123 is refused as
+  // oversized, and the bytes after its header, which hold no start
+  // sequence, are purged as one garbage run (docs/mocks/leka.md): two bad
+  // frames. No valid frame follows in that session.
   leka.limit_frames = {{leka_frame(std::string(122, '\x70')), 0, 122},
-                       {leka_frame(std::string(123, '\x70')), 1, 0}};
+                       {leka_frame(std::string(123, '\x70')), 2, 0}};
   leka.endless_head = "\x2A\x2B\x2C\x2D\x7A";
   all.push_back(leka);
 
@@ -406,7 +411,14 @@ TEST_P(Abuse, FramesAtAndPastTheLengthLimit) {
   ASSERT_TRUE(target_->settled()) << target_->log();
   const auto counts = target_->last_session();
   ASSERT_TRUE(counts) << target_->log();
-  EXPECT_EQ((*counts)[2], expected_bad) << target_->log();
+  if (car().name == "leka") {
+    // Leka's parser purges garbage once a loop pass: a run the serial line
+    // hands over across two passes counts twice.
+    EXPECT_GE((*counts)[2], expected_bad) << target_->log();
+    EXPECT_LE((*counts)[2], expected_bad + 2) << target_->log();
+  } else {
+    EXPECT_EQ((*counts)[2], expected_bad) << target_->log();
+  }
   expect_recovered("frames at and past the limit");
 }
 

@@ -100,7 +100,9 @@ TEST(HilCli, EncodesArduinoWithSequenceNumber) {
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.output, "^02|V|160*63$\n");
   EXPECT_EQ(run_hil("encode arduino --seq 4 R -90").output, "^04|R|-90*72$\n");
-  EXPECT_EQ(run_hil("encode arduino --seq 8 STATUS").output, "^08|STATUS|*1C$\n");
+  // The real sketch (the default) wants one space where there is no argument.
+  EXPECT_EQ(run_hil("encode arduino --seq 8 STATUS").output, "^08|STATUS| *3C$\n");
+  EXPECT_EQ(run_hil("encode arduino --profile readme --seq 8 STATUS").output, "^08|STATUS|*1C$\n");
   EXPECT_EQ(run_hil("encode arduino --seq 2 V:160").output, "^02|V|160*63$\n");
 }
 
@@ -111,9 +113,13 @@ TEST(HilCli, RefusesArduinoSpeedOutOfRange) {
 }
 
 TEST(HilCli, DecodesArduinoRequest) {
-  const auto r = run_hil("decode arduino '^02|V|160*63$'");
+  const auto r = run_hil("decode arduino --profile readme '^02|V|160*63$'");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("SetSpeed seq=02 pwm=160"));
+  // The real sketch's view: the fields its parser splits out.
+  const auto sketch = run_hil("decode arduino '^02|V|160*63$'");
+  EXPECT_EQ(sketch.exit_code, 0);
+  EXPECT_THAT(sketch.output, HasSubstr("request seq=02 cmd=V payload='160'"));
 }
 
 TEST(HilCli, EncodesLekaFramesAsSpacedHex) {
@@ -149,7 +155,7 @@ TEST(HilCli, EveryCaptureDecodesWithTheErrorsItWasMadeWith) {
     const char* summary;
   };
   for (const Capture& c : {
-           Capture{"arduino --file scenarios/captures/arduino-session.txt",
+           Capture{"arduino --profile readme --file scenarios/captures/arduino-session.txt",
                    "summary: 243 bytes, 15 frame(s), 4 error(s), 1 bad_checksum, 1 bad_format, 1 "
                    "bad_value, 1 garbage"},
            Capture{"wr8 --hex --file scenarios/captures/wr8-vehicle.hex",
@@ -240,8 +246,8 @@ TEST(HilCli, ProfilesListsEveryCarsProfilesWithTheirSources) {
     EXPECT_THAT(all.output, HasSubstr(car));
   const auto arduino = run_hil("profiles arduino");
   ASSERT_EQ(arduino.exit_code, 0) << arduino.output;
-  EXPECT_THAT(arduino.output, HasSubstr("  readme (default)\n"));
-  EXPECT_THAT(arduino.output, HasSubstr("  firmware\n"));
+  EXPECT_THAT(arduino.output, HasSubstr("  firmware (default)\n"));
+  EXPECT_THAT(arduino.output, HasSubstr("  readme\n"));
   EXPECT_THAT(arduino.output, HasSubstr("andrii-mazurchuk/arduino_robot_steering- at 8dcfab0"));
   EXPECT_EQ(arduino.output.find("leka"), std::string::npos) << arduino.output;
   const auto tank = run_hil("profiles tank");
@@ -269,8 +275,8 @@ TEST(HilCli, ArduinoFirmwareProfileEncodesAndJudgesAsTheRealBoard) {
 
   const auto wrong = run_hil("encode arduino --profile sketch PING");
   EXPECT_NE(wrong.exit_code, 0);
-  EXPECT_THAT(wrong.output, HasSubstr("arduino has no profile 'sketch'; its profiles are readme "
-                                      "(the default) and firmware"));
+  EXPECT_THAT(wrong.output, HasSubstr("arduino has no profile 'sketch'; its profiles are firmware "
+                                      "(the default) and readme"));
 }
 
 // The third-party generator's documented frame (MMyster/Leka-Command-

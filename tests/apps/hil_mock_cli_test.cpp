@@ -12,8 +12,10 @@
 
 #include <chrono>
 #include <filesystem>
+#include <optional>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "tests/apps/hil_cli_support.hpp"
 
@@ -104,41 +106,93 @@ TEST(HilMock, CountRunsIndependentCarsAndASecondClientIsTurnedAway) {
   EXPECT_EQ(mock.interrupt(), 0);
 }
 
+/// `hil mock arduino ARGS --pty <a temp folder>/robot0`, listening, and
+/// the port opened as a serial program opens it.
+struct ArduinoOnPty {
+  explicit ArduinoOnPty(const std::vector<std::string>& args)
+      : path(make_dir(dir) + "/robot0"),
+        mock(command(args, path)),
+        listening(mock.wait_for_line("as a serial port at 9600 baud")),
+        port(listening ? ::open(path.c_str(), O_RDWR | O_NOCTTY) : -1) {}
+  ~ArduinoOnPty() { std::filesystem::remove_all(dir); }
+  ArduinoOnPty(const ArduinoOnPty&) = delete;
+  ArduinoOnPty& operator=(const ArduinoOnPty&) = delete;
+
+  static std::string make_dir(const std::filesystem::path& d) {
+    std::filesystem::create_directories(d);
+    return d.string();
+  }
+  static std::vector<std::string> command(const std::vector<std::string>& args,
+                                          const std::string& path) {
+    std::vector<std::string> all{"mock", "arduino"};
+    all.insert(all.end(), args.begin(), args.end());
+    all.insert(all.end(), {"--pty", path});
+    return all;
+  }
+
+  std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("hil-mock-ard-" + std::to_string(::getpid()));
+  std::string path;
+  HilProcess mock;
+  std::optional<std::string> listening;
+  Fd port;
+};
+
 TEST(HilMock, ArduinoRobotAnswersOnAPty) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("hil-mock-cli-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "robot0").string();
-  HilProcess mock({"mock", "arduino", "--pty", path});
-  const auto line = mock.wait_for_line("as a serial port at 9600 baud");
-  ASSERT_TRUE(line) << mock.output();
-  EXPECT_NE(line->find(path), std::string::npos);
-  Fd port(::open(path.c_str(), O_RDWR | O_NOCTTY));
-  ASSERT_TRUE(port.ok());
-  port.send("^01|PING|*11$");
-  EXPECT_TRUE(port.read_until("^01|ACK|")) << port.received;
-  EXPECT_EQ(mock.interrupt(), 0);
-  std::filesystem::remove_all(dir);
+  ArduinoOnPty robot({});
+  ASSERT_TRUE(robot.listening) << robot.mock.output();
+  EXPECT_NE(robot.listening->find(robot.path), std::string::npos);
+  ASSERT_TRUE(robot.port.ok());
+  // The real client's PING (one space for no argument), answered as the
+  // real sketch answers it: the default profile is the board people own.
+  robot.port.send("^01|PING| *31$");
+  EXPECT_TRUE(robot.port.read_until("^01|ACK|PONG*")) << robot.port.received;
+  EXPECT_EQ(robot.mock.interrupt(), 0);
 }
 
 // --profile firmware plays the real sketch: the README's empty-payload PING
 // is refused as the board refuses it, and the real client's one-space PING
-// is answered PONG (arduino.ino at 8dcfab0).
+// is answered PONG (arduino.ino at 8dcfab0); --profile readme takes it.
 TEST(HilMock, ArduinoFirmwareProfileAnswersAsTheRealSketch) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("hil-mock-fw-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "robot0").string();
-  HilProcess mock({"mock", "arduino", "--profile", "firmware", "--pty", path});
-  ASSERT_TRUE(mock.wait_for_line("as a serial port at 9600 baud")) << mock.output();
-  Fd port(::open(path.c_str(), O_RDWR | O_NOCTTY));
-  ASSERT_TRUE(port.ok());
-  port.send("^01|PING|*11$");
-  EXPECT_TRUE(port.read_until("^01|NACK|BAD_FMT*41$")) << port.received;
-  port.send("^02|PING| *32$");
-  EXPECT_TRUE(port.read_until("^02|ACK|PONG*5D$")) << port.received;
-  EXPECT_EQ(mock.interrupt(), 0);
-  std::filesystem::remove_all(dir);
+  ArduinoOnPty robot({"--profile", "firmware"});
+  ASSERT_TRUE(robot.listening) << robot.mock.output();
+  ASSERT_TRUE(robot.port.ok());
+  robot.port.send("^01|PING|*11$");
+  EXPECT_TRUE(robot.port.read_until("^01|NACK|BAD_FMT*41$")) << robot.port.received;
+  robot.port.send("^02|PING| *32$");
+  EXPECT_TRUE(robot.port.read_until("^02|ACK|PONG*5D$")) << robot.port.received;
+  EXPECT_EQ(robot.mock.interrupt(), 0);
+}
+
+TEST(HilMock, ArduinoReadmeProfileAnswersTheReadmesFrames) {
+  ArduinoOnPty robot({"--profile", "readme"});
+  ASSERT_TRUE(robot.listening) << robot.mock.output();
+  ASSERT_TRUE(robot.port.ok());
+  robot.port.send("^01|PING|*11$");
+  EXPECT_TRUE(robot.port.read_until("^01|ACK|OK*4C$")) << robot.port.received;
+  EXPECT_EQ(robot.mock.interrupt(), 0);
+}
+
+// --reply-latency holds each answer back by the firmware's processing
+// time; real time, so only the lower bound is checked.
+TEST(HilMock, AReplyLatencyHoldsTheAnswerBackAtLeastThatLong) {
+  ArduinoOnPty robot({"--reply-latency", "300ms"});
+  ASSERT_TRUE(robot.listening) << robot.mock.output();
+  ASSERT_TRUE(robot.port.ok());
+  const auto sent = std::chrono::steady_clock::now();
+  robot.port.send("^01|PING| *31$");
+  ASSERT_TRUE(robot.port.read_until("^01|ACK|PONG*5E$")) << robot.port.received;
+  EXPECT_GE(std::chrono::steady_clock::now() - sent, std::chrono::milliseconds(300));
+  EXPECT_EQ(robot.mock.interrupt(), 0);
+}
+
+TEST(HilMock, AReplyLatencyWithoutAUnitIsRefused) {
+  HilProcess mock({"mock", "arduino", "--reply-latency", "20", "--pty", "/tmp/hil-unused-ard"});
+  EXPECT_EQ(mock.wait_exit(), 2) << mock.output();
+  EXPECT_NE(mock.output().find("--reply-latency must be a duration with a unit (20ms, 1.5s), got "
+                               "'20'"),
+            std::string::npos)
+      << mock.output();
 }
 
 TEST(HilMock, AnUnknownProfileIsRefusedWithTheCarsProfiles) {

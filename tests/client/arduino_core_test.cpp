@@ -22,9 +22,18 @@ std::string text_of(const Bytes& b) {
   return std::string(b.begin(), b.end());
 }
 
+/// The client of the README's examples (profile `readme`), whose frames
+/// these timing tests spell out; the sketch's frames, the default, are
+/// checked in arduino_firmware_dialect_test.cpp.
+ClientConfig readme_client() {
+  ClientConfig c;
+  c.dialect = proto::Dialect::readme;
+  return c;
+}
+
 /// A core with a clock and everything it handed back, recorded in order.
 struct Harness {
-  explicit Harness(ClientConfig config = {}) : core(config) {}
+  explicit Harness(ClientConfig config = readme_client()) : core(config) {}
 
   void at(Time t) { now = t; }
   /// Runs the core's timer up to `t`, firing at every wakeup on the way.
@@ -88,7 +97,7 @@ struct Harness {
 };
 
 ClientConfig no_health_check() {
-  ClientConfig c;
+  ClientConfig c = readme_client();
   c.health_check_interval = Duration::zero();
   return c;
 }

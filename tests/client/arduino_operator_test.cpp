@@ -310,18 +310,19 @@ TEST_F(ArduinoOperatorRunner, PingWaitStatusEndsAtTheTimeTheLinePacingGives) {
   const Time t0 = executor.now();
   run_script("ping\nwait 1s\nstatus\n");
   ASSERT_EQ(outcomes.size(), 3u);
-  // "^00|PING|*10$" is 13 bytes out, "^00|ACK|OK*4D$" 14 bytes back.
-  EXPECT_EQ(outcomes[0].text, "ACK OK");
-  EXPECT_EQ(outcomes[0].finished - t0, milliseconds(27));
-  EXPECT_EQ(outcomes[1].started - t0, milliseconds(27));
-  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(1027));
-  // "^01|STATUS|*..$" is 15 bytes, so the robot reads it at 1042 ms after
-  // its boot at the connection; the answer is the text plus 12 bytes of frame.
+  // The real sketch's dialect: "^00|PING| *30$" is 14 bytes out,
+  // "^00|ACK|PONG*5F$" 16 bytes back.
+  EXPECT_EQ(outcomes[0].text, "ACK PONG");
+  EXPECT_EQ(outcomes[0].finished - t0, milliseconds(30));
+  EXPECT_EQ(outcomes[1].started - t0, milliseconds(30));
+  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(1030));
+  // "^01|STATUS| *..$" is 16 bytes, so the robot reads it at 1046 ms; the
+  // answer is the text plus 12 bytes of frame.
   const auto& status = outcomes[2];
   ASSERT_TRUE(status.ok) << status.text;
   const std::string info = status.result->info;
-  EXPECT_EQ(info.rfind("IDLE PWM=140 UP_MS=1042 ", 0), 0u) << info;
-  EXPECT_EQ(status.finished - t0, milliseconds(1042 + static_cast<int>(info.size()) + 12));
+  EXPECT_EQ(info, "STATUS:V=140,DIR=stop,MOT:IDLE");
+  EXPECT_EQ(status.finished - t0, milliseconds(1046 + static_cast<int>(info.size()) + 12));
   EXPECT_EQ(runner->failures(), 0u);
   EXPECT_EQ(runner->completed(), 3u);
   EXPECT_GE(idle_calls, 1);
@@ -332,15 +333,16 @@ TEST_F(ArduinoOperatorRunner, EveryRequestIsCarriedOutAndAnswered) {
   run_script("PING\nV 160\nM 20\nstatus\nS\nR -90\nB\nI\nHELP\n");
   const auto out = lines();
   ASSERT_EQ(out.size(), 9u);
-  EXPECT_EQ(out[0], "PING -> ACK OK");
-  EXPECT_EQ(out[1], "V 160 -> ACK 160");
-  EXPECT_EQ(out[2], "M 20 -> ACK OK");
-  EXPECT_EQ(out[3].rfind("STATUS -> ACK MOVING M:20 PWM=160 ", 0), 0u) << out[3];
-  EXPECT_EQ(out[4], "S -> ACK OK");
-  EXPECT_EQ(out[5], "R -90 -> ACK OK");
-  EXPECT_EQ(out[6].rfind("B -> ACK ", 0), 0u) << out[6];
-  EXPECT_EQ(out[7].rfind("I -> ACK L=", 0), 0u) << out[7];
-  EXPECT_EQ(out[8].rfind("HELP -> ACK PING STATUS", 0), 0u) << out[8];
+  // The real sketch's answers (the default profile).
+  EXPECT_EQ(out[0], "PING -> ACK PONG");
+  EXPECT_EQ(out[1], "V 160 -> ACK OK");
+  EXPECT_EQ(out[2], "M 20 -> ACK ACCEPTED");
+  EXPECT_EQ(out[3].rfind("STATUS -> ACK STATUS:V=160,DIR=fwd,MOT:MOVE,tleft:", 0), 0u) << out[3];
+  EXPECT_EQ(out[4], "S -> ACK STOPPED");
+  EXPECT_EQ(out[5], "R -90 -> ACK ACCEPTED");
+  EXPECT_EQ(out[6].rfind("B -> ACK B:", 0), 0u) << out[6];
+  EXPECT_EQ(out[7].rfind("I -> ACK I:AL=", 0), 0u) << out[7];
+  EXPECT_EQ(out[8], "HELP -> ACK CMDS:PING,HELP,STATUS,V,M,R,S,B,I");
   EXPECT_EQ(firmware->state().pwm, 160);
 }
 
@@ -349,8 +351,9 @@ TEST_F(ArduinoOperatorRunner, AMoveScriptDrivesTheRobotForItsTimedDuration) {
   // M 50 runs 900 ms: polled at 899 ms it still moves, at 900 ms it is idle.
   run_script("M 50\nwait 899ms\nSTATUS\nwait 1ms\nSTATUS\n");
   ASSERT_EQ(outcomes.size(), 5u);
-  EXPECT_EQ(outcomes[2].result->info.rfind("MOVING M:50 ", 0), 0u) << outcomes[2].result->info;
-  EXPECT_EQ(outcomes[4].result->info.rfind("IDLE ", 0), 0u) << outcomes[4].result->info;
+  EXPECT_EQ(outcomes[2].result->info.rfind("STATUS:V=140,DIR=fwd,MOT:MOVE,tleft:", 0), 0u)
+      << outcomes[2].result->info;
+  EXPECT_EQ(outcomes[4].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE");
 }
 
 TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
@@ -374,8 +377,8 @@ TEST_F(ArduinoOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
   const auto out = lines();
   ASSERT_EQ(out.size(), 3u);
   EXPECT_EQ(out[0], "V 160 -> NACK BUSY");
-  EXPECT_EQ(out[1], "V 170 -> ACK 170");
-  EXPECT_EQ(out[2].rfind("STATUS -> ACK IDLE PWM=170 ", 0), 0u) << out[2];
+  EXPECT_EQ(out[1], "V 170 -> ACK OK");
+  EXPECT_EQ(out[2], "STATUS -> ACK STATUS:V=170,DIR=stop,MOT:IDLE");
   EXPECT_EQ(runner->failures(), 1u);
   EXPECT_FALSE(runner->halted());
 }
@@ -388,16 +391,16 @@ TEST_F(ArduinoOperatorRunner, HistoryAndSaveLogShowTheFramesSoFar) {
   const auto csv = (dir / "run.csv").string();
   run_script("ping\nhistory\nsave-log " + csv + "\nsave-log /nonexistent/dir/run.txt\n");
   ASSERT_EQ(outcomes.size(), 4u);
-  EXPECT_NE(outcomes[1].text.find(" TX seq=00 ^00|PING|*10$"), std::string::npos)
+  EXPECT_NE(outcomes[1].text.find(" TX seq=00 ^00|PING| *30$"), std::string::npos)
       << outcomes[1].text;
-  EXPECT_NE(outcomes[1].text.find(" RX seq=00 ^00|ACK|OK*4D$"), std::string::npos)
+  EXPECT_NE(outcomes[1].text.find(" RX seq=00 ^00|ACK|PONG*5F$"), std::string::npos)
       << outcomes[1].text;
   EXPECT_EQ(outcomes[2].text, "saved 2 frame(s) to " + csv + " (csv)");
   std::ifstream in(csv);
   std::stringstream content;
   content << in.rdbuf();
   EXPECT_EQ(content.str().rfind("time,direction,seq,raw,hex\n", 0), 0u) << content.str();
-  EXPECT_NE(content.str().find(",TX,00,^00|PING|*10$,"), std::string::npos) << content.str();
+  EXPECT_NE(content.str().find(",TX,00,^00|PING| *30$,"), std::string::npos) << content.str();
   EXPECT_FALSE(outcomes[3].ok);
   EXPECT_EQ(outcomes[3].text, "cannot write /nonexistent/dir/run.txt");
   EXPECT_TRUE(runner->halted());
@@ -413,7 +416,7 @@ TEST_F(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
   EXPECT_EQ(outcomes[1].text, "reconnected, link OPEN");
   EXPECT_EQ(outcomes[1].finished - outcomes[1].started, milliseconds(500))
       << "closed for the session's reconnect_base_delay";
-  EXPECT_EQ(outcomes[2].result->info.rfind("IDLE PWM=140 ", 0), 0u)
+  EXPECT_EQ(outcomes[2].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE")
       << "the board reset when the port opened: " << outcomes[2].result->info;
   EXPECT_EQ(firmware->state().boots, boots + 1);
   ASSERT_GE(changes.size(), 2u);

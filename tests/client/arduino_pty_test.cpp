@@ -22,6 +22,8 @@
 namespace hil::client::arduino {
 namespace {
 
+namespace proto = protocol::arduino;
+
 TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) {
   mocks::test::TempDir dir("hil-arduino-client");
   const std::string uri = "pty://" + (dir.path / "arduino0").string() + "?baud=9600";
@@ -49,21 +51,23 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   };
   auto ping = run([](auto& s, auto cb) { return s.ping(cb); });
   EXPECT_EQ(ping.code, ResultCode::ok) << ping.detail;
-  EXPECT_EQ(ping.info, "OK");
+  // The real sketch's answers (the default profile).
+  EXPECT_EQ(ping.info, "PONG");
   auto v = run([](auto& s, auto cb) { return s.set_v(180, cb); });
-  EXPECT_EQ(v.info, "180");
+  EXPECT_EQ(v.info, "OK");
   auto status = run([](auto& s, auto cb) { return s.status(cb); });
-  EXPECT_EQ(status.info.rfind("IDLE PWM=180 ", 0), 0u) << status.info;
+  EXPECT_EQ(status.info, "STATUS:V=180,DIR=stop,MOT:IDLE");
   // A raw token goes out as typed; the board refuses the value.
-  auto bad = run([](auto& s, auto cb) { return s.raw("R:99999", cb); });
+  auto bad = run([](auto& s, auto cb) { return s.raw("V:999", cb); });
   EXPECT_EQ(bad.code, ResultCode::nack) << bad.detail;
+  EXPECT_EQ(bad.nack, (proto::Nack{proto::NackCode::bad_v}));
   auto turn = run([](auto& s, auto cb) { return s.raw("R:-90", cb); });
-  EXPECT_EQ(turn.info, "OK");
+  EXPECT_EQ(turn.info, "ACCEPTED");
   EXPECT_EQ(firmware.state().pwm, 180);
 
   const auto entries = session.log().entries();
   ASSERT_GE(entries.size(), 8u);
-  EXPECT_EQ(entries[0].raw, "^00|PING|*10$");
+  EXPECT_EQ(entries[0].raw, "^00|PING| *30$");
   EXPECT_EQ(entries[0].direction, LogDirection::tx);
   EXPECT_EQ(entries[1].direction, LogDirection::rx);
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));

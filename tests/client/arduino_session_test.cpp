@@ -83,26 +83,28 @@ TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
     EXPECT_EQ(r->code, ResultCode::ok) << r->detail;
     return r->info;
   };
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ping(cb); })), "OK");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.set_v(160, cb); })), "160");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.move_cm(10, cb); })), "OK");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.status(cb); })).rfind("MOVING M:10 PWM=160", 0),
+  // The real sketch's answers (the default profile).
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ping(cb); })), "PONG");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.set_v(160, cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.move_cm(10, cb); })), "ACCEPTED");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.status(cb); }))
+                .rfind("STATUS:V=160,DIR=fwd,MOT:MOVE,tleft:", 0),
             0u);
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.stop(cb); })), "OK");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.raw("R:-90", cb); })), "OK");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.rotate_deg(30, cb); })), "OK");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.stop(cb); })), "STOPPED");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.raw("R:-90", cb); })), "ACCEPTED");
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.rotate_deg(30, cb); })), "ACCEPTED");
   const std::string sonar = ok(run([](auto& s, auto cb) { return s.sonar(cb); }));
-  EXPECT_FALSE(sonar.empty());
-  EXPECT_EQ(sonar.find_first_not_of("0123456789"), std::string::npos) << sonar;
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ir(cb); })).rfind("L=", 0), 0u);
+  ASSERT_EQ(sonar.rfind("B:", 0), 0u) << sonar;
+  EXPECT_EQ(sonar.find_first_not_of("0123456789", 2), std::string::npos) << sonar;
+  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ir(cb); })).rfind("I:AL=", 0), 0u);
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.help(cb); })),
-            mocks::ArduinoFirmware::help_text());
+            mocks::ArduinoFirmware::help_text(proto::Dialect::firmware));
   EXPECT_EQ(firmware->state().last_seq, std::optional<std::uint8_t>(0x09));
   // Every frame in the log, both ways, with its SEQ.
   const auto entries = session->log().entries();
   ASSERT_EQ(entries.size(), 20u);
-  EXPECT_EQ(entries[0].raw, "^00|PING|*10$");
-  EXPECT_EQ(entries[1].raw, "^00|ACK|OK*4D$");
+  EXPECT_EQ(entries[0].raw, "^00|PING| *30$");
+  EXPECT_EQ(entries[1].raw, "^00|ACK|PONG*5F$");
   EXPECT_EQ(entries[1].direction, LogDirection::rx);
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
 }
@@ -149,7 +151,7 @@ TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
   auto r = run([](auto& s, auto cb) { return s.set_v(200, cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::ok);
-  EXPECT_EQ(r->info, "200");
+  EXPECT_EQ(r->info, "OK");
   EXPECT_EQ(r->attempts, 1);
   EXPECT_EQ(r->bad_cs_resends, 1);
   const auto entries = session->log().entries();

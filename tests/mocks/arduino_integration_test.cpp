@@ -1,4 +1,4 @@
-// The Arduino robot's mock firmware behind a real pty at 9600 baud, under
+// The Arduino robot's mock firmware (profile `readme`) behind a real pty at 9600 baud, under
 // the real-time driver, with a client that opens the port the way a serial
 // program does. Waits are bounded and generous; no upper bound on timing.
 
@@ -88,13 +88,17 @@ class SerialClient {
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
-/// The robot behind pty://<tmpdir>/arduino0, driven in real time.
+/// The robot behind pty://<tmpdir>/arduino0, driven in real time, in the
+/// README's dialect (profile `readme`), whose frames these tests spell out;
+/// arduino_sketch_test.cpp drives the real sketch's dialect.
 struct ArduinoOverPty : ::testing::Test {
   void start(const std::string& query = "?baud=9600") {
     uri = "pty://" + (dir.path / "arduino0").string() + query;
     world.emplace(sim::WorldDef{});
     sim::Vehicle& vehicle = world->add_vehicle(sim::arduino_robot());
-    firmware = std::make_unique<ArduinoFirmware>(*world, vehicle);
+    ArduinoConfig config;
+    config.dialect = arduino::Dialect::readme;
+    firmware = std::make_unique<ArduinoFirmware>(*world, vehicle, config);
     ServerOptions options;
     options.listen = link::parse_endpoint(uri);
     options.name = "arduino";
@@ -170,7 +174,7 @@ TEST_F(ArduinoOverPty, ASessionWithEveryCommandAndEveryNackKeepsTheSeqs) {
   auto client = open_port();
 
   expect_ack(*client, 0x01, arduino::Ping{}, "OK");
-  expect_ack(*client, 0x02, arduino::Help{}, std::string(ArduinoFirmware::help_text()));
+  expect_ack(*client, 0x02, arduino::Help{}, std::string(ArduinoFirmware::help_text(arduino::Dialect::readme)));
   EXPECT_EQ(ack_text(*client, 0x03, arduino::StatusRequest{}).rfind("IDLE PWM=140 ", 0), 0u);
   expect_ack(*client, 0x04, arduino::SetSpeed{160}, "160");
 

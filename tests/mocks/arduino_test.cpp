@@ -1,4 +1,5 @@
-// The Arduino robot's mock firmware under the virtual-time driver: every
+// The Arduino robot's mock firmware, profile `readme`, under the
+// virtual-time driver: every
 // command and answer, every NACK, the 96-byte bound, timed moves on the
 // virtual clock, sensors, reset on connect and scripted behaviours.
 
@@ -36,26 +37,34 @@ std::string nack(std::uint8_t seq, std::string text) {
   return request(seq, arduino::Nack{std::move(text)});
 }
 
+// The board of the README's examples (profile `readme`): these tests pin
+// its answers; arduino_sketch_test.cpp covers the real sketch, the default.
+ArduinoConfig readme_board() {
+  ArduinoConfig config;
+  config.dialect = arduino::Dialect::readme;
+  return config;
+}
+
 // ---------------------------------------------------------------- answers
 
 TEST(ArduinoFirmware, PingAnswersOkWithTheRequestsSeq) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^01|PING|*11$"), "^01|ACK|OK*4C$");
   EXPECT_EQ(robot.state().last_seq, 0x01);
 }
 
 TEST(ArduinoFirmware, EveryAnswerEchoesTheRequestsSeqOverTheWholeRange) {
-  Robot robot;
+  Robot robot(readme_board());
   for (int seq = 0; seq <= 0xFF; ++seq) {
     const auto s = static_cast<std::uint8_t>(seq);
     ASSERT_EQ(robot.ask(request(s, arduino::Ping{})), ack(s, "OK")) << "seq " << seq;
     ASSERT_EQ(robot.ask(request(s, arduino::Help{})),
-              ack(s, std::string(ArduinoFirmware::help_text())));
+              ack(s, std::string(ArduinoFirmware::help_text(arduino::Dialect::readme))));
   }
 }
 
 TEST(ArduinoFirmware, SetSpeedAnswersTheAppliedValue) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^02|V|160*63$"), ack(0x02, "160"));
   EXPECT_EQ(robot.state().pwm, 160);
   EXPECT_EQ(robot.ask(request(0x03, arduino::SetSpeed{0})), ack(0x03, "0"));
@@ -70,7 +79,7 @@ TEST(ArduinoFirmware, SetSpeedAnswersTheAppliedValue) {
 }
 
 TEST(ArduinoFirmware, MoveAnswersOkAsTheMoveStartsAndDrivesBothSides) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^03|M|25*49$"), "^03|ACK|OK*4E$");
   EXPECT_EQ(robot.state().motion, ArduinoMotion::move);
   EXPECT_EQ(robot.state().motion_arg, 25);
@@ -82,7 +91,7 @@ TEST(ArduinoFirmware, MoveAnswersOkAsTheMoveStartsAndDrivesBothSides) {
 }
 
 TEST(ArduinoFirmware, RotatePositiveTurnsRightAndNegativeLeft) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask(request(0x04, arduino::Rotate{90})), ack(0x04, "OK"));
   EXPECT_EQ(robot.state().motion, ArduinoMotion::rotate);
   EXPECT_EQ(robot.chassis().left_pwm(), 140);
@@ -93,7 +102,7 @@ TEST(ArduinoFirmware, RotatePositiveTurnsRightAndNegativeLeft) {
 }
 
 TEST(ArduinoFirmware, StopAnswersOkAndCutsTheMotors) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::Move{50}));
   robot.run_for(milliseconds(200));
   EXPECT_EQ(robot.ask("^07|S|*54$"), ack(0x07, "OK"));
@@ -105,7 +114,7 @@ TEST(ArduinoFirmware, StopAnswersOkAndCutsTheMotors) {
 }
 
 TEST(ArduinoFirmware, StatusTellsIdleThePwmUptimeAndBattery) {
-  Robot robot;
+  Robot robot(readme_board());
   const Time booted = robot.state().booted_at;
   robot.run_until(booted + milliseconds(1234));
   const std::string answer = robot.ask("^08|STATUS|*1C$");
@@ -115,7 +124,7 @@ TEST(ArduinoFirmware, StatusTellsIdleThePwmUptimeAndBattery) {
 }
 
 TEST(ArduinoFirmware, StatusWhileMovingNamesTheMoveAndTheTimeLeft) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::SetSpeed{200}));
   robot.ask(request(0x02, arduino::Rotate{-30}));  // 180 ms
   robot.run_until(robot.state().motion_started + milliseconds(100));
@@ -126,24 +135,24 @@ TEST(ArduinoFirmware, StatusWhileMovingNamesTheMoveAndTheTimeLeft) {
 }
 
 TEST(ArduinoFirmware, TheLongestStatusFitsTheBoardsFrame) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::SetSpeed{255}));
   robot.ask(request(0x02, arduino::Move{-32768}));
   const std::string answer = robot.ask(request(0xFF, arduino::StatusRequest{}));
   EXPECT_EQ(answer.rfind("^FF|ACK|MOVING M:-32768 PWM=255 REM_MS=589824 UP_MS=", 0), 0u) << answer;
   EXPECT_LE(answer.size(), arduino::kFirmwareMaxFrameBytes);
-  EXPECT_LE(ack(0, std::string(ArduinoFirmware::help_text())).size(),
+  EXPECT_LE(ack(0, std::string(ArduinoFirmware::help_text(arduino::Dialect::readme))).size(),
             arduino::kFirmwareMaxFrameBytes);
 }
 
 TEST(ArduinoFirmware, HelpListsTheCommands) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask(request(0x09, arduino::Help{})),
             ack(0x09, "PING STATUS V<pwm> M<cm> R<deg> S B I HELP"));
 }
 
 TEST(ArduinoFirmware, AFrameInPiecesAndLineEndsAfterItAreAnsweredOnce) {
-  Robot robot;
+  Robot robot(readme_board());
   const std::string frame = "^01|PING|*11$\r\n";
   for (const char c : frame) {
     robot.client->write(std::string_view(&c, 1));
@@ -157,7 +166,7 @@ TEST(ArduinoFirmware, AFrameInPiecesAndLineEndsAfterItAreAnsweredOnce) {
 }
 
 TEST(ArduinoFirmware, SeveralFramesInOneWriteAreAnsweredInOrder) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^01|PING|*11$^02|V|160*63$^07|JUMP|*05$"),
             "^01|ACK|OK*4C$" + ack(0x02, "160") + "^07|NACK|BAD_CMD*52$");
 }
@@ -165,7 +174,7 @@ TEST(ArduinoFirmware, SeveralFramesInOneWriteAreAnsweredInOrder) {
 // ---------------------------------------------------------------- NACKs
 
 TEST(ArduinoFirmware, BadChecksumIsAnsweredBadCsAndNothingHappens) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^02|V|160*00$"), nack(0x02, arduino::NackCode::bad_cs));
   EXPECT_EQ(robot.ask("^2A|S|*00$"), "^2A|NACK|BAD_CS*7C$");
   EXPECT_EQ(robot.state().pwm, 140);
@@ -177,7 +186,7 @@ TEST(ArduinoFirmware, BadChecksumIsAnsweredBadCsAndNothingHappens) {
 }
 
 TEST(ArduinoFirmware, BadFormatIsAnsweredBadFmt) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^03|PING|x*6B$"), nack(0x03, arduino::NackCode::bad_fmt));
   EXPECT_EQ(robot.ask(arduino::frame_body("04|PING")), nack(0x04, arduino::NackCode::bad_fmt));
   EXPECT_EQ(robot.ask(arduino::frame_body("05|M|ten")), nack(0x05, arduino::NackCode::bad_fmt));
@@ -188,14 +197,14 @@ TEST(ArduinoFirmware, BadFormatIsAnsweredBadFmt) {
 }
 
 TEST(ArduinoFirmware, BadSeqIsAnsweredBadSeqWithSeqZero) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^G1|PING|*66$"), "^00|NACK|BAD_SEQ*58$");
   EXPECT_EQ(robot.ask(arduino::frame_body("1|M|10")), nack(0x00, arduino::NackCode::bad_seq));
   EXPECT_FALSE(robot.firmware().moving());
 }
 
 TEST(ArduinoFirmware, UnknownCommandIsAnsweredBadCmd) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^07|JUMP|*05$"), "^07|NACK|BAD_CMD*52$");
   EXPECT_EQ(robot.ask(arduino::frame_body("08|ping|")), nack(0x08, arduino::NackCode::bad_cmd));
   EXPECT_EQ(robot.ask(arduino::frame_body("09|HISTORY|")), nack(0x09, arduino::NackCode::bad_cmd));
@@ -206,7 +215,7 @@ TEST(ArduinoFirmware, UnknownCommandIsAnsweredBadCmd) {
 }
 
 TEST(ArduinoFirmware, BadSpeedIsAnsweredBadVAndKeepsTheSpeed) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^05|V|999*6A$"), "^05|NACK|BAD_V*4C$");
   EXPECT_EQ(robot.ask(arduino::frame_body("06|V|fast")), nack(0x06, arduino::NackCode::bad_v));
   EXPECT_EQ(robot.ask(arduino::frame_body("07|V|-1")), nack(0x07, arduino::NackCode::bad_v));
@@ -215,9 +224,9 @@ TEST(ArduinoFirmware, BadSpeedIsAnsweredBadVAndKeepsTheSpeed) {
 }
 
 TEST(ArduinoFirmware, LowercaseChecksumIsTakenUnlessConfiguredStrict) {
-  Robot lenient;
+  Robot lenient(readme_board());
   EXPECT_EQ(lenient.ask("^06|I|*4f$").rfind("^06|ACK|", 0), 0u);
-  ArduinoConfig strict;
+  ArduinoConfig strict = readme_board();
   strict.accept_lowercase_checksum = false;
   Robot robot(strict);
   EXPECT_EQ(robot.ask("^06|I|*4f$"), nack(0x06, arduino::NackCode::bad_cs));
@@ -227,7 +236,7 @@ TEST(ArduinoFirmware, LowercaseChecksumIsTakenUnlessConfiguredStrict) {
 // ---------------------------------------------------------------- frame bound
 
 TEST(ArduinoFirmware, FramesOverNinetySixBytesAreDroppedWithoutAnAnswer) {
-  Robot robot;
+  Robot robot(readme_board());
   // ^01|M|<payload>*CS$ is 10 bytes plus the payload.
   const std::string at_bound = arduino::frame_body("01|M|" + std::string(86, 'x'));
   const std::string over = arduino::frame_body("02|M|" + std::string(87, 'x'));
@@ -246,7 +255,7 @@ TEST(ArduinoFirmware, FramesOverNinetySixBytesAreDroppedWithoutAnAnswer) {
 }
 
 TEST(ArduinoFirmware, AFrameCutShortByTheNextIsDroppedAndTheNextAnswered) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.ask("^01|M|25^02|PING|*12$"), ack(0x02, "OK"));
   EXPECT_FALSE(robot.firmware().moving());
 }
@@ -254,7 +263,7 @@ TEST(ArduinoFirmware, AFrameCutShortByTheNextIsDroppedAndTheNextAnswered) {
 // ---------------------------------------------------------------- motion
 
 TEST(ArduinoFirmware, MoveLastsEighteenMillisecondsPerCentimetre) {
-  Robot robot;
+  Robot robot(readme_board());
   const sim::Pose start = robot.pose();
   ASSERT_EQ(robot.ask(request(0x01, arduino::Move{50})), ack(0x01, "OK"));
   const Time t0 = robot.state().motion_started;
@@ -280,7 +289,7 @@ TEST(ArduinoFirmware, MoveLastsEighteenMillisecondsPerCentimetre) {
 }
 
 TEST(ArduinoFirmware, BackwardMoveDrivesBack) {
-  Robot robot;
+  Robot robot(readme_board());
   const sim::Pose start = robot.pose();
   robot.ask(request(0x01, arduino::Move{-30}));
   const Time t0 = robot.state().motion_started;
@@ -290,7 +299,7 @@ TEST(ArduinoFirmware, BackwardMoveDrivesBack) {
 }
 
 TEST(ArduinoFirmware, RotateLastsSixMillisecondsPerDegree) {
-  Robot robot;
+  Robot robot(readme_board());
   const sim::Pose start = robot.pose();
   ASSERT_EQ(robot.ask(request(0x01, arduino::Rotate{90})), ack(0x01, "OK"));
   const Time t0 = robot.state().motion_started;
@@ -314,7 +323,7 @@ TEST(ArduinoFirmware, RotateLastsSixMillisecondsPerDegree) {
 }
 
 TEST(ArduinoFirmware, DurationDoesNotScaleWithSpeedSoAFasterMoveOvershoots) {
-  Robot robot;
+  Robot robot(readme_board());
   const sim::Pose start = robot.pose();
   robot.ask(request(0x01, arduino::SetSpeed{70}));
   robot.ask(request(0x02, arduino::Move{50}));
@@ -325,7 +334,7 @@ TEST(ArduinoFirmware, DurationDoesNotScaleWithSpeedSoAFasterMoveOvershoots) {
 }
 
 TEST(ArduinoFirmware, ScaledDurationKeepsTheDistanceAtAnySpeed) {
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.scale_duration_with_pwm = true;
   Robot robot(config);
   const sim::Pose start = robot.pose();
@@ -342,7 +351,7 @@ TEST(ArduinoFirmware, ScaledDurationKeepsTheDistanceAtAnySpeed) {
 }
 
 TEST(ArduinoFirmware, StopDuringAMoveHaltsTheRobotEarly) {
-  Robot robot;
+  Robot robot(readme_board());
   const sim::Pose start = robot.pose();
   robot.ask(request(0x01, arduino::Move{100}));  // 1.8 s
   robot.run_for(milliseconds(500));
@@ -354,7 +363,7 @@ TEST(ArduinoFirmware, StopDuringAMoveHaltsTheRobotEarly) {
 }
 
 TEST(ArduinoFirmware, ANewMoveReplacesTheRunningOne) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::Move{100}));
   robot.run_for(milliseconds(300));
   robot.ask(request(0x02, arduino::Rotate{90}));
@@ -371,7 +380,7 @@ TEST(ArduinoFirmware, ANewMoveReplacesTheRunningOne) {
 }
 
 TEST(ArduinoFirmware, SpeedSetDuringAMoveAppliesToTheNextMove) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::Move{50}));
   robot.run_for(milliseconds(100));
   EXPECT_EQ(robot.ask(request(0x02, arduino::SetSpeed{200})), ack(0x02, "200"));
@@ -384,7 +393,7 @@ TEST(ArduinoFirmware, SpeedSetDuringAMoveAppliesToTheNextMove) {
 }
 
 TEST(ArduinoFirmware, TheControlLoopRunsOnATenMillisecondGridOnlyWhileTheRobotMoves) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.firmware().next_wakeup(), std::nullopt);
   robot.run_until(Time(milliseconds(3)));
   robot.ask(request(0x01, arduino::Move{1}));  // 18 ms
@@ -409,7 +418,7 @@ sim::Pose place(Robot& robot, double x_m, double y_m, double heading_deg) {
 }
 
 TEST(ArduinoFirmware, SonarReadsTheDistanceToAWallInWholeCentimetres) {
-  Robot robot;
+  Robot robot(readme_board());
   // Facing the east wall (x = 4 m); the sonar sits 0.1 m ahead of the centre.
   place(robot, 3.5, 1.0, 0);
   EXPECT_EQ(robot.ask("^05|B|*47$"), ack(0x05, "40"));
@@ -425,16 +434,16 @@ TEST(ArduinoFirmware, SonarWithoutAnEchoReadsTheConfiguredValue) {
   open_field.arena.tapes.clear();
   open_field.arena.tags.clear();
   open_field.arena.start = sim::Pose{6, 6, 0};
-  Robot robot({}, open_field);
+  Robot robot(readme_board(), open_field);
   EXPECT_EQ(robot.ask(request(0x01, arduino::SonarRead{})), ack(0x01, "0"));
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.no_echo_cm = 400;
   Robot other(config, open_field);
   EXPECT_EQ(other.ask(request(0x01, arduino::SonarRead{})), ack(0x01, "400"));
 }
 
 TEST(ArduinoFirmware, IrReadsBothSidesAsAnalogAndObstacle) {
-  Robot robot;
+  Robot robot(readme_board());
   // Heading east 0.15 m below the north wall: the left sensor, 6 cm left of
   // the axis and looking 30 degrees left, meets the wall after 0.18 m; the
   // right one sees nothing within its 0.30 m.
@@ -454,7 +463,7 @@ TEST(ArduinoFirmware, IrReadsBothSidesAsAnalogAndObstacle) {
 // ---------------------------------------------------------------- silence
 
 TEST(ArduinoFirmware, NeverSendsAnythingUnasked) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.run_for(seconds(30));
   EXPECT_EQ(robot.client->take_text(), "");
   robot.ask(request(0x01, arduino::Move{40}));
@@ -467,7 +476,7 @@ TEST(ArduinoFirmware, NeverSendsAnythingUnasked) {
 // ---------------------------------------------------------------- reset on connect
 
 TEST(ArduinoFirmware, OpeningThePortResetsTheBoard) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.state().boots, 2u);  // power-on, then the client's open
   robot.ask(request(0x01, arduino::SetSpeed{200}));
   robot.ask(request(0x02, arduino::Move{500}));  // 9 s
@@ -497,7 +506,7 @@ TEST(ArduinoFirmware, OpeningThePortResetsTheBoard) {
 }
 
 TEST(ArduinoFirmware, APartialFrameDoesNotSurviveTheReset) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.client->write("^01|PI");
   robot.run_for(milliseconds(5));
   robot.client->pipe->close();
@@ -507,7 +516,7 @@ TEST(ArduinoFirmware, APartialFrameDoesNotSurviveTheReset) {
 }
 
 TEST(ArduinoFirmware, ABoardWithoutAutoResetKeepsItsStateAcrossSessions) {
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.reset_on_connect = false;
   Robot robot(config);
   EXPECT_EQ(robot.state().boots, 1u);
@@ -524,7 +533,7 @@ TEST(ArduinoFirmware, ABoardWithoutAutoResetKeepsItsStateAcrossSessions) {
 // ---------------------------------------------------------------- repeated requests
 
 TEST(ArduinoFirmware, ARepeatedMoveRestartsItAsTheSketchDoes) {
-  Robot robot;
+  Robot robot(readme_board());
   const std::string move = request(0x05, arduino::Move{50});
   robot.ask(move);
   robot.run_for(milliseconds(400));
@@ -533,7 +542,7 @@ TEST(ArduinoFirmware, ARepeatedMoveRestartsItAsTheSketchDoes) {
 }
 
 TEST(ArduinoFirmware, ConfiguredToRepeatAnswersARepeatedRequestWithoutActingTwice) {
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.repeat_answer_for_repeated_request = true;
   Robot robot(config);
   const std::string move = request(0x05, arduino::Move{50});
@@ -556,7 +565,7 @@ TEST(ArduinoFirmware, ConfiguredToRepeatAnswersARepeatedRequestWithoutActingTwic
 // ---------------------------------------------------------------- behaviours
 
 TEST(ArduinoFirmware, FaultStopsTheMotorsAndRefusesMotionUntilCleared) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.ask(request(0x01, arduino::Move{100}));
   robot.run_for(milliseconds(200));
   robot.firmware().arm(Behaviour{"", When{}, EnterFault{}});
@@ -587,7 +596,7 @@ TEST(ArduinoFirmware, FaultStopsTheMotorsAndRefusesMotionUntilCleared) {
 }
 
 TEST(ArduinoFirmware, AFaultOutlastsAResetAndUsesTheConfiguredCode) {
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.fault_code = "MOTOR_FAULT";
   Robot robot(config);
   robot.firmware().arm(Behaviour{"", When{std::nullopt, "M", 1}, EnterFault{}});
@@ -602,7 +611,7 @@ TEST(ArduinoFirmware, AFaultOutlastsAResetAndUsesTheConfiguredCode) {
 }
 
 TEST(ArduinoFirmware, RejectAnswersBusyWithTheSeqAndHasNoEffect) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.firmware().arm(Behaviour{"", When{}, Reject{"M", 2}});
   robot.run_for(milliseconds(1));
   EXPECT_EQ(robot.ask(request(0x01, arduino::Move{10})), nack(0x01, "BUSY"));
@@ -612,7 +621,7 @@ TEST(ArduinoFirmware, RejectAnswersBusyWithTheSeqAndHasNoEffect) {
   EXPECT_EQ(robot.ask(request(0x04, arduino::Move{10})), ack(0x04, "OK"));
   EXPECT_EQ(robot.firmware().stats().rejected, 2u);
 
-  ArduinoConfig config;
+  ArduinoConfig config = readme_board();
   config.reject_code = "OUT_OF_RANGE";
   Robot other(config);
   other.firmware().arm(Behaviour{"", When{}, Reject{"", 1}});
@@ -621,7 +630,7 @@ TEST(ArduinoFirmware, RejectAnswersBusyWithTheSeqAndHasNoEffect) {
 }
 
 TEST(ArduinoFirmware, IgnoreSwallowsCommandsWithoutAnAnswerOrAnEffect) {
-  Robot robot;
+  Robot robot(readme_board());
   robot.firmware().arm(Behaviour{"", When{}, Ignore{"V", 1, std::nullopt}});
   robot.run_for(milliseconds(1));
   EXPECT_EQ(robot.ask(request(0x01, arduino::SetSpeed{200})), "");
@@ -652,7 +661,7 @@ TEST(ArduinoFirmware, RefusesConfigValuesOutOfRange) {
   sim::World world(sim::WorldDef{});
   sim::Vehicle& robot = world.add_vehicle(sim::arduino_robot());
   const auto refuses = [&](auto change) {
-    ArduinoConfig config;
+    ArduinoConfig config = readme_board();
     change(config);
     EXPECT_THROW(std::make_unique<ArduinoFirmware>(world, robot, config), std::invalid_argument);
   };
@@ -667,7 +676,7 @@ TEST(ArduinoFirmware, RefusesConfigValuesOutOfRange) {
 }
 
 TEST(ArduinoFirmware, SummaryShowsWhatTheRobotDoes) {
-  Robot robot;
+  Robot robot(readme_board());
   EXPECT_EQ(robot.firmware().protocol(), "arduino");
   EXPECT_EQ(robot.firmware().summary(), "IDLE PWM 140");
   robot.ask(request(0x01, arduino::Rotate{-45}));

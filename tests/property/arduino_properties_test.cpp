@@ -382,7 +382,7 @@ std::vector<WireFrame> wire_of(const ArduinoRig& rig) {
     f.tx = e.direction == LogDirection::tx;
     f.raw = e.raw;
     const protocol::Bytes bytes(e.raw.begin(), e.raw.end());
-    const auto item = proto::decode_frame(bytes);
+    const auto item = proto::decode_frame(bytes, rig.session->core().config().dialect);
     if (const auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item))
       f.message = frame->message;
     out.push_back(std::move(f));
@@ -520,6 +520,7 @@ enum class ResultRules : std::uint8_t {
 void check_results(const ArduinoRig& rig, const std::vector<WireFrame>& wire,
                    const std::vector<Exchange>& exchanges, ResultRules rules) {
   const ClientConfig& config = rig.session->core().config();
+  const proto::Dialect dialect = config.dialect;
   for (const auto& d : rig.done) {
     const proto::Body& body = rig.bodies.at(d.id);
     const Result& r = d.result;
@@ -538,7 +539,7 @@ void check_results(const ArduinoRig& rig, const std::vector<WireFrame>& wire,
       if (e.seq == *r.seq && wire[e.first].at <= d.at) x = &e;
     }
     RC_ASSERT((x != nullptr));
-    RC_ASSERT(wire[x->first].raw == proto::encode_text({*r.seq, body}));
+    RC_ASSERT(wire[x->first].raw == proto::encode_text({*r.seq, body}, dialect));
     if (rules == ResultRules::attempts) {
       RC_ASSERT(r.attempts == x->retries + 1);
       RC_ASSERT(r.bad_cs_resends == x->resends);
@@ -567,10 +568,13 @@ void check_results(const ArduinoRig& rig, const std::vector<WireFrame>& wire,
     }
     RC_ASSERT((answer != nullptr));
     if (r.code == ResultCode::ok) {
-      // What the robot says to V is the value it applied: the ACK belongs to this V.
+      // The README's board says the value it applied to V: the ACK belongs
+      // to this V. The real sketch says OK, and PONG to PING.
+      const bool readme = dialect == proto::Dialect::readme;
       if (const auto* v = std::get_if<proto::SetSpeed>(&body))
-        RC_ASSERT(r.info == std::to_string(v->pwm));
-      if (std::holds_alternative<proto::Ping>(body)) RC_ASSERT(r.info == std::string("OK"));
+        RC_ASSERT(r.info == (readme ? std::to_string(v->pwm) : std::string("OK")));
+      if (std::holds_alternative<proto::Ping>(body))
+        RC_ASSERT(r.info == std::string(readme ? "OK" : "PONG"));
       // Physics: the robot stands with its motors off once S is acknowledged.
       if (std::holds_alternative<proto::Stop>(body)) {
         RC_ASSERT(!d.robot_moving);

@@ -56,13 +56,13 @@ TEST_F(ArduinoClientCli, RawTokensRunOnceEachAndTheStatusShowsTheSpeedSet) {
   start_mock();
   const auto r = client({"PING", "V 160", "STATUS"});
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "PING -> ACK OK\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "V 160 -> ACK 160\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=160 ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "PING -> ACK PONG\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 160 -> ACK OK\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=160,DIR=stop,MOT:IDLE")) << r.output;
   // The seed CLI's raw form works too, and the robot moves.
   const auto move = client({"v:200", "M:20", "status"});
   EXPECT_EQ(move.exit_code, 0) << move.output;
-  EXPECT_TRUE(contains(move.output, "STATUS -> ACK MOVING M:20 PWM=200 ")) << move.output;
+  EXPECT_TRUE(contains(move.output, "STATUS -> ACK STATUS:V=200,DIR=fwd,MOT:MOVE,tleft:")) << move.output;
 }
 
 // The real CLI's own command line (CLI.py at 8dcfab0) against the mock
@@ -89,8 +89,8 @@ TEST_F(ArduinoClientCli, AnUnknownProfileIsRefusedWithTheValidNames) {
   const auto r = client({"--profile", "sketch", "PING"});
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(contains(r.output,
-                       "arduino has no profile 'sketch'; its profiles are readme (the "
-                       "default) and firmware"))
+                       "arduino has no profile 'sketch'; its profiles are firmware (the "
+                       "default) and readme"))
       << r.output;
 }
 
@@ -100,13 +100,13 @@ TEST_F(ArduinoClientCli, AScriptRunsAndItsFrameLogIsWritten) {
   const auto log = dir / "run.csv";
   const auto r = client({"--script", script.string(), "--log", log.string()});
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "V 120 -> ACK 120\n")) << r.output;
+  EXPECT_TRUE(contains(r.output, "V 120 -> ACK OK\n")) << r.output;
   EXPECT_TRUE(contains(r.output, "B -> ACK ")) << r.output;
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=120 ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=120,DIR=stop,MOT:IDLE")) << r.output;
   const auto csv = read_file(log);
   EXPECT_EQ(csv.rfind("time,direction,seq,raw,hex\n", 0), 0u) << csv;
   EXPECT_TRUE(contains(csv, ",TX,01,^01|V|120*")) << csv;
-  EXPECT_TRUE(contains(csv, ",RX,01,^01|ACK|120*")) << csv;
+  EXPECT_TRUE(contains(csv, ",RX,01,^01|ACK|OK*")) << csv;
 }
 
 TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
@@ -125,27 +125,27 @@ TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
     ASSERT_TRUE(mock->process().wait_for_line("client gone", 20s)) << mock->output();
   }
   const auto r = client({"STATUS"});
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK IDLE PWM=140 ")) << "a fresh boot: " << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE")) << "a fresh boot: " << r.output;
 }
 
 TEST_F(ArduinoClientCli, TheReplReadsAPipeAndQueuesLinesInOrder) {
   start_mock();
   HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(repl.write_stdin("ping\n"));
-  ASSERT_TRUE(repl.wait_for_line("PING -> ACK OK")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("PING -> ACK PONG")) << repl.output();
   // Three lines at once: the second and third wait for the one before.
   ASSERT_TRUE(repl.write_stdin("V 170\nM 10\nstatus\n"));
-  ASSERT_TRUE(repl.wait_for_line("V 170 -> ACK 170")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("M 10 -> ACK OK")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK MOVING M:10 PWM=170 ")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("V 170 -> ACK OK")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("M 10 -> ACK ACCEPTED")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK STATUS:V=170,DIR=fwd,MOT:MOVE,tleft:")) << repl.output();
   // A bad line is an error and the REPL goes on.
   ASSERT_TRUE(repl.write_stdin("V 300\n"));
   const auto error = repl.wait_for_line("error: column 3:");
   ASSERT_TRUE(error) << repl.output();
   EXPECT_TRUE(contains(*error, "V needs a number 0..255, not '300'")) << *error;
   ASSERT_TRUE(repl.write_stdin("history\n"));
-  ASSERT_TRUE(repl.wait_for_line("TX seq=00 ^00|PING|*10$")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("|ACK|MOVING M:10 PWM=170")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("TX seq=00 ^00|PING| *30$")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("|ACK|STATUS:V=170,DIR=fwd,MOT:MOVE")) << repl.output();
   const auto log = dir / "session.ndjson";
   ASSERT_TRUE(repl.write_stdin("save-log " + log.string() + "\n"));
   const auto saved = repl.wait_for_line(" frame(s) to " + log.string() + " (ndjson)");
@@ -157,7 +157,7 @@ TEST_F(ArduinoClientCli, TheReplReadsAPipeAndQueuesLinesInOrder) {
   EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
   EXPECT_FALSE(contains(repl.output(), "arduino> ")) << "no prompt on a pipe";
   const auto ndjson = read_file(log);
-  EXPECT_TRUE(contains(ndjson, R"("raw":"^00|PING|*10$")")) << ndjson;
+  EXPECT_TRUE(contains(ndjson, R"("raw":"^00|PING| *30$")")) << ndjson;
   EXPECT_TRUE(contains(ndjson, R"("direction":"RX")")) << ndjson;
   EXPECT_EQ(std::count(ndjson.begin(), ndjson.end(), '\n'), frames) << ndjson;
 }
@@ -168,8 +168,8 @@ TEST_F(ArduinoClientCli, TheReplEndsAtTheEndOfItsInputAfterTheLastReply) {
   ASSERT_TRUE(repl.write_stdin("V 90\nstatus"));  // the last line has no newline
   repl.close_stdin();
   EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
-  EXPECT_TRUE(contains(repl.output(), "V 90 -> ACK 90\n")) << repl.output();
-  EXPECT_TRUE(contains(repl.output(), "STATUS -> ACK IDLE PWM=90 ")) << repl.output();
+  EXPECT_TRUE(contains(repl.output(), "V 90 -> ACK OK\n")) << repl.output();
+  EXPECT_TRUE(contains(repl.output(), "STATUS -> ACK STATUS:V=90,DIR=stop,MOT:IDLE")) << repl.output();
 }
 
 TEST_F(ArduinoClientCli, ReconnectReopensThePortAndTheBoardResets) {
@@ -177,7 +177,7 @@ TEST_F(ArduinoClientCli, ReconnectReopensThePortAndTheBoardResets) {
   HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(repl.write_stdin("V 99\nreconnect\nstatus\n"));
   ASSERT_TRUE(repl.wait_for_line("reconnected, link OPEN")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK IDLE PWM=140 ")) << repl.output();
+  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE")) << repl.output();
   EXPECT_EQ(repl.interrupt(), 130) << repl.output();
 }
 
@@ -195,7 +195,7 @@ TEST_F(ArduinoClientCli, ANackedCommandExits1WithItsCodeAndStopsTheRun) {
   start_mock({"--behaviours", behaviours.string()});
   const auto all = client({"--keep-going", "V 160", "STATUS"});
   EXPECT_EQ(all.exit_code, 1) << all.output;
-  EXPECT_TRUE(contains(all.output, "STATUS -> ACK IDLE PWM=140 ")) << all.output;
+  EXPECT_TRUE(contains(all.output, "STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE")) << all.output;
 }
 
 TEST_F(ArduinoClientCli, ATypoInAScriptExits2WithFileLineAndColumn) {

@@ -126,10 +126,10 @@ TEST(ProtocolAdapter, EachAdapterNamesItsProfile) {
   EXPECT_EQ(protocol_adapter("logi")->profile(), "guide");
   EXPECT_EQ(protocol_adapter("logi", "firmware")->profile(), "firmware");
   EXPECT_EQ(protocol_adapter("wr8")->profile(), "document");
-  EXPECT_EQ(protocol_adapter("arduino")->profile(), "readme");
+  EXPECT_EQ(protocol_adapter("arduino")->profile(), "firmware");
   EXPECT_EQ(protocol_adapter("leka")->profile(), "readme");
   EXPECT_EQ(protocol_adapter("raw")->profile(), "");
-  EXPECT_EQ(protocol_adapter("arduino", "firmware")->profile(), "firmware");
+  EXPECT_EQ(protocol_adapter("arduino", "readme")->profile(), "readme");
   EXPECT_EQ(protocol_adapter("leka", "comspecs-v3")->profile(), "comspecs-v3");
   EXPECT_EQ(protocol_adapter("leka", "")->profile(), "readme");
   try {
@@ -175,7 +175,8 @@ TEST(ProtocolAdapter, ArduinoFirmwareProfileJudgesFramesAsTheSketch) {
   EXPECT_EQ(frames[0].kind, "PING");
   // The README's PING: an empty payload, refused with BAD_FMT.
   EXPECT_FALSE(frames[1].valid);
-  EXPECT_EQ(frames[1].text, "refused by the firmware: NACK BAD_FMT");
+  // Its error kind (before the ':') is the decoder's name for the NACK.
+  EXPECT_EQ(frames[1].text, "bad_format: refused by the firmware: NACK BAD_FMT");
   EXPECT_FALSE(frames[2].valid);  // garbage
   EXPECT_TRUE(frames[3].valid) << frames[3].text;
   EXPECT_EQ(frames[3].kind, "B");
@@ -194,6 +195,19 @@ TEST(ProtocolAdapter, InvalidBytesBecomeInvalidFramesWithTheDecoderError) {
   EXPECT_FALSE(frames[1].valid);
   EXPECT_EQ(frames[1].raw, bad);
   EXPECT_THAT(frames[1].text, testing::StartsWith("bad_checksum"));
+}
+
+TEST(ProtocolAdapter, TheSketchsRefusalsCarryTheDecodersErrorKind) {
+  // The sketch answers a checksum mismatch NACK BAD_CS; the frame's error
+  // kind is bad_checksum in the firmware profile as in the readme one.
+  const auto adapter = protocol_adapter("arduino", "firmware");
+  std::vector<WireFrame> frames;
+  const auto splitter = adapter->splitter_for(Direction::to_car);
+  splitter->feed(to_bytes("^00|V|160*51$^01|JUMP| *23$"), frames);
+  ASSERT_EQ(frames.size(), 2U);
+  EXPECT_FALSE(frames[0].valid);
+  EXPECT_EQ(frames[0].text, "bad_checksum: refused by the firmware: NACK BAD_CS");
+  EXPECT_TRUE(frames[1].valid) << "an unknown command is a frame the sketch answers BAD_CMD to";
 }
 
 TEST(ProtocolAdapter, SplittingDoesNotDependOnChunking) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -158,9 +159,26 @@ TEST(ArduinoSketch, TheFirmwareDialectEncodesRequestsAsTheRealClientSendsThem) {
   EXPECT_EQ(encode_text(Message{0x01, Ping{}}, Dialect::readme), "^01|PING|*11$");
   EXPECT_EQ(encode_text(Message{0x01, Ack{""}}, Dialect::firmware), "^01|ACK|*48$");
   EXPECT_EQ(dialect_named("firmware"), Dialect::firmware);
-  EXPECT_EQ(dialect_named(""), Dialect::readme);
+  EXPECT_EQ(dialect_named(""), Dialect::firmware);
+  EXPECT_EQ(dialect_named(""), kDefaultDialect);
   EXPECT_EQ(dialect_named("readme"), Dialect::readme);
   EXPECT_THROW(dialect_named("sketch"), ProfileError);
+}
+
+TEST(ArduinoSketch, TheRealClientsFramesTypeAsTheirRequestsInTheFirmwareDialect) {
+  const auto typed = [](std::string_view raw, Dialect d) -> std::optional<Message> {
+    const auto item = decode_frame(to_bytes(raw), d);
+    if (const auto* f = std::get_if<Frame<Message>>(&item)) return f->message;
+    return std::nullopt;
+  };
+  // robot_client.py at 8dcfab0 sends these.
+  EXPECT_EQ(typed("^01|PING| *31$", Dialect::firmware), (Message{0x01, Ping{}}));
+  EXPECT_EQ(typed("^05|B| *67$", Dialect::firmware), (Message{0x05, SonarRead{}}));
+  EXPECT_EQ(typed("^02|V|160*63$", Dialect::firmware), (Message{0x02, SetSpeed{160}}));
+  // The README's empty payload still types; a space is only the sketch's.
+  EXPECT_EQ(typed("^01|PING|*11$", Dialect::firmware), (Message{0x01, Ping{}}));
+  EXPECT_EQ(typed("^01|PING| *31$", Dialect::readme), std::nullopt);
+  EXPECT_EQ(typed("^01|PING|  *11$", Dialect::firmware), std::nullopt) << "two spaces";
 }
 
 TEST(ArduinoSketch, PayloadNumbersAreReadAsAtolReadsThem) {

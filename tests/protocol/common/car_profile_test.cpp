@@ -29,9 +29,10 @@ TEST(CarProfiles, EveryCarHasExactlyOneDefaultAndUniqueNames) {
 }
 
 TEST(CarProfiles, TheDefaultsAreTheBoardPeopleOwnAndTheReadme) {
-  EXPECT_EQ(default_car_profile("arduino").name, "readme");
+  EXPECT_EQ(default_car_profile("arduino").name, "firmware");
   EXPECT_EQ(default_car_profile("leka").name, "readme");
-  EXPECT_EQ(find_car_profile("arduino", "").name, "readme");
+  EXPECT_EQ(default_car_profile("logi").name, "guide");
+  EXPECT_EQ(find_car_profile("arduino", "").name, "firmware");
   EXPECT_EQ(find_car_profile("arduino", "readme").car, "arduino");
 }
 
@@ -41,8 +42,8 @@ TEST(CarProfiles, AWrongNameIsRefusedWithTheValidOnes) {
     FAIL() << "no error";
   } catch (const ProfileError& e) {
     EXPECT_STREQ(e.what(),
-                 "arduino has no profile 'firmwar'; its profiles are readme (the default) and "
-                 "firmware");
+                 "arduino has no profile 'firmwar'; its profiles are firmware (the default) and "
+                 "readme");
   }
   EXPECT_EQ(car_profile_problem("arduino", "firmware"), "");
   EXPECT_EQ(car_profile_problem("arduino", ""), "");
@@ -57,7 +58,7 @@ TEST(CarProfiles, AWrongNameIsRefusedWithTheValidOnes) {
   }
   EXPECT_THROW(car_profiles_of("tank"), ProfileError);
   EXPECT_EQ(car_profile_names("leka"), "readme (the default) and comspecs-v3");
-  EXPECT_EQ(car_profile_names("arduino"), "readme (the default) and firmware");
+  EXPECT_EQ(car_profile_names("arduino"), "firmware (the default) and readme");
 }
 
 }  // namespace
