@@ -8,10 +8,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "tests/apps/client_program_support.hpp"
 
@@ -29,22 +30,21 @@ std::vector<std::string> delivered_to_car_of(const std::string& wire_log) {
 // frame may span records. A record gives its bytes as "hex", or as "text"
 // when they are all printable.
 std::string delivered_bytes_of(const std::string& wire_log) {
-  static const std::regex hex_field(R"re("hex":"([0-9A-F ]*)")re");
-  static const std::regex text_field(R"re("text":"((?:[^"\\]|\\.)*)")re");
   std::string out;
-  const auto add = [&](const std::string& hex) { out += (out.empty() ? "" : " ") + hex; };
-  for (const auto& record : delivered_to_car_of(wire_log)) {
-    std::smatch m;
-    if (std::regex_search(record, m, hex_field)) {
-      add(m[1].str());
-    } else if (std::regex_search(record, m, text_field)) {
-      const std::string text = m[1].str();
-      for (std::size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i] == '\\' && i + 1 < text.size() ? text[++i] : text[i];
-        char byte[4];
-        std::snprintf(byte, sizeof byte, "%02X", static_cast<unsigned char>(c));
-        add(byte);
-      }
+  const auto add = [&](unsigned char byte) {
+    char hex[4];
+    std::snprintf(hex, sizeof hex, "%s%02X", out.empty() ? "" : " ", byte);
+    out += hex;
+  };
+  for (const auto& line : delivered_to_car_of(wire_log)) {
+    const auto record = nlohmann::json::parse(line);
+    if (record.contains("hex")) {
+      std::istringstream hex(record["hex"].get<std::string>());
+      for (unsigned byte = 0; hex >> std::hex >> byte;)
+        add(static_cast<unsigned char>(byte));
+    } else {
+      for (const char c : record["text"].get<std::string>())
+        add(static_cast<unsigned char>(c));
     }
   }
   return out;
