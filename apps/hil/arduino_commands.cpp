@@ -33,24 +33,24 @@ Commands: PING STATUS V <pwm> M <cm> R <deg> S B I HELP (lowercase accepted),
 Examples:
   hil encode arduino --seq 2 V 160            ^02|V|160*63$
   hil encode arduino --seq 4 R -90            ^04|R|-90*72$
-  hil encode arduino --seq 8 STATUS           ^08|STATUS|*1C$
+  hil encode arduino --seq 8 STATUS           ^08|STATUS| *3C$  (the real sketch wants one space)
   hil encode arduino --seq 1 ACK OK           ^01|ACK|OK*4C$
   hil encode arduino --seq 4 NACK BAD_CS      ^04|NACK|BAD_CS*0B$
   hil encode arduino --seq 9 --raw JUMP HIGH  ^09|JUMP|HIGH*05$
   hil encode arduino --body 'G1|PING|'        ^G1|PING|*66$
   hil encode arduino --seq 2 V 160 --checksum 00   ^02|V|160*00$
-  hil encode arduino --profile firmware PING  ^01|PING| *31$  (the real client's one-space payload))";
+  hil encode arduino --profile readme PING    ^01|PING|*11$  (the README's empty payload))";
 
 constexpr const char* kArduinoDecodeFooter =
     R"(Frames on the command line are joined in order and decoded as one stream;
 quote them, the shell treats ^ $ | * specially. Exit status: 0 all frames, 1 any error, 2 no bytes.
 Examples:
-  hil decode arduino '^02|V|160*63$'
-  hil decode arduino '^01|PING|*11$^01|ACK|OK*4C$'
-  hil decode arduino --nack '^2A|S|*00$'       also print the NACK the firmware answers
-  hil decode arduino --firmware -f capture.bin  the firmware's 96-byte frame bound
-  hil decode arduino --hex '5E 30 37 7C 53 7C 2A 35 34 24'
-  hil decode arduino --profile firmware '^01|PING|*11$'   what the real sketch does with it)";
+  hil decode arduino '^02|V|160*63$'                what the real sketch takes from it
+  hil decode arduino '^01|PING|*11$'                the README's PING: the sketch answers BAD_FMT
+  hil decode arduino --profile readme '^01|PING|*11$^01|ACK|OK*4C$'
+  hil decode arduino --profile readme --nack '^2A|S|*00$'   also print the NACK it answers
+  hil decode arduino --profile readme --firmware -f capture.bin  the 96-byte frame bound
+  hil decode arduino --hex '5E 30 37 7C 53 7C 20 2A 37 34 24')";
 
 // Decimal 0..255, or 0x00..0xFF.
 std::optional<std::uint8_t> parse_seq(const std::string& text) {

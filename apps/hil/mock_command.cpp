@@ -628,7 +628,7 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka"}));
   cmd->add_option("--profile", args->profile,
                   "The car's profile, its dialect (hil profiles CAR lists them; default: the "
-                  "car's default profile), e.g. arduino --profile firmware plays the real sketch");
+                  "car's default profile), e.g. arduino --profile readme plays the README's board");
   cmd->add_option(
       "--bind", args->bind,
       "Address TCP cars listen on (default 127.0.0.1; 0.0.0.0 opens it to the network)");

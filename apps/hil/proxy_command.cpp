@@ -35,7 +35,7 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka", "raw"}));
   cmd->add_option("--profile", args->profile,
                   "The car's profile the frames are judged by (hil profiles CAR lists them; "
-                  "default: the car's default), e.g. arduino --profile firmware");
+                  "default: the car's default), e.g. arduino --profile readme");
   cmd->add_option("--listen", args->listen,
                   "Where the client connects: tcp://127.0.0.1:PORT or pty:///PATH[?baud=9600]")
       ->required();
