@@ -269,8 +269,8 @@ void register_arduino(CommandSet& commands) {
   auto* enc = commands.encode.add_subcommand(
       "arduino", "Arduino robot frame ^SEQ|CMD|PAYLOAD*CS$, e.g. --seq 2 V 160 or ACK OK");
   add_profile_option(*enc, encode_args->profile, "arduino",
-                     "readme (the default) or firmware: argument-less requests with the one-space "
-                     "payload the real sketch needs");
+                     "firmware (the default): argument-less requests with the one-space payload "
+                     "the real sketch needs; or readme, the README's empty payload");
   enc->add_option("words", encode_args->words,
                   "CMD then PAYLOAD words (V 160), or one CMD:PAYLOAD token (V:160)");
   auto* seq = enc->add_option("--seq", encode_args->seq,
@@ -292,8 +292,8 @@ void register_arduino(CommandSet& commands) {
       commands.decode.add_subcommand("arduino", "Decode Arduino robot frames or a byte stream");
   add_decode_input(*dec, decode_args->input, false);
   add_profile_option(*dec, decode_args->profile, "arduino",
-                     "readme (the default: the README's rules) or firmware: what the real sketch "
-                     "does with each frame (acted on, refused with a NACK, or dropped)");
+                     "firmware (the default): what the real sketch does with each frame (acted "
+                     "on, refused with a NACK, or dropped); or readme, the README's rules");
   dec->add_flag("--firmware", decode_args->firmware,
                 "Use the firmware's 96-byte frame bound instead of the PC's 256-byte guard");
   dec->add_option("--max-frame-bytes", decode_args->max_frame_bytes,
