@@ -38,6 +38,18 @@ TcpEndpoint parse_tcp(std::string_view uri, std::string_view rest) {
   return e;
 }
 
+/// The `?key=value&...` options of a URI, each handed to `option(key, value)`.
+template <typename Option>
+void parse_options(std::string_view query, Option option) {
+  for (const std::string_view item : protocol::split(query, '&')) {
+    const std::size_t eq = item.find('=');
+    option(item.substr(0, eq),
+           eq == std::string_view::npos ? std::string_view{} : item.substr(eq + 1));
+  }
+}
+
+constexpr unsigned long long kMaxBaud = 4'000'000;
+
 PtyEndpoint parse_pty(std::string_view uri, std::string_view rest) {
   const std::size_t q = rest.find('?');
   PtyEndpoint e;
@@ -46,19 +58,28 @@ PtyEndpoint parse_pty(std::string_view uri, std::string_view rest) {
     fail(uri, "expected pty:///ABSOLUTE/PATH (three slashes), e.g. pty:///tmp/hil-arduino0");
   }
   if (q == std::string_view::npos) return e;
-  for (const std::string_view option : protocol::split(rest.substr(q + 1), '&')) {
-    const std::size_t eq = option.find('=');
-    const std::string_view key = option.substr(0, eq);
-    const std::string_view value =
-        eq == std::string_view::npos ? std::string_view{} : option.substr(eq + 1);
+  parse_options(rest.substr(q + 1), [&](std::string_view key, std::string_view value) {
     if (key == "baud") {
-      e.baud = static_cast<unsigned>(number(uri, value, "baud", 4'000'000));
+      e.baud = static_cast<unsigned>(number(uri, value, "baud", kMaxBaud));
     } else if (key == "reset_ms") {
       e.reset_on_open = milliseconds(number(uri, value, "reset_ms", 60'000));
     } else {
       fail(uri, "unknown option '" + std::string(key) + "' (known: baud, reset_ms)");
     }
-  }
+  });
+  return e;
+}
+
+MemEndpoint parse_mem(std::string_view uri, std::string_view rest) {
+  const std::size_t q = rest.find('?');
+  MemEndpoint e;
+  e.name = std::string(rest.substr(0, q));
+  if (e.name.empty()) fail(uri, "expected mem://NAME, e.g. mem://car0 or mem://car0?baud=9600");
+  if (q == std::string_view::npos) return e;
+  parse_options(rest.substr(q + 1), [&](std::string_view key, std::string_view value) {
+    if (key != "baud") fail(uri, "unknown option '" + std::string(key) + "' (known: baud)");
+    e.baud = static_cast<unsigned>(number(uri, value, "baud", kMaxBaud));
+  });
   return e;
 }
 
@@ -73,10 +94,7 @@ Endpoint parse_endpoint(std::string_view uri) {
   const std::string_view rest = uri.substr(sep + 3);
   if (scheme == "tcp") return parse_tcp(uri, rest);
   if (scheme == "pty") return parse_pty(uri, rest);
-  if (scheme == "mem") {
-    if (rest.empty()) fail(uri, "expected mem://NAME");
-    return MemEndpoint{std::string(rest)};
-  }
+  if (scheme == "mem") return parse_mem(uri, rest);
   fail(uri, "unknown scheme '" + std::string(scheme) + "' (known: tcp, pty, mem)");
 }
 
@@ -101,7 +119,9 @@ std::string to_uri(const Endpoint& endpoint) {
             }
             return uri;
           },
-          [](const MemEndpoint& e) { return "mem://" + e.name; }},
+          [](const MemEndpoint& e) {
+            return "mem://" + e.name + (e.baud != 0 ? "?baud=" + std::to_string(e.baud) : "");
+          }},
       endpoint);
 }
 

@@ -2,7 +2,7 @@
 // Transport endpoints chosen by URI:
 //   tcp://127.0.0.1:9000
 //   pty:///tmp/hil-arduino0?baud=9600&reset_ms=200
-//   mem://car0
+//   mem://car0?baud=9600
 
 #include <cstdint>
 #include <stdexcept>
@@ -32,6 +32,10 @@ struct PtyEndpoint {
 
 struct MemEndpoint {
   std::string name;
+  /// Serial pacing in both directions, as on a pty (8N1: 10 bits per byte),
+  /// in the executor's time; 0 = unpaced. A listener's rate is the line's:
+  /// a client connecting to it is paced at it whatever its own URI says.
+  unsigned baud = 0;
   friend bool operator==(const MemEndpoint&, const MemEndpoint&) = default;
 };
 

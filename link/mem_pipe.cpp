@@ -3,13 +3,22 @@
 #include <deque>
 
 #include "link/endpoint.hpp"
+#include "link/serial_pacer.hpp"
 
 namespace hil::link {
 namespace {
 
+// Beyond the line time of the queued bytes: the pacer's tick rounding.
+constexpr Duration kLineSlack = milliseconds(20);
+
 class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPipe> {
  public:
-  MemPipe(Executor& executor, std::string name) : executor_(executor), name_(std::move(name)) {}
+  MemPipe(Executor& executor, std::string name, unsigned baud)
+      : executor_(executor),
+        name_(std::move(name)),
+        baud_(baud),
+        line_(executor, baud,
+              [this](ByteView chunk) { arrive(Bytes(chunk.begin(), chunk.end())); }) {}
 
   void connect_to(const std::shared_ptr<MemPipe>& peer) { peer_ = peer; }
 
@@ -27,9 +36,13 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
     auto peer = peer_.lock();
     if (!peer) return;
     in_flight_ += bytes.size();
-    executor_.post([self = shared_from_this(), peer, data = Bytes(bytes.begin(), bytes.end())] {
-      self->in_flight_ -= data.size();
-      peer->receive(data);
+    if (baud_ != 0) {
+      line_.push(bytes);
+      watch_line();
+      return;
+    }
+    executor_.post([self = shared_from_this(), data = Bytes(bytes.begin(), bytes.end())] {
+      self->arrive(data);
     });
   }
 
@@ -37,10 +50,19 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
     if (!open_) return;
     open_ = false;
     if (auto peer = peer_.lock()) {
-      if (mode == CloseMode::reset) peer->discard_ = true;  // data in flight is lost, as with RST
-      const auto ec = mode == CloseMode::reset ? std::make_error_code(std::errc::connection_reset)
-                                               : end_of_stream();
-      executor_.post([peer, ec] { peer->remote_closed(ec); });
+      if (mode == CloseMode::reset) {
+        peer->discard_ = true;  // data in flight is lost, as with RST
+        line_.clear();
+        in_flight_ = 0;
+        watching_line_ = false;
+        close_after_line_ = false;
+        executor_.post(
+            [peer] { peer->remote_closed(std::make_error_code(std::errc::connection_reset)); });
+      } else if (watching_line_) {
+        close_after_line_ = true;  // the end of the stream follows the bytes on the line
+      } else {
+        executor_.post([peer] { peer->remote_closed(end_of_stream()); });
+      }
     }
     executor_.post([self = shared_from_this()] { self->notify_close(closed_here()); });
   }
@@ -50,6 +72,34 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
   std::string describe() const override { return "mem " + name_; }
 
  private:
+  /// While bytes are on a paced line, a timer on the executor holds this
+  /// end until they are all out (so what was written arrives even if its
+  /// owner lets go of it, and nothing is held once the executor is gone);
+  /// a graceful close reaches the peer after them.
+  void watch_line() {
+    auto self = shared_from_this();
+    if (keep_timer_ != 0) executor_.cancel(keep_timer_);
+    const auto queued = static_cast<Duration::rep>(line_.queued() + 1);
+    const Time until = executor_.now() + SerialPacer::byte_time(baud_) * queued + kLineSlack;
+    keep_timer_ = executor_.call_at(until, [self] { self->keep_timer_ = 0; });
+    if (watching_line_) return;
+    watching_line_ = true;
+    line_.when_drained([this] {
+      watching_line_ = false;
+      if (!close_after_line_) return;
+      close_after_line_ = false;
+      if (auto peer = peer_.lock()) {
+        executor_.post([peer] { peer->remote_closed(end_of_stream()); });
+      }
+    });
+  }
+
+  /// Bytes written here reach the peer.
+  void arrive(const Bytes& data) {
+    in_flight_ -= std::min(in_flight_, data.size());
+    if (auto peer = peer_.lock()) peer->receive(data);
+  }
+
   void receive(const Bytes& data) {
     if (discard_ || closed_notified_) return;
     if (!started_) {
@@ -93,6 +143,11 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
   std::deque<Bytes> early_;
   std::optional<std::error_code> early_close_;
   std::size_t in_flight_ = 0;
+  unsigned baud_;
+  SerialPacer line_;  // this end's writes; unused when unpaced
+  Executor::TimerId keep_timer_ = 0;
+  bool watching_line_ = false;
+  bool close_after_line_ = false;
   bool open_ = true;
   bool started_ = false;
   bool discard_ = false;
@@ -101,9 +156,10 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
 
 }  // namespace
 
-std::pair<BytePipePtr, BytePipePtr> make_mem_pipe(Executor& executor, const std::string& name) {
-  auto a = std::make_shared<MemPipe>(executor, name + " (client end)");
-  auto b = std::make_shared<MemPipe>(executor, name + " (server end)");
+std::pair<BytePipePtr, BytePipePtr> make_mem_pipe(Executor& executor, const std::string& name,
+                                                  unsigned baud) {
+  auto a = std::make_shared<MemPipe>(executor, name + " (client end)", baud);
+  auto b = std::make_shared<MemPipe>(executor, name + " (server end)", baud);
   a->connect_to(b);
   b->connect_to(a);
   return {a, b};
@@ -111,6 +167,7 @@ std::pair<BytePipePtr, BytePipePtr> make_mem_pipe(Executor& executor, const std:
 
 struct MemNetwork::Entry {
   std::function<void(BytePipePtr)> on_accept;
+  unsigned baud = 0;
   bool open = true;
 };
 
@@ -128,7 +185,7 @@ class MemListener final : public Listener {
     entry_->open = false;
     network_.listeners_.erase(name_);
   }
-  std::string address() const override { return "mem://" + name_; }
+  std::string address() const override { return to_uri(MemEndpoint{name_, entry_->baud}); }
 
  private:
   MemNetwork& network_;
@@ -136,9 +193,10 @@ class MemListener final : public Listener {
   std::shared_ptr<MemNetwork::Entry> entry_;
 };
 
-std::unique_ptr<Listener> MemNetwork::listen(const std::string& name) {
+std::unique_ptr<Listener> MemNetwork::listen(const std::string& name, unsigned baud) {
   if (listeners_.count(name) != 0) throw EndpointError("mem://" + name + " is already listened on");
   auto entry = std::make_shared<Entry>();
+  entry->baud = baud;
   listeners_.emplace(name, entry);
   return std::make_unique<MemListener>(*this, name, entry);
 }
@@ -151,7 +209,7 @@ void MemNetwork::connect(const std::string& name, ConnectHandler handler) {
     });
     return;
   }
-  auto [client, server] = make_mem_pipe(executor_, name);
+  auto [client, server] = make_mem_pipe(executor_, name, it->second->baud);
   // The server learns of the connection first, as with a TCP accept.
   executor_.post([entry = it->second, server = server] {
     if (entry->open && entry->on_accept) entry->on_accept(server);

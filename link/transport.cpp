@@ -37,7 +37,7 @@ std::unique_ptr<Listener> listen(TransportContext& context, const Endpoint& endp
                                                real_time_io(context, "pty"), context.executor, e);
                                          },
                                          [&](const MemEndpoint& e) -> std::unique_ptr<Listener> {
-                                           return mem_network(context).listen(e.name);
+                                           return mem_network(context).listen(e.name, e.baud);
                                          }},
                     endpoint);
 }

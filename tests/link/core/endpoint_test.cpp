@@ -25,11 +25,13 @@ TEST(Endpoint, ParsesPtyWithOptions) {
 
 TEST(Endpoint, ParsesMem) {
   EXPECT_EQ(parse_endpoint("mem://car0"), (Endpoint{MemEndpoint{"car0"}}));
+  EXPECT_EQ(parse_endpoint("mem://car0?baud=9600"), (Endpoint{MemEndpoint{"car0", 9600}}));
 }
 
 TEST(Endpoint, RoundTripsThroughText) {
-  for (const char* uri : {"tcp://127.0.0.1:9000", "tcp://[::1]:80",
-                          "pty:///tmp/a?baud=9600&reset_ms=200", "pty:///tmp/b", "mem://x"}) {
+  for (const char* uri :
+       {"tcp://127.0.0.1:9000", "tcp://[::1]:80", "pty:///tmp/a?baud=9600&reset_ms=200",
+        "pty:///tmp/b", "mem://x", "mem://x?baud=115200"}) {
     EXPECT_EQ(to_uri(parse_endpoint(uri)), uri);
   }
 }
@@ -52,6 +54,9 @@ TEST(Endpoint, ErrorsSayWhatWasExpected) {
   EXPECT_THAT(message("pty:///tmp/x?baud=fast"), HasSubstr("baud 'fast'"));
   EXPECT_THAT(message("udp://1.2.3.4:5"), HasSubstr("unknown scheme 'udp'"));
   EXPECT_THAT(message("mem://"), HasSubstr("mem://NAME"));
+  EXPECT_THAT(message("mem://car0?reset_ms=200"),
+              HasSubstr("unknown option 'reset_ms' (known: baud)"));
+  EXPECT_THAT(message("mem://car0?baud=5000000"), HasSubstr("baud '5000000' is not a number"));
 }
 
 }  // namespace

@@ -72,6 +72,105 @@ TEST(MemPipe, ResetDropsDataInFlight) {
   EXPECT_EQ(rb.closed, std::make_error_code(std::errc::connection_reset));
 }
 
+// A paced line: 9600 baud, 8N1, so byte k of a burst is in once its last
+// bit is, at (k + 1) * 1.0417 ms.
+TEST(MemPipe, APacedLineDeliversEachByteOnceItsLastBitIsSent) {
+  VirtualExecutor ex;
+  auto [a, b] = make_mem_pipe(ex, "t", 9600);
+  PipeRecorder ra, rb;
+  a->start(ra.handlers());
+  b->start(rb.handlers());
+  a->write(protocol::to_bytes("^01|PING| *31$"));  // 14 bytes: 14.58 ms on the line
+  EXPECT_EQ(a->queued_bytes(), 14u);
+  ex.run_until(Time(std::chrono::nanoseconds(14'583'333)));
+  EXPECT_EQ(rb.data, "^01|PING| *31");  // the 14th byte's last bit is not out yet
+  ex.run_until(Time(std::chrono::nanoseconds(14'583'334)));
+  EXPECT_EQ(rb.data, "^01|PING| *31$");
+  EXPECT_EQ(a->queued_bytes(), 0u);
+}
+
+TEST(MemPipe, APacedLinePacesEachDirectionOnItsOwn) {
+  VirtualExecutor ex;
+  auto [a, b] = make_mem_pipe(ex, "t", 9600);
+  PipeRecorder ra, rb;
+  a->start(ra.handlers());
+  b->start(rb.handlers());
+  a->write(protocol::to_bytes("0123456789"));
+  b->write(protocol::to_bytes("abcde"));
+  ex.run_until(Time(milliseconds(6)));
+  EXPECT_EQ(ra.data, "abcde");  // 5.21 ms
+  EXPECT_EQ(rb.data, "01234");
+  ex.run_until(Time(milliseconds(11)));
+  EXPECT_EQ(rb.data, "0123456789");  // 10.42 ms
+}
+
+TEST(MemPipe, OnAPacedLineTheEndOfStreamFollowsTheBytesStillOnIt) {
+  VirtualExecutor ex;
+  auto [a, b] = make_mem_pipe(ex, "t", 9600);
+  PipeRecorder ra, rb;
+  a->start(ra.handlers());
+  b->start(rb.handlers());
+  a->write(protocol::to_bytes("last"));
+  a->close(CloseMode::graceful);
+  ex.run_until(Time(milliseconds(4)));
+  EXPECT_EQ(rb.data, "las");
+  EXPECT_FALSE(rb.closed.has_value()) << "the close may not overtake the bytes";
+  ex.run_until_idle();
+  EXPECT_EQ(rb.data, "last");
+  EXPECT_EQ(rb.closed, end_of_stream());
+}
+
+TEST(MemPipe, APacedLineDeliversWhatWasWrittenAfterItsWriterIsDropped) {
+  VirtualExecutor ex;
+  PipeRecorder rb;
+  BytePipePtr b;
+  {
+    auto [a, server] = make_mem_pipe(ex, "t", 9600);
+    b = server;
+    b->start(rb.handlers());
+    a->write(protocol::to_bytes("bye"));
+    a->close(CloseMode::graceful);
+  }
+  ex.run_until_idle();
+  EXPECT_EQ(rb.data, "bye");
+  EXPECT_EQ(rb.closed, end_of_stream());
+}
+
+TEST(MemPipe, AResetOnAPacedLineDropsWhatIsStillOnIt) {
+  VirtualExecutor ex;
+  auto [a, b] = make_mem_pipe(ex, "t", 9600);
+  PipeRecorder ra, rb;
+  a->start(ra.handlers());
+  b->start(rb.handlers());
+  a->write(protocol::to_bytes("0123456789"));
+  ex.run_until(Time(milliseconds(3)));
+  a->close(CloseMode::reset);
+  ex.run_until_idle();
+  EXPECT_EQ(rb.data, "01");  // in by 2.08 ms; the rest was still on the line
+  EXPECT_EQ(rb.closed, std::make_error_code(std::errc::connection_reset));
+}
+
+TEST(MemNetwork, AListenersBaudPacesEveryConnectionToIt) {
+  VirtualExecutor ex;
+  MemNetwork net(ex);
+  auto listener = net.listen("car0", 9600);
+  EXPECT_EQ(listener->address(), "mem://car0?baud=9600");
+  BytePipePtr server, client;
+  listener->start([&](BytePipePtr p) { server = std::move(p); });
+  net.connect("car0", [&](std::error_code, BytePipePtr p) { client = std::move(p); });
+  ex.run_until_idle();
+  ASSERT_TRUE(server && client);
+  PipeRecorder rs, rc;
+  server->start(rs.handlers());
+  client->start(rc.handlers());
+  const Time start = ex.now();
+  client->write(protocol::to_bytes("0123456789"));
+  ex.run_until(start + milliseconds(10));
+  EXPECT_EQ(rs.data, "012345678");
+  ex.run_until(start + milliseconds(11));
+  EXPECT_EQ(rs.data, "0123456789");
+}
+
 TEST(MemNetwork, ConnectsToAListener) {
   VirtualExecutor ex;
   MemNetwork net(ex);

@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "link/pty.hpp"
+#include "link/serial_pacer.hpp"
 
 namespace hil::link {
 namespace {
@@ -100,6 +100,19 @@ TEST(SerialPacer, HighRatesReleaseChunksAtMostOncePerTick) {
   for (std::size_t i = 1; i < p.arrivals.size(); ++i) {
     EXPECT_GE(p.arrivals[i].at - p.arrivals[i - 1].at, milliseconds(1));
   }
+}
+
+TEST(SerialPacer, TheFirstByteOfTheFirstBurstIsNotHeldForATick) {
+  // At 115200 baud a byte is 86.8 us: the first one is due long before the
+  // 1 ms tick, and nothing was released before it to space it from.
+  Paced p(115200, milliseconds(1));
+  p.pacer.push(counting(3));
+  p.ex.run_until_idle();
+  ASSERT_EQ(p.arrivals.size(), 2u);
+  EXPECT_EQ(p.arrivals[0].at, nanoseconds(86'806));
+  EXPECT_EQ(p.arrivals[0].bytes, 1u);
+  EXPECT_EQ(p.arrivals[1].at, nanoseconds(86'806) + milliseconds(1));
+  EXPECT_EQ(p.arrivals[1].bytes, 2u);
 }
 
 TEST(SerialPacer, LongStreamsKeepExactTiming) {
