@@ -79,14 +79,16 @@ void bare_box2d(benchmark::State& state) {
   for (auto _ : state) {
     // What Vehicle::before_step hands Box2D: the twist turned into the arena
     // frame (the footprint is centred, so no centre-of-mass correction).
-    const double angle = body->GetAngle();
+    const double angle = static_cast<double>(body->GetAngle());
     body->SetLinearVelocity(b2Vec2(static_cast<float>(kDriveSpeed_mps * std::cos(angle)),
                                    static_cast<float>(kDriveSpeed_mps * std::sin(angle))));
     body->SetAngularVelocity(static_cast<float>(kTurnRate_radps));
     world.Step(static_cast<float>(kStepSeconds), 8, 3);
   }
   const b2Vec2 p = body->GetPosition();
-  if (const auto error = off_circle({p.x, p.y}); !error.empty()) state.SkipWithError(error.c_str());
+  if (const auto error = off_circle({static_cast<double>(p.x), static_cast<double>(p.y)});
+      !error.empty())
+    state.SkipWithError(error.c_str());
 }
 
 // Which sensors a model benchmark reads after every step.

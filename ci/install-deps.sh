@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  clang libclang-rt-14-dev   # the ASan, TSan and libFuzzer trees (clang 14)
+  clang libclang-rt-14-dev   # every tree's compiler (clang 14), with its sanitizer and libFuzzer runtimes
   mold                       # the linker of every tree (cmake/hil_build_speed.cmake)
   libasio-dev                # standalone Asio (header-only)
   libgtest-dev libgmock-dev  # GoogleTest / GoogleMock

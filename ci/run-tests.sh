@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets up this machine (Debian 12) and runs every test hil has:
-#   1. the default RelWithDebInfo build and its whole CTest suite,
+#   1. the default RelWithDebInfo build (clang) and its whole CTest suite,
 #   2. the same suite built with AddressSanitizer + UndefinedBehaviorSanitizer
 #      (clang), in a tree that builds the libFuzzer targets too,
 #   3. the tests that start threads, processes or real sockets and ptys

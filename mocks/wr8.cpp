@@ -42,7 +42,7 @@ double value_of(wr8::Word w, wr8::ValueType type) {
     case wr8::ValueType::unsigned_int:
       return w.bits;
     case wr8::ValueType::float32:
-      return w.as_f32();
+      return static_cast<double>(w.as_f32());
   }
   return std::numeric_limits<double>::quiet_NaN();
 }

@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <set>
 
 namespace hil::sim {
 
 double Tape::distance_to_centerline(Vec2 p) const {
-  if (points_m.empty()) return INFINITY;
+  if (points_m.empty()) return std::numeric_limits<double>::infinity();
   if (points_m.size() == 1) return length(p - points_m.front());
-  double best = INFINITY;
+  double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i + 1 < points_m.size(); ++i) {
     best = std::min(best, distance_to_segment(p, points_m[i], points_m[i + 1]));
   }

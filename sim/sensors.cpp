@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hil::sim {
 
@@ -10,7 +11,7 @@ SonarReading read_sonar(const SonarDef& def, const Pose& pose, const RayCaster& 
   const Vec2 origin = pose.to_arena(def.mount_m);
   const double axis = pose.heading_rad + def.mount_angle_rad;
   // An ultrasonic echo comes back from the nearest surface anywhere in the cone.
-  double nearest = INFINITY;
+  double nearest = std::numeric_limits<double>::infinity();
   const int rays = std::max(1, def.rays);
   for (int i = 0; i < rays; ++i) {
     const double offset = rays == 1 ? 0.0 : def.beam_half_angle_rad * (2.0 * i / (rays - 1) - 1.0);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string_view>
@@ -374,7 +375,7 @@ class LabelPlacer {
       candidates.push_back({c.x, c.y + d + 11, 'm', ring});
     }
     std::size_t best = 0;
-    double best_cost = INFINITY;
+    double best_cost = std::numeric_limits<double>::infinity();
     Rect best_box;
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const auto& k = candidates[i];

@@ -28,6 +28,15 @@ b2Vec2 to_b2(Vec2 v) {
   return b2Vec2(static_cast<float>(v.x_m), static_cast<float>(v.y_m));
 }
 
+// Box2D keeps floats; hil's geometry is in doubles.
+Vec2 from_b2(b2Vec2 v) {
+  return {static_cast<double>(v.x), static_cast<double>(v.y)};
+}
+
+double angle_of(const b2Body& body) {
+  return static_cast<double>(body.GetAngle());
+}
+
 }  // namespace
 
 Vehicle::Vehicle(World& world, std::size_t index, VehicleDef def)
@@ -67,13 +76,13 @@ Vehicle::~Vehicle() {
 
 Pose Vehicle::pose() const {
   const b2Vec2 p = body_->GetPosition();
-  return {p.x, p.y, wrap_angle(body_->GetAngle())};
+  return {static_cast<double>(p.x), static_cast<double>(p.y), wrap_angle(angle_of(*body_))};
 }
 
 Twist Vehicle::velocity() const {
   const b2Vec2 v = body_->GetLinearVelocityFromLocalPoint(b2Vec2(0.0f, 0.0f));
-  const Vec2 body = rotate({v.x, v.y}, -body_->GetAngle());
-  return {body.x_m, body.y_m, body_->GetAngularVelocity()};
+  const Vec2 body = rotate(from_b2(v), -angle_of(*body_));
+  return {body.x_m, body.y_m, static_cast<double>(body_->GetAngularVelocity())};
 }
 
 void Vehicle::place(const Pose& pose) {
@@ -86,7 +95,8 @@ void Vehicle::before_step(double dt_s) {
   // Box2D keeps the angle unwrapped in a float; a car circling for hours
   // would lose turning precision, so bring it back near zero now and then.
   if (const float angle = body_->GetAngle(); std::abs(angle) > 8.0f) {
-    body_->SetTransform(body_->GetPosition(), static_cast<float>(wrap_angle(angle)));
+    body_->SetTransform(body_->GetPosition(),
+                        static_cast<float>(wrap_angle(static_cast<double>(angle))));
   }
   const Twist wheels = chassis_->update(dt_s);
 
@@ -102,13 +112,13 @@ void Vehicle::before_step(double dt_s) {
   // The ground gets what the wheels give, less slip; Box2D then resolves
   // contacts, so a wall stops or deflects the body whatever the wheels do.
   const double grip = 1.0 - std::clamp(def_.faults.wheel_slip_fraction, 0.0, 1.0);
-  const double angle = body_->GetAngle();
+  const double angle = angle_of(*body_);
   const Vec2 v_ref = rotate({wheels.vx_mps * grip, wheels.vy_mps * grip}, angle);
   const double wz = wheels.wz_radps * grip;
   // Box2D's linear velocity is the centre of mass's: add w x (com - reference).
   const b2Vec2 com = body_->GetWorldCenter() - body_->GetPosition();
-  body_->SetLinearVelocity(b2Vec2(static_cast<float>(v_ref.x_m - wz * double{com.y}),
-                                  static_cast<float>(v_ref.y_m + wz * double{com.x})));
+  body_->SetLinearVelocity(b2Vec2(static_cast<float>(v_ref.x_m - wz * static_cast<double>(com.y)),
+                                  static_cast<float>(v_ref.y_m + wz * static_cast<double>(com.x))));
   body_->SetAngularVelocity(static_cast<float>(wz));
 }
 

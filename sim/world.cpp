@@ -28,7 +28,8 @@ class World::ContactListener final : public b2ContactListener {
       b2WorldManifold manifold;
       contact->GetWorldManifold(&manifold);
       if (contact->GetManifold()->pointCount > 0)
-        point = {manifold.points[0].x, manifold.points[0].y};
+        point = {static_cast<double>(manifold.points[0].x),
+                 static_cast<double>(manifold.points[0].y)};
     }
     one_side(a, b, phase, point);
     one_side(b, a, phase, point);
@@ -234,7 +235,7 @@ std::optional<double> World::ray_cast(Vec2 from, Vec2 to, const b2Body* ignore) 
   b2_->RayCast(&callback, b2Vec2(static_cast<float>(from.x_m), static_cast<float>(from.y_m)),
                b2Vec2(static_cast<float>(to.x_m), static_cast<float>(to.y_m)));
   if (!callback.fraction()) return std::nullopt;
-  return double{*callback.fraction()} * length_m;
+  return static_cast<double>(*callback.fraction()) * length_m;
 }
 
 }  // namespace hil::sim

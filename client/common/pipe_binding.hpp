@@ -74,14 +74,19 @@ PipeBinding::Handlers core_handlers(Core& core, Now now, After after) {
     core.on_connected(now());
     after();
   };
-  h.connect_failed = [&core, now, after](std::error_code ec) {
-    if constexpr (requires { core.on_connect_failed(now(), ec.message()); }) {
+  if constexpr (requires { core.on_connect_failed(now(), std::string()); }) {
+    h.connect_failed = [&core, now, after](std::error_code ec) {
       core.on_connect_failed(now(), ec.message());
-    } else if constexpr (requires { core.on_connect_failed(now()); }) {
+      after();
+    };
+  } else if constexpr (requires { core.on_connect_failed(now()); }) {
+    h.connect_failed = [&core, now, after](std::error_code) {
       core.on_connect_failed(now());
-    }
-    after();
-  };
+      after();
+    };
+  } else {
+    h.connect_failed = [after](std::error_code) { after(); };
+  }
   h.bytes = [&core, now, after](protocol::ByteView bytes) {
     core.on_bytes(now(), bytes);
     after();

@@ -185,7 +185,7 @@ double value(const wr8::Data& data, std::uint8_t code) {
         return v.value.as_i32();
       case wr8::data_code::speed:
       case wr8::data_code::wheel_angle:
-        return v.value.as_f32();
+        return static_cast<double>(v.value.as_f32());
       default:
         return v.value.bits;
     }

@@ -7,6 +7,7 @@
 #include "sim/svg.hpp"
 
 #include <gtest/gtest.h>
+#include <limits>
 
 #include <clocale>
 #include <cmath>
@@ -496,7 +497,10 @@ TEST(Svg, FootprintAndHeadingSitAtTheLastPose) {
   };
   const auto corners = points_of("class=\"footprint\"");
   ASSERT_EQ(corners.size(), 4u);
-  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  double x0 = std::numeric_limits<double>::infinity(),
+         x1 = -std::numeric_limits<double>::infinity(),
+         y0 = std::numeric_limits<double>::infinity(),
+         y1 = -std::numeric_limits<double>::infinity();
   for (const auto& p : corners) {
     x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
   }

@@ -7,6 +7,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
+#include <limits>
 
 #include <cmath>
 #include <cstdlib>
@@ -139,11 +140,12 @@ class Browser {
 };
 
 inline double number(const json& dataset, const char* key) {
-  if (!dataset.is_object() || !dataset.contains(key) || !dataset[key].is_string()) return NAN;
+  if (!dataset.is_object() || !dataset.contains(key) || !dataset[key].is_string())
+    return std::numeric_limits<double>::quiet_NaN();
   try {
     return std::stod(dataset[key].get<std::string>());
   } catch (const std::exception&) {
-    return NAN;
+    return std::numeric_limits<double>::quiet_NaN();
   }
 }
 
