@@ -45,7 +45,9 @@ using hil::sim::kStepsPerSecond;
 
 constexpr const char* kStack = "stack";
 constexpr const char* kBare = "bare_box2d";
-constexpr std::uint64_t kSeed = 1;
+// For a scenario file without a seed of its own, so every run covers the
+// same simulated time.
+constexpr std::uint64_t kSeedWhenTheFileHasNone = 1;
 
 struct Subject {
   hil::harness::Scenario scenario;
@@ -60,7 +62,7 @@ Subject& subject() {
 
 hil::harness::RunOptions run_options() {
   hil::harness::RunOptions options;
-  options.seed = kSeed;
+  if (!subject().scenario.seed) options.seed = kSeedWhenTheFileHasNone;
   return options;
 }
 
@@ -94,13 +96,13 @@ void bare_box2d(benchmark::State& state) {
     hil::bench::add_bare_arena(*world, arena);
     b2Body* body = hil::bench::add_bare_car(*world, car, hil::sim::Pose{0.7, 0.7, 0.0});
     for (std::int64_t i = 0; i < steps; ++i) {
-      const double angle = body->GetAngle();
+      const double angle = static_cast<double>(body->GetAngle());
       body->SetLinearVelocity(b2Vec2(static_cast<float>(kSpeed_mps * std::cos(angle)),
                                      static_cast<float>(kSpeed_mps * std::sin(angle))));
       body->SetAngularVelocity(static_cast<float>(kTurnRate_radps));
       world->Step(static_cast<float>(kStepSeconds), 8, 3);
     }
-    end_x = body->GetPosition().x;
+    end_x = static_cast<double>(body->GetPosition().x);
   }
   // The circle (centre (0.7, 1.0)) stays between x 0.4 and 1.0: a car held
   // by a wall or stopped somewhere else did not measure a moving car.

@@ -271,9 +271,9 @@ bool ReferenceRun::build() {
   car.kind = scenario_.car;
   car.seed = mocks::car_seed(seed_, 0);
   car.name = "car0";
-  car.reply_latency = scenario_.reply_latency;
   try {
     mocks::apply_profile(car.configs, scenario_.car, scenario_.profile);
+    if (scenario_.reply_latency) car.configs.reply_latency = *scenario_.reply_latency;
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));
     car_ = std::make_unique<mocks::MockCar>(std::move(car));
   } catch (const std::exception& e) {
@@ -305,7 +305,14 @@ bool ReferenceRun::build() {
 }
 
 std::optional<link::Endpoint> ReferenceRun::listen_endpoint() {
-  if (!driver_->real_time()) return link::MemEndpoint{"car0"};
+  if (!driver_->real_time()) {
+    // A serial car's line keeps its baud in virtual time too: every byte
+    // takes its 10 bits of line time, as on the pty.
+    link::MemEndpoint mem{"car0"};
+    const link::Endpoint e = mocks::default_endpoint(scenario_.car, 0);
+    if (const auto* pty = std::get_if<link::PtyEndpoint>(&e)) mem.baud = pty->baud;
+    return mem;
+  }
   // A folder of this run's own for the pty and the actions file, so runs
   // in parallel never meet.
   std::string pattern = (std::filesystem::temp_directory_path() / "hil-run-XXXXXX").string();

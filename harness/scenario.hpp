@@ -194,8 +194,9 @@ struct Scenario {
   /// The car's profile (protocol/common/car_profile.hpp), mock and
   /// reference client alike; empty: the car's default.
   std::string profile;
-  /// The car's processing time before each answer; zero: in the same instant.
-  Duration reply_latency{0};
+  /// The car's processing time before each answer; none: its profile's
+  /// (protocol/common/car_profile.hpp). Zero: in the same instant.
+  std::optional<Duration> reply_latency;
   std::string world;                  ///< a world file; empty: the built-in arena for the car
   std::optional<std::uint64_t> seed;  ///< none: chosen per run and printed
   std::map<std::string, std::string> variables;  ///< ${name} in texts, already substituted

@@ -95,8 +95,8 @@ class ArduinoFirmware final : public Firmware {
 
   std::string_view protocol() const override { return "arduino"; }
   /// Frames the link by this robot's profile (its dialect).
-  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
-    return link::protocol_adapter("arduino", hil::protocol::arduino::to_string(config_.dialect));
+  std::string_view profile() const override {
+    return hil::protocol::arduino::to_string(config_.dialect);
   }
   std::string summary() const override;
 

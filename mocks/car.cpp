@@ -46,6 +46,7 @@ sim::VehicleDef vehicle_preset(CarKind kind) {
 
 void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view profile) {
   const protocol::CarProfile& p = protocol::find_car_profile(to_string(kind), profile);
+  configs.reply_latency = std::chrono::duration_cast<Duration>(p.reply_latency);
   switch (kind) {
     case CarKind::arduino:
       configs.arduino.dialect = protocol::arduino::dialect_named(p.name);
@@ -61,8 +62,11 @@ void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view prof
   }
 }
 
-std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
-                                        const FirmwareConfigs& configs) {
+namespace {
+
+std::unique_ptr<Firmware> make_firmware_of_kind(CarKind kind, sim::World& world,
+                                                sim::Vehicle& vehicle,
+                                                const FirmwareConfigs& configs) {
   switch (kind) {
     case CarKind::logi:
       return std::make_unique<LogiFirmware>(world, vehicle, configs.logi);
@@ -76,13 +80,22 @@ std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Ve
   throw std::invalid_argument("unknown car kind");
 }
 
+}  // namespace
+
+std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
+                                        const FirmwareConfigs& configs) {
+  auto firmware = make_firmware_of_kind(kind, world, vehicle, configs);
+  firmware->set_reply_latency(configs.reply_latency.value_or(std::chrono::duration_cast<Duration>(
+      protocol::default_car_profile(to_string(kind)).reply_latency)));
+  return firmware;
+}
+
 MockCar::MockCar(CarOptions options) : kind_(options.kind), name_(options.name) {
   world_ = std::make_unique<sim::World>(sim::WorldDef{std::move(options.arena), options.seed});
   sim::VehicleDef def = vehicle_preset(kind_);
   def.name = name_;
   vehicle_ = &world_->add_vehicle(std::move(def));
   firmware_ = make_firmware(kind_, *world_, *vehicle_, options.configs);
-  firmware_->set_reply_latency(options.reply_latency);
 }
 
 MockCar::~MockCar() = default;
@@ -90,6 +103,12 @@ MockCar::~MockCar() = default;
 std::uint64_t car_seed(std::uint64_t run_seed, std::size_t index) {
   return index == 0 ? run_seed : sim::mix_seed(run_seed, index);
 }
+
+namespace {
+unsigned profile_baud(CarKind kind) {
+  return protocol::default_car_profile(to_string(kind)).baud;
+}
+}  // namespace
 
 link::Endpoint default_endpoint(CarKind kind, std::size_t index) {
   const auto n = static_cast<std::uint16_t>(index);
@@ -99,9 +118,9 @@ link::Endpoint default_endpoint(CarKind kind, std::size_t index) {
     case CarKind::wr8:
       return link::TcpEndpoint{"127.0.0.1", static_cast<std::uint16_t>(9100 + n)};
     case CarKind::arduino:
-      return link::PtyEndpoint{"/tmp/hil-arduino" + std::to_string(index), 9600, {}};
+      return link::PtyEndpoint{"/tmp/hil-arduino" + std::to_string(index), profile_baud(kind), {}};
     case CarKind::leka:
-      return link::PtyEndpoint{"/tmp/hil-leka" + std::to_string(index), 115200, {}};
+      return link::PtyEndpoint{"/tmp/hil-leka" + std::to_string(index), profile_baud(kind), {}};
   }
   throw std::invalid_argument("unknown car kind");
 }

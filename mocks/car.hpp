@@ -35,11 +35,16 @@ struct FirmwareConfigs {
   Wr8Config wr8;
   ArduinoConfig arduino;
   LekaConfig leka;
+  /// The firmware's processing time before each answer (Firmware::
+  /// set_reply_latency); nullopt: the default profile's. Zero: in the same
+  /// instant, only when asked for.
+  std::optional<Duration> reply_latency;
 };
 
 /// Sets the car's firmware config to play profile `profile` of `kind`
-/// (protocol/common/car_profile.hpp; empty: the default). Throws
-/// protocol::ProfileError, with the valid names, for another name.
+/// (protocol/common/car_profile.hpp; empty: the default), its reply latency
+/// included. Throws protocol::ProfileError, with the valid names, for
+/// another name.
 void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view profile);
 
 /// The firmware of `kind` for a vehicle already in `world` (a scenario's
@@ -53,9 +58,6 @@ struct CarOptions {
   std::uint64_t seed = 1;  ///< sensor noise and sensor faults
   std::string name = "car0";
   FirmwareConfigs configs;
-  /// The firmware's processing time before each answer (Firmware::
-  /// set_reply_latency); zero: in the same instant.
-  Duration reply_latency{0};
 };
 
 class MockCar {
@@ -86,7 +88,8 @@ std::uint64_t car_seed(std::uint64_t run_seed, std::size_t index);
 
 /// Where car number `index` (0-based) of a kind listens by default:
 /// tcp://127.0.0.1:9000+index (LOGI), tcp://127.0.0.1:9100+index (WR8),
-/// pty:///tmp/hil-arduino<index>?baud=9600, pty:///tmp/hil-leka<index>?baud=115200.
+/// pty:///tmp/hil-arduino<index>?baud=9600, pty:///tmp/hil-leka<index>?baud=115200
+/// (the baud of the car's profiles).
 link::Endpoint default_endpoint(CarKind kind, std::size_t index);
 
 }  // namespace hil::mocks

@@ -29,7 +29,7 @@ Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), ve
 Firmware::~Firmware() = default;
 
 std::shared_ptr<const link::ProtocolAdapter> Firmware::adapter() const {
-  return link::protocol_adapter(protocol());
+  return link::protocol_adapter(protocol(), profile());
 }
 
 void Firmware::advance(Time now) {

@@ -55,9 +55,12 @@ class Firmware {
 
   /// "logi", "wr8", "arduino" or "leka".
   virtual std::string_view protocol() const = 0;
+  /// The car profile it plays (protocol/common/car_profile.hpp); empty: the
+  /// car's default.
+  virtual std::string_view profile() const { return {}; }
   /// How a link in front of this firmware frames its bytes (fault rules,
-  /// captures): protocol_adapter(protocol()) unless the firmware's own
-  /// settings change the framing (a WR8 profile).
+  /// captures): protocol_adapter(protocol(), profile()) unless the
+  /// firmware's own settings change the framing (a WR8 byte layout).
   virtual std::shared_ptr<const link::ProtocolAdapter> adapter() const;
 
   // ---- driver side: every call first advances the world to `now` ----

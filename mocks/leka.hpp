@@ -112,8 +112,8 @@ class LekaFirmware final : public Firmware {
 
   std::string_view protocol() const override { return "leka"; }
   /// Frames the link by this robot's profile (its dialect).
-  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
-    return link::protocol_adapter("leka", hil::protocol::leka::to_string(config_.dialect));
+  std::string_view profile() const override {
+    return hil::protocol::leka::to_string(config_.dialect);
   }
   std::string summary() const override;
 

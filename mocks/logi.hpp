@@ -105,8 +105,8 @@ class LogiFirmware final : public Firmware {
 
   std::string_view protocol() const override { return "logi"; }
   /// Frames the link by this car's profile.
-  std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
-    return link::protocol_adapter("logi", hil::protocol::logi::to_string(config_.dialect));
+  std::string_view profile() const override {
+    return hil::protocol::logi::to_string(config_.dialect);
   }
   std::string summary() const override;
 

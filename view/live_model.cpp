@@ -245,6 +245,10 @@ json LiveModel::car_json(const Car& car, std::size_t index, link::Time now) cons
   };
   j["mode"] = firmware.summary();
   j["in_fault"] = firmware.in_fault();
+  // The dialect the car plays (protocol/common/car_profile.hpp) and its
+  // processing time before each answer.
+  j["profile"] = std::string(firmware.adapter()->profile());
+  j["reply_latency_ms"] = sim::round_to(ms_of(firmware.reply_latency()), 0.001);
   j["sim_time_ms"] = sim::round_to(ms_of(now), 1);
   const auto& stats = firmware.stats();
   j["stats"] = {{"frames_in", stats.frames_in},   {"frames_out", stats.frames_out},

@@ -165,6 +165,7 @@ function showTelemetry(car) {
     ["frames in / out / bad", car.stats.frames_in + " / " + car.stats.frames_out + " / " + car.stats.bad_frames],
     ["rejected / ignored", car.stats.rejected + " / " + car.stats.ignored],
     ["behaviours waiting / active", car.behaviours.waiting + " / " + car.behaviours.active],
+    ["profile", (car.profile || "-") + " (reply latency " + car.reply_latency_ms + " ms)"],
     ["listening", car.address || "-"],
     ["last close", car.last_close || "-"],
   ];

@@ -429,7 +429,7 @@ int run_mock(const MockArgs& args) {
                 << args.reply_latency << "'\n";
       return 2;
     }
-    base.reply_latency = *latency;
+    base.configs.reply_latency = *latency;
   }
   if (args.data_hz) {
     base.configs.wr8.data_period = std::chrono::duration_cast<link::Duration>(
@@ -641,8 +641,9 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--baud", args->baud,
                   "Serial cars: line rate (default 9600 for arduino, 115200 for leka; 0 unpaced)");
   cmd->add_option("--reply-latency", args->reply_latency,
-                  "The firmware's processing time before each answer, e.g. 20ms (default 0; a "
-                  "serial car's bytes also take their time on the line at --baud)");
+                  "The firmware's processing time before each answer, e.g. 20ms; 0 answers in "
+                  "the same instant (default: the profile's, `hil profiles`; a serial car's bytes "
+                  "also take their time on the line at --baud)");
   cmd->add_option("--reset-ms", args->reset_ms,
                   "Serial cars: bytes sent this long after opening the port are lost, as when an "
                   "Arduino resets (default 0)");

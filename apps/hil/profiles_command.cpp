@@ -2,8 +2,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "apps/hil/cli_common.hpp"
@@ -12,12 +14,22 @@
 namespace hil::apps {
 namespace {
 
+/// "5 ms", "0 ms", "0.5 ms".
+std::string milliseconds_text(std::chrono::microseconds t) {
+  std::ostringstream text;
+  text << static_cast<double>(t.count()) / 1000.0 << " ms";
+  return text.str();
+}
+
 void print_car(std::ostream& out, std::string_view car) {
   out << car << '\n';
   for (const protocol::CarProfile& p : protocol::car_profiles_of(car)) {
     out << "  " << p.name << (p.is_default ? " (default)" : "") << '\n'
         << "    source: " << p.source << '\n'
-        << "    " << p.summary << '\n';
+        << "    " << p.summary << '\n'
+        << "    reply latency: " << milliseconds_text(p.reply_latency) << " processing";
+    if (p.baud != 0) out << ", then the line at " << p.baud << " baud";
+    out << "\n      " << p.latency_basis << '\n';
   }
 }
 

@@ -8,42 +8,57 @@ namespace {
 
 // Sources are named by repository and commit; the facts are described in
 // docs/protocols/<car>.md.
+using std::chrono::microseconds;
+
+constexpr std::string_view kLogiLatency =
+    "accepted commands wait in a FreeRTOS queue for the task that serves it, and every byte "
+    "crosses the ESP-12F's UART both ways; the excerpts of the firmware give no task period, "
+    "so 5 ms is an estimate";
+constexpr std::string_view kWr8Latency =
+    "the vehicle program answers from its Qt event loop on a Linux computer; an estimate";
+constexpr std::string_view kArduinoLatency =
+    "the sketch answers in the loop pass that reads the closing '$' (microseconds at 16 MHz); "
+    "the time is the line's, 1.04 ms a byte at 9600 baud";
+constexpr std::string_view kLekaLatency =
+    "no processing time is documented; the time is the line's, 87 us a byte at 115200 baud";
+
 constexpr std::array kProfiles{
     CarProfile{"logi", "firmware",
                "car_stm32f103vet6 firmware: docs/upper_computer_ai_guide.md and the frame parser "
                "of Core/Bsp/protocol.c",
                "the STM32 parser: each hand-over from the Wi-Fi module is one message of 10 bytes "
                "or more ending in '#', its checksum field after the last ':'",
-               false},
+               false, 0, microseconds(5000), kLogiLatency},
     CarProfile{"logi", "guide",
                "car_stm32f103vet6 docs/upper_computer_ai_guide.md, section 8 (the stream rule)",
                "the guide's stream rule on the car's input: a frame from the first LOGI: to the "
                "first '#', wherever the writes and reads cut the stream",
-               true},
+               true, 0, microseconds(5000), kLogiLatency},
     CarProfile{"wr8", "document", "the WR8 protocol document of 2019-01-06 (smart_vehicle_gui)",
-               "packets exactly as the document gives them: no length byte before a packet", true},
+               "packets exactly as the document gives them: no length byte before a packet", true,
+               0, microseconds(1000), kWr8Latency},
     CarProfile{
         "arduino", "firmware",
         "andrii-mazurchuk/arduino_robot_steering- at 8dcfab0: arduino.ino and robot_client.py",
         "the real sketch: the payload field may not be empty (the real client sends one "
         "space), replies PONG, STATUS:V=..,DIR=..,MOT:.., ACCEPTED, STOPPED, B:<cm>, "
         "I:AL=..; malformed frames dropped without an answer",
-        true},
+        true, 9600, microseconds(0), kArduinoLatency},
     CarProfile{"arduino", "readme",
                "the README of andrii-mazurchuk/arduino_robot_steering- (hil's protocol document)",
                "the README's examples: argument-less commands with an empty payload, replies OK, "
                "IDLE PWM=.., the bare sonar distance",
-               false},
+               false, 9600, microseconds(0), kArduinoLatency},
     CarProfile{"leka", "readme", "the README of leka/LKAlphaComSpecs v3.0.0 (381046f)",
                "the README's command ids (belt single 0x15) and its worked examples' checksum: "
                "the low byte of a 16-bit BSD sum over the command group",
-               true},
+               true, 115200, microseconds(0), kLekaLatency},
     CarProfile{"leka", "comspecs-v3",
                "leka/LKAlphaComSpecs v3.0.0 (381046f): Specs/LKAlphaComSpecs.yml and its Swift "
                "and C++ tables; MMyster/Leka-Command-Generator's checksum",
                "the YAML's command ids (led.ear.range 0x12, then ear single 0x13 .. belt single "
                "0x16) and an 8-bit BSD checksum over the length byte and the group",
-               false},
+               false, 115200, microseconds(0), kLekaLatency},
 };
 
 std::string spoken_list(const std::vector<std::string_view>& names) {

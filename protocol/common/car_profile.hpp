@@ -5,6 +5,7 @@
 // protocol takes a profile name and refuses an unknown one with the list
 // of valid names (docs/protocols/<car>.md has a section per profile).
 
+#include <chrono>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,14 @@ struct CarProfile {
   std::string_view summary;
   /// The profile a car gets when none is named.
   bool is_default = false;
+  /// A serial car's line rate (8N1, 10 bits per byte); 0 for a TCP car.
+  unsigned baud = 0;
+  /// The firmware's processing time before each answer when a scenario or
+  /// `hil mock` names none. A serial car's bytes also take their line time
+  /// at its baud, on a pty and in virtual time alike; this comes on top.
+  std::chrono::microseconds reply_latency{0};
+  /// Why reply_latency is what it is, for `hil profiles` and the docs.
+  std::string_view latency_basis;
 };
 
 /// An unknown car or profile name; the message lists the valid ones.

@@ -12,6 +12,7 @@
 
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "protocol/common/car_profile.hpp"
 #include "sim/arena.hpp"
 #include "tests/harness/runner_test_support.hpp"
 
@@ -168,7 +169,14 @@ TEST(RunnerLogi, TheSameSeedGivesTheSameTimelineRecordForRecord) {
   EXPECT_NE(a.timeline.to_ndjson(), c.timeline.to_ndjson()) << "another seed, other faults";
 }
 
+// The LOGI profile's processing time: every byte the car sends, and so a
+// hang-up that follows them, leaves this long after what made it.
+const link::Duration kLogiLatency =
+    std::chrono::duration_cast<link::Duration>(protocol::default_car_profile("logi").reply_latency);
+
 TEST(RunnerLogi, AfterTheCarHangsUpAt5sTheClientReconnectsAt6s) {
+  // The hang-up waits for the STAT of 5 s, which leaves after the car's
+  // latency; the client's backoff of 1 s counts from there.
   Scenario s = scenario(mocks::CarKind::logi, {action("connect"), wait(seconds(8))});
   s.schedule.push_back(
       ScheduledStep{Anchor{std::nullopt, 1, seconds(5)},
@@ -179,8 +187,11 @@ TEST(RunnerLogi, AfterTheCarHangsUpAt5sTheClientReconnectsAt6s) {
   for (const auto& r : of(o, Source::client, "connection"))
     states.emplace_back(r.at, r.data["state"]);
   const std::vector<std::pair<Time, std::string>> expected = {
-      {Time(0), "connecting"},    {Time(0), "connected"},    {seconds(5), "reconnecting"},
-      {seconds(6), "connecting"}, {seconds(6), "connected"},
+      {Time(0), "connecting"},
+      {Time(0), "connected"},
+      {seconds(5) + kLogiLatency, "reconnecting"},
+      {seconds(6) + kLogiLatency, "connecting"},
+      {seconds(6) + kLogiLatency, "connected"},
   };
   EXPECT_EQ(states, expected);
   const auto behaviours = of(o, Source::car, "behaviour");
@@ -195,7 +206,8 @@ TEST(RunnerLogi, RefusedConnectionsAreFaultRecordsAndTheClientGetsBackInWhenThey
   // The car hangs up at 5 s and refuses connections until 10.5 s. A refusal
   // is an accept and a reset, as over TCP; the car said nothing on those
   // connections, so the client keeps backing off: 6 s, 8 s, then 11 s, where
-  // it stays.
+  // it stays, each plus the car's latency (the hang-up follows the STAT of
+  // 5 s out).
   Scenario s = scenario(mocks::CarKind::logi, {action("connect"), wait(seconds(12))});
   link::FaultRule refuse;
   refuse.name = "unreachable";
@@ -209,16 +221,17 @@ TEST(RunnerLogi, RefusedConnectionsAreFaultRecordsAndTheClientGetsBackInWhenThey
   std::vector<Time> attempts;
   for (const auto& r : of(o, Source::client, "connection"))
     if (r.data["state"] == "connecting" && r.at > seconds(5)) attempts.push_back(r.at);
-  EXPECT_EQ(attempts, (std::vector<Time>{seconds(6), seconds(8), seconds(11)}));
+  EXPECT_EQ(attempts, (std::vector<Time>{seconds(6) + kLogiLatency, seconds(8) + kLogiLatency,
+                                         seconds(11) + kLogiLatency}));
   std::vector<Time> refused;
   for (const auto& r : of(o, Source::fault, "refuse")) {
     refused.push_back(r.at);
     EXPECT_EQ(r.data["rule"], "unreachable");
   }
-  EXPECT_EQ(refused, (std::vector<Time>{seconds(6), seconds(8)}));
+  EXPECT_EQ(refused, (std::vector<Time>{seconds(6) + kLogiLatency, seconds(8) + kLogiLatency}));
   const auto opens = of(o, Source::wire, "open");
   ASSERT_EQ(opens.size(), 2u) << "a refused connection gets no link";
-  EXPECT_EQ(opens[1].at, seconds(11));
+  EXPECT_EQ(opens[1].at, seconds(11) + kLogiLatency);
   EXPECT_EQ(of(o, Source::client, "connection").back().data["state"], "connected");
 }
 
@@ -364,7 +377,8 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
   for (const auto& r : wire(o, "to_client", "sent"))
     if (r.data["frame"] == "STAT") last_stat = r.at;
   ASSERT_TRUE(last_stat);
-  EXPECT_EQ(*last_stat, seconds(1)) << "STAT every 500 ms until the mute at 1.2 s";
+  EXPECT_EQ(*last_stat, seconds(1) + kLogiLatency)
+      << "STAT every 500 ms, each after the car's latency, until the mute at 1.2 s";
   const auto stale = of(o, Source::client, "stale");
   ASSERT_EQ(stale.size(), 1u);
   EXPECT_EQ(stale[0].at, *last_stat + seconds(2));

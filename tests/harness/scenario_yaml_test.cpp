@@ -820,7 +820,7 @@ TEST(ScenarioYamlVariables, UndefinedVariableIsAnErrorAtItsPosition) {
 TEST(ScenarioYamlProfiles, AReplyLatencyIsADurationAndNoneIsZero) {
   EXPECT_EQ(parse("name: t\ncar: arduino\nreply_latency: 20ms\nsteps: [PING]\n").reply_latency,
             link::milliseconds(20));
-  EXPECT_EQ(parse("name: t\ncar: arduino\nsteps: [PING]\n").reply_latency, Duration{0});
+  EXPECT_EQ(parse("name: t\ncar: arduino\nsteps: [PING]\n").reply_latency, std::nullopt);
   EXPECT_EQ(error_of("name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n"),
             "t.yaml:3:16: 'reply_latency' must be a duration with a unit (500ms, 2s, 1.5s), got "
             "'20'");

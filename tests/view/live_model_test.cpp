@@ -7,9 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <future>
 #include <memory>
 #include <string>
 #include <thread>
@@ -104,6 +105,8 @@ TEST(LiveModel, SnapshotDrawsTheWarehouseAndTheCarAtItsStart) {
   EXPECT_NEAR(car["pose"]["x"].get<double>(), arena["start"]["x"].get<double>(), 1e-6);
   EXPECT_NEAR(car["pose"]["y"].get<double>(), arena["start"]["y"].get<double>(), 1e-6);
   EXPECT_EQ(car["kind"], "logi");
+  EXPECT_EQ(car["profile"], "guide") << "the car plays its default profile";
+  EXPECT_EQ(car["reply_latency_ms"], 5.0) << "the LOGI profile's processing time";
   EXPECT_FALSE(car["client_connected"].get<bool>());
   // The start pose is on the tape: the middle line sensors see it.
   EXPECT_EQ(car["line"]["sensors"].size(), 4U);
@@ -163,25 +166,38 @@ TEST(LiveModel, AWr8LoginStringNeverReachesThePage) {
 
 TEST(LiveViewServer, StopsAtOnceWhenStoppedRightAfterStarting) {
   // hil mock stops the page server as soon as a Ctrl-C arrives, which may
-  // be before the server's thread has begun to accept connections.
+  // be before the server's thread has begun to accept connections. A hang
+  // is a cycle that never ends; a cycle is slow only under a sanitizer
+  // (each start makes httplib's thread pool: about 0.2 s under GCC's
+  // ThreadSanitizer), so each cycle gets its own 10 s.
+  constexpr int kCycles = 100;
   Desk desk;
   asio::io_context io;
-  std::promise<void> done;
-  auto stopped = done.get_future();
+  std::atomic<int> cycles{0};
   std::thread([&] {
-    for (int i = 0; i < 100; ++i) {
+    for (int i = 0; i < kCycles; ++i) {
       ViewOptions options;
       options.port = 0;
       LiveViewServer server(io, desk.executor(), desk.model(), options);
       server.start();
       server.stop();
+      ++cycles;
     }
-    done.set_value();
   }).detach();
-  if (stopped.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
-    // The server thread will never end: the process cannot be left cleanly.
-    std::fputs("LiveViewServer.stop() right after start() did not return in 20 s\n", stderr);
-    std::_Exit(1);
+  int seen = 0;
+  auto last_progress = std::chrono::steady_clock::now();
+  while (seen < kCycles) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (const int now = cycles.load(); now != seen) {
+      seen = now;
+      last_progress = std::chrono::steady_clock::now();
+    } else if (std::chrono::steady_clock::now() - last_progress > std::chrono::seconds(10)) {
+      // The server thread will never end: the process cannot be left cleanly.
+      std::fprintf(stderr,
+                   "LiveViewServer.stop() right after start() did not return in 10 s (cycle %d)\n",
+                   seen + 1);
+      std::_Exit(1);
+    }
   }
 }
 
