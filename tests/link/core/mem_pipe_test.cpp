@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "link/endpoint.hpp"
 #include "link/mem_pipe.hpp"
 
@@ -13,6 +15,18 @@ struct PipeRecorder {
     return {[this](ByteView b) { data.append(b.begin(), b.end()); },
             [this](std::error_code ec) { closed = ec; }};
   }
+};
+
+// Two started ends of a mem:// line at `baud`, each with its recorder.
+struct PacedLine {
+  explicit PacedLine(unsigned baud) {
+    std::tie(a, b) = make_mem_pipe(ex, "t", baud);
+    a->start(ra.handlers());
+    b->start(rb.handlers());
+  }
+  VirtualExecutor ex;
+  BytePipePtr a, b;
+  PipeRecorder ra, rb;
 };
 
 TEST(MemPipe, DeliversInOrderOnTheExecutor) {
@@ -75,49 +89,37 @@ TEST(MemPipe, ResetDropsDataInFlight) {
 // A paced line: 9600 baud, 8N1, so byte k of a burst is in once its last
 // bit is, at (k + 1) * 1.0417 ms.
 TEST(MemPipe, APacedLineDeliversEachByteOnceItsLastBitIsSent) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t", 9600);
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
-  a->write(protocol::to_bytes("^01|PING| *31$"));  // 14 bytes: 14.58 ms on the line
-  EXPECT_EQ(a->queued_bytes(), 14u);
-  ex.run_until(Time(std::chrono::nanoseconds(14'583'333)));
-  EXPECT_EQ(rb.data, "^01|PING| *31");  // the 14th byte's last bit is not out yet
-  ex.run_until(Time(std::chrono::nanoseconds(14'583'334)));
-  EXPECT_EQ(rb.data, "^01|PING| *31$");
-  EXPECT_EQ(a->queued_bytes(), 0u);
+  PacedLine line(9600);
+  line.a->write(protocol::to_bytes("^01|PING| *31$"));  // 14 bytes: 14.58 ms on the line
+  EXPECT_EQ(line.a->queued_bytes(), 14u);
+  line.ex.run_until(Time(std::chrono::nanoseconds(14'583'333)));
+  EXPECT_EQ(line.rb.data, "^01|PING| *31");  // the 14th byte's last bit is not out yet
+  line.ex.run_until(Time(std::chrono::nanoseconds(14'583'334)));
+  EXPECT_EQ(line.rb.data, "^01|PING| *31$");
+  EXPECT_EQ(line.a->queued_bytes(), 0u);
 }
 
 TEST(MemPipe, APacedLinePacesEachDirectionOnItsOwn) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t", 9600);
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
-  a->write(protocol::to_bytes("0123456789"));
-  b->write(protocol::to_bytes("abcde"));
-  ex.run_until(Time(milliseconds(6)));
-  EXPECT_EQ(ra.data, "abcde");  // 5.21 ms
-  EXPECT_EQ(rb.data, "01234");
-  ex.run_until(Time(milliseconds(11)));
-  EXPECT_EQ(rb.data, "0123456789");  // 10.42 ms
+  PacedLine line(9600);
+  line.a->write(protocol::to_bytes("0123456789"));
+  line.b->write(protocol::to_bytes("abcde"));
+  line.ex.run_until(Time(milliseconds(6)));
+  EXPECT_EQ(line.ra.data, "abcde");  // 5.21 ms
+  EXPECT_EQ(line.rb.data, "01234");
+  line.ex.run_until(Time(milliseconds(11)));
+  EXPECT_EQ(line.rb.data, "0123456789");  // 10.42 ms
 }
 
 TEST(MemPipe, OnAPacedLineTheEndOfStreamFollowsTheBytesStillOnIt) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t", 9600);
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
-  a->write(protocol::to_bytes("last"));
-  a->close(CloseMode::graceful);
-  ex.run_until(Time(milliseconds(4)));
-  EXPECT_EQ(rb.data, "las");
-  EXPECT_FALSE(rb.closed.has_value()) << "the close may not overtake the bytes";
-  ex.run_until_idle();
-  EXPECT_EQ(rb.data, "last");
-  EXPECT_EQ(rb.closed, end_of_stream());
+  PacedLine line(9600);
+  line.a->write(protocol::to_bytes("last"));
+  line.a->close(CloseMode::graceful);
+  line.ex.run_until(Time(milliseconds(4)));
+  EXPECT_EQ(line.rb.data, "las");
+  EXPECT_FALSE(line.rb.closed.has_value()) << "the close may not overtake the bytes";
+  line.ex.run_until_idle();
+  EXPECT_EQ(line.rb.data, "last");
+  EXPECT_EQ(line.rb.closed, end_of_stream());
 }
 
 TEST(MemPipe, APacedLineDeliversWhatWasWrittenAfterItsWriterIsDropped) {
@@ -137,17 +139,13 @@ TEST(MemPipe, APacedLineDeliversWhatWasWrittenAfterItsWriterIsDropped) {
 }
 
 TEST(MemPipe, AResetOnAPacedLineDropsWhatIsStillOnIt) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t", 9600);
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
-  a->write(protocol::to_bytes("0123456789"));
-  ex.run_until(Time(milliseconds(3)));
-  a->close(CloseMode::reset);
-  ex.run_until_idle();
-  EXPECT_EQ(rb.data, "01");  // in by 2.08 ms; the rest was still on the line
-  EXPECT_EQ(rb.closed, std::make_error_code(std::errc::connection_reset));
+  PacedLine line(9600);
+  line.a->write(protocol::to_bytes("0123456789"));
+  line.ex.run_until(Time(milliseconds(3)));
+  line.a->close(CloseMode::reset);
+  line.ex.run_until_idle();
+  EXPECT_EQ(line.rb.data, "01");  // in by 2.08 ms; the rest was still on the line
+  EXPECT_EQ(line.rb.closed, std::make_error_code(std::errc::connection_reset));
 }
 
 TEST(MemNetwork, AListenersBaudPacesEveryConnectionToIt) {
