@@ -169,6 +169,19 @@ struct DecodeArgs {
   bool nack = false;
 };
 
+// What a frame the sketch stores means: the typed request (or, for a
+// board's reply read back, the typed answer) when the firmware profile's
+// decoder reads it, else the sketch's own split of it.
+std::string sketch_request_text(const ard::SketchFrame& frame, const ard::SketchRequest& r) {
+  const auto item = ard::decode_frame(frame.raw, ard::Dialect::firmware);
+  if (const auto* f = std::get_if<protocol::Frame<ard::Message>>(&item)) {
+    const bool request = ard::is_request(f->message.body);
+    return std::string(request ? "request " : "reply (the board answers it NACK BAD_CMD) ") +
+           ard::describe(f->message);
+  }
+  return "request seq=" + r.seq + " cmd=" + r.cmd + " payload='" + r.payload + "'";
+}
+
 // The real sketch's verdict on each frame it would store: acted on,
 // refused with a NACK (the reply printed), or dropped without a word.
 int run_sketch_decode(const protocol::Bytes& bytes) {
@@ -180,8 +193,7 @@ int run_sketch_decode(const protocol::Bytes& bytes) {
     const std::string raw(frame.raw.begin(), frame.raw.end());
     std::visit(protocol::Overloaded{
                    [&](const ard::SketchRequest& r) {
-                     std::cout << "request seq=" << r.seq << " cmd=" << r.cmd << " payload='"
-                               << r.payload << "'  " << raw << '\n';
+                     std::cout << sketch_request_text(frame, r) << "  " << raw << '\n';
                    },
                    [&](const ard::SketchRefusal& r) {
                      status = 1;

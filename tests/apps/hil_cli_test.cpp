@@ -116,10 +116,11 @@ TEST(HilCli, DecodesArduinoRequest) {
   const auto r = run_hil("decode arduino --profile readme '^02|V|160*63$'");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_THAT(r.output, HasSubstr("SetSpeed seq=02 pwm=160"));
-  // The real sketch's view: the fields its parser splits out.
+  // The real sketch's view (the default profile): a request it acts on,
+  // typed.
   const auto sketch = run_hil("decode arduino '^02|V|160*63$'");
   EXPECT_EQ(sketch.exit_code, 0);
-  EXPECT_THAT(sketch.output, HasSubstr("request seq=02 cmd=V payload='160'"));
+  EXPECT_EQ(sketch.output, "request SetSpeed seq=02 pwm=160  ^02|V|160*63$\n");
 }
 
 TEST(HilCli, EncodesLekaFramesAsSpacedHex) {
@@ -276,7 +277,17 @@ TEST(HilCli, ArduinoFirmwareProfileEncodesAndJudgesAsTheRealBoard) {
   EXPECT_THAT(refused.output, HasSubstr("refused ^01|PING|*11$ -> ^01|NACK|BAD_FMT*41$"));
   const auto taken = run_hil("decode arduino --profile firmware '^01|PING| *31$'");
   EXPECT_EQ(taken.exit_code, 0) << taken.output;
-  EXPECT_THAT(taken.output, HasSubstr("request seq=01 cmd=PING payload=' '"));
+  EXPECT_EQ(taken.output, "request Ping seq=01  ^01|PING| *31$\n");
+  // The sketch matches commands without regard to case, and reads a number
+  // with atol ("abc" is 0): frames it acts on that the typed decoder would
+  // not read show as the sketch splits them. A reply read back is typed,
+  // with what the board would make of it.
+  const auto loose = run_hil("decode arduino '^01|ping| *31$' '^03|V|abc*35$' '^02|ACK|PONG*5D$'");
+  EXPECT_EQ(loose.exit_code, 0) << loose.output;
+  EXPECT_EQ(loose.output,
+            "request seq=01 cmd=ping payload=' '  ^01|ping| *31$\n"
+            "request seq=03 cmd=V payload='abc'  ^03|V|abc*35$\n"
+            "reply (the board answers it NACK BAD_CMD) Ack seq=02 info=\"PONG\"  ^02|ACK|PONG*5D$\n");
 
   const auto wrong = run_hil("encode arduino --profile sketch PING");
   EXPECT_NE(wrong.exit_code, 0);
