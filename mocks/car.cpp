@@ -44,9 +44,15 @@ sim::VehicleDef vehicle_preset(CarKind kind) {
   throw std::invalid_argument("unknown car kind");
 }
 
+namespace {
+Duration latency_of(const protocol::CarProfile& profile) {
+  return std::chrono::duration_cast<Duration>(profile.reply_latency);
+}
+}  // namespace
+
 void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view profile) {
   const protocol::CarProfile& p = protocol::find_car_profile(to_string(kind), profile);
-  configs.reply_latency = std::chrono::duration_cast<Duration>(p.reply_latency);
+  configs.reply_latency = latency_of(p);
   switch (kind) {
     case CarKind::arduino:
       configs.arduino.dialect = protocol::arduino::dialect_named(p.name);
@@ -85,8 +91,8 @@ std::unique_ptr<Firmware> make_firmware_of_kind(CarKind kind, sim::World& world,
 std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
                                         const FirmwareConfigs& configs) {
   auto firmware = make_firmware_of_kind(kind, world, vehicle, configs);
-  firmware->set_reply_latency(configs.reply_latency.value_or(std::chrono::duration_cast<Duration>(
-      protocol::default_car_profile(to_string(kind)).reply_latency)));
+  firmware->set_reply_latency(
+      configs.reply_latency.value_or(latency_of(protocol::default_car_profile(to_string(kind)))));
   return firmware;
 }
 

@@ -5,21 +5,14 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include "apps/hil/cli_common.hpp"
+#include "link/time.hpp"
 #include "protocol/common/car_profile.hpp"
 
 namespace hil::apps {
 namespace {
-
-/// "5 ms", "0 ms", "0.5 ms".
-std::string milliseconds_text(std::chrono::microseconds t) {
-  std::ostringstream text;
-  text << static_cast<double>(t.count()) / 1000.0 << " ms";
-  return text.str();
-}
 
 void print_car(std::ostream& out, std::string_view car) {
   out << car << '\n';
@@ -27,7 +20,9 @@ void print_car(std::ostream& out, std::string_view car) {
     out << "  " << p.name << (p.is_default ? " (default)" : "") << '\n'
         << "    source: " << p.source << '\n'
         << "    " << p.summary << '\n'
-        << "    reply latency: " << milliseconds_text(p.reply_latency) << " processing";
+        << "    reply latency: "
+        << link::format_ms(std::chrono::duration_cast<link::Duration>(p.reply_latency))
+        << " processing";
     if (p.baud != 0) out << ", then the line at " << p.baud << " baud";
     out << "\n      " << p.latency_basis << '\n';
   }

@@ -252,9 +252,9 @@ TEST(HilCli, ProfilesListsEveryCarsProfilesWithTheirSources) {
   EXPECT_THAT(arduino.output, HasSubstr("andrii-mazurchuk/arduino_robot_steering- at 8dcfab0"));
   EXPECT_EQ(arduino.output.find("leka"), std::string::npos) << arduino.output;
   EXPECT_THAT(arduino.output,
-              HasSubstr("    reply latency: 0 ms processing, then the line at 9600 baud\n"));
+              HasSubstr("    reply latency: 0.000 ms processing, then the line at 9600 baud\n"));
   const auto logi = run_hil("profiles logi");
-  EXPECT_THAT(logi.output, HasSubstr("    reply latency: 5 ms processing\n"));
+  EXPECT_THAT(logi.output, HasSubstr("    reply latency: 5.000 ms processing\n"));
   EXPECT_THAT(logi.output, HasSubstr("so 5 ms is an estimate"));
   const auto tank = run_hil("profiles tank");
   EXPECT_EQ(tank.exit_code, 2) << tank.output;
