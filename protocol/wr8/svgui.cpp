@@ -1,7 +1,7 @@
 #include "protocol/wr8/svgui.hpp"
 
 #include <bit>
-#include <cstdio>
+#include <charconv>
 #include <stdexcept>
 #include <string>
 
@@ -154,10 +154,11 @@ Item error(ErrorKind kind, ByteView packet, std::string detail, std::string_view
                      std::string(context)};
 }
 
-std::string fixed(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+/// The shortest text that reads back as exactly `v`.
+std::string shortest(double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc{} ? std::string(buf, end) : std::string("?");
 }
 
 }  // namespace
@@ -410,8 +411,8 @@ Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view
       m = c;
       break;
     }
-    default:
-      break;
+    default:  // decode_packet names only the codes above
+      return error(ErrorKind::unknown_code, packet, "packet code " + std::to_string(code), name);
   }
   if (!r.ok()) {
     return error(ErrorKind::bad_format, packet,
@@ -504,7 +505,7 @@ std::string describe(const Message& m) {
           [](const Set& st) {
             std::string s = "Set";
             for (std::size_t i = 0; i < st.values.size(); ++i)
-              s += ' ' + std::string(kSetNames[i]) + '=' + fixed(st.values[i]);
+              s += ' ' + std::string(kSetNames[i]) + '=' + shortest(st.values[i]);
             return s;
           },
           [](const Answer& a) {
@@ -515,7 +516,7 @@ std::string describe(const Message& m) {
           [](const Data& d) {
             return "Data state=" + std::string(to_string(d.state)) +
                    " t=" + std::to_string(d.timestamp_ms) + "ms encoder=" + std::to_string(d.encoder) +
-                   " steering=" + fixed(d.steering) + " motor-battery=" +
+                   " steering=" + shortest(d.steering) + " motor-battery=" +
                    std::to_string(d.motor_battery) + " computer-battery=" +
                    std::to_string(d.computer_battery);
           },
@@ -527,15 +528,15 @@ std::string describe(const Message& m) {
             return "LowFreqData state=" + std::string(to_string(d.state)) +
                    " t=" + std::to_string(d.timestamp_ms) + "ms motor-battery=" +
                    std::to_string(d.motor_battery) + " computer-battery=" +
-                   std::to_string(d.computer_battery) + " temperature=" + fixed(d.temperature);
+                   std::to_string(d.computer_battery) + " temperature=" + shortest(d.temperature);
           },
           [](const HighFreqData& d) {
             return "HighFreqData t=" + std::to_string(d.timestamp_ms) +
-                   "ms encoder=" + fixed(d.encoder) + " steering=" + fixed(d.steering) +
-                   " x=" + fixed(d.x) + " y=" + fixed(d.y) + " angle=" + fixed(d.angle);
+                   "ms encoder=" + shortest(d.encoder) + " steering=" + shortest(d.steering) +
+                   " x=" + shortest(d.x) + " y=" + shortest(d.y) + " angle=" + shortest(d.angle);
           },
           [](const Control& c) {
-            return "Control x=" + fixed(c.x_axis) + " y=" + fixed(c.y_axis);
+            return "Control x=" + shortest(c.x_axis) + " y=" + shortest(c.y_axis);
           },
       },
       m);

@@ -272,6 +272,8 @@ TEST(Wr8Svgui, DescribeNamesTheFields) {
             "computer-battery=60");
   EXPECT_EQ(describe(Answer{4, 2}), "Answer coi=4 code=2");
   EXPECT_EQ(describe(Control{0.5, -1}), "Control x=0.5 y=-1");
+  // Doubles are shown exactly, in the shortest text that reads back the same.
+  EXPECT_EQ(describe(Control{0.1, 1.0 / 3}), "Control x=0.1 y=0.3333333333333333");
 }
 
 }  // namespace
