@@ -16,6 +16,9 @@ constexpr std::string_view kLogiLatency =
     "so 5 ms is an estimate";
 constexpr std::string_view kWr8Latency =
     "the vehicle program answers from its Qt event loop on a Linux computer; an estimate";
+constexpr std::string_view kSvguiLatency =
+    "the vehicle program answers from its Qt event loop on a Linux computer; an estimate (the "
+    "real programs run on one machine, over loopback)";
 constexpr std::string_view kArduinoLatency =
     "the sketch answers in the loop pass that reads the closing '$' (microseconds at 16 MHz); "
     "the time is the line's, 1.04 ms a byte at 9600 baud";
@@ -37,6 +40,20 @@ constexpr std::array kProfiles{
     CarProfile{"wr8", "document", "the WR8 protocol document of 2019-01-06 (smart_vehicle_gui)",
                "packets exactly as the document gives them: no length byte before a packet", true,
                0, microseconds(1000), kWr8Latency},
+    CarProfile{"wr8", "svgui-2019",
+               "lsd-maddrive/smart_vehicle_gui at 8d80e92 (2019-02-18): common/svserver.cpp, "
+               "common/datapackage.cpp and the SVGUI_qml client",
+               "the real programs of the document's time: a length byte before every packet, "
+               "TASK and SETTINGS little-endian, big-endian DATA of 42 bytes, the fixed "
+               "AUTH-REPLY 1 2 WAIT, tasks and settings dropped while a task runs",
+               false, 0, microseconds(1000), kSvguiLatency, 5556},
+    CarProfile{"wr8", "svgui-head",
+               "lsd-maddrive/smart_vehicle_gui at 431e8d4 (protocol of 2019-05-18): "
+               "common/svserver.cpp, common/datapackage.cpp, SVServer_console_test and SVGUI_qml",
+               "the maintained real programs: a length byte before every packet, one packet read "
+               "per arrival, SET of 12 doubles, SET-REQUEST, MAP, HIGH-FREQ DATA every 50 ms and "
+               "LOW-FREQ every 1000 ms to every connection, CONTROL axes; no TASK",
+               false, 0, microseconds(1000), kSvguiLatency, 5556},
     CarProfile{
         "arduino", "firmware",
         "andrii-mazurchuk/arduino_robot_steering- at 8dcfab0: arduino.ino and robot_client.py",

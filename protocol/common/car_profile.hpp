@@ -6,6 +6,7 @@
 // of valid names (docs/protocols/<car>.md has a section per profile).
 
 #include <chrono>
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -31,6 +32,9 @@ struct CarProfile {
   std::chrono::microseconds reply_latency{0};
   /// Why reply_latency is what it is, for `hil profiles` and the docs.
   std::string_view latency_basis;
+  /// The TCP port the real car listens on (`hil mock` listens on it plus
+  /// the car's index); 0: hil's own port for the car, or a serial car.
+  std::uint16_t tcp_port = 0;
 };
 
 /// An unknown car or profile name; the message lists the valid ones.

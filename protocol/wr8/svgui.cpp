@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/wr8/length_prefix.hpp"
 
@@ -135,17 +136,28 @@ std::optional<State> state_of(std::uint8_t b) {
 
 std::string_view packet_name(std::uint8_t code, Version version) {
   switch (code) {
-    case kAuth: return "AUTH";
-    case kAuthReply: return "AUTH-REPLY";
-    case kTask: return version == Version::v2019 ? "TASK" : "";
-    case kSet: return version == Version::v2019 ? "SETTINGS" : "SET";
-    case kAnswer: return "ANSWER";
-    case kSix: return version == Version::v2019 ? "DATA" : "SET-REQUEST";
-    case kMap: return version == Version::head ? "MAP" : "";
-    case kLowFreq: return version == Version::head ? "LOW-FREQ-DATA" : "";
-    case kHighFreq: return version == Version::head ? "HIGH-FREQ-DATA" : "";
-    case kControl: return version == Version::head ? "CONTROL" : "";
-    default: return "";
+    case kAuth:
+      return "AUTH";
+    case kAuthReply:
+      return "AUTH-REPLY";
+    case kTask:
+      return version == Version::v2019 ? "TASK" : "";
+    case kSet:
+      return version == Version::v2019 ? "SETTINGS" : "SET";
+    case kAnswer:
+      return "ANSWER";
+    case kSix:
+      return version == Version::v2019 ? "DATA" : "SET-REQUEST";
+    case kMap:
+      return version == Version::head ? "MAP" : "";
+    case kLowFreq:
+      return version == Version::head ? "LOW-FREQ-DATA" : "";
+    case kHighFreq:
+      return version == Version::head ? "HIGH-FREQ-DATA" : "";
+    case kControl:
+      return version == Version::head ? "CONTROL" : "";
+    default:
+      return "";
   }
 }
 
@@ -164,11 +176,22 @@ std::string shortest(double v) {
 }  // namespace
 
 const std::array<std::string_view, 12> kSetNames = {
-    "steering-p", "steering-i", "steering-d", "steering-zero", "forward-p",  "forward-i",
-    "forward-d",  "forward-int", "backward-p", "backward-i", "backward-d", "backward-int"};
+    "steering-p", "steering-i",  "steering-d", "steering-zero", "forward-p",  "forward-i",
+    "forward-d",  "forward-int", "backward-p", "backward-i",    "backward-d", "backward-int"};
 
 std::string_view to_string(Version version) {
   return version == Version::v2019 ? "v2019" : "head";
+}
+
+std::optional<Version> version_of_profile(std::string_view profile) {
+  const CarProfile& p = find_car_profile("wr8", profile);
+  if (p.name == profile_of(Version::v2019)) return Version::v2019;
+  if (p.name == profile_of(Version::head)) return Version::head;
+  return std::nullopt;
+}
+
+std::string_view profile_of(Version version) {
+  return version == Version::v2019 ? "svgui-2019" : "svgui-head";
 }
 
 std::uint8_t code_of(const Message& m) {
@@ -203,86 +226,85 @@ Bytes encode(const Message& m, Version version) {
                                       " programs have no such packet (code " +
                                       std::to_string(code_of(m)) + ")");
   Writer w(code_of(m));
-  std::visit(
-      Overloaded{
-          [&](const Auth& a) {
-            require(a.text.size() < kLongestPrefixedPacket, "an AUTH text over 126 bytes");
-            w.bytes(a.text);
-          },
-          [&](const AuthReply& r) {
-            w.u8(r.device_code);
-            w.u8(r.device_id);
-            w.u8(static_cast<std::uint8_t>(r.state));
-          },
-          [&](const Task& t) {
-            require(t.params.size() <= kMaxTaskParams, "a TASK of more than 31 parameters");
-            w.u8(t.coi);
-            w.u8(t.type);
-            w.u8(static_cast<std::uint8_t>(t.params.size()));
-            for (const std::int32_t p : t.params)
-              w.le32(static_cast<std::uint32_t>(p));
-          },
-          [&](const Settings& s) {
-            w.u8(s.coi);
-            for (const std::int32_t v : s.values)
-              w.le32(static_cast<std::uint32_t>(v));
-          },
-          [&](const Set& s) {
-            for (const double v : s.values)
-              w.real(v);
-          },
-          [&](const Answer& a) {
-            require(a.coi.has_value() == (version == Version::v2019),
-                    version == Version::v2019 ? "a v2019 ANSWER needs its COI"
-                                              : "a head ANSWER has no COI");
-            if (a.coi) w.u8(*a.coi);
-            w.u8(a.code);
-          },
-          [&](const SetRequest&) {},
-          [&](const Data& d) {
-            w.u8(static_cast<std::uint8_t>(d.state));
-            w.be32(d.timestamp_ms);
-            w.be32(1);
-            w.be32(static_cast<std::uint32_t>(d.encoder));
-            w.coded(2, d.steering);
-            w.be32(3);
-            w.be32(d.motor_battery);
-            w.be32(4);
-            w.be32(d.computer_battery);
-          },
-          [&](const Map& map) {
-            w.u8(static_cast<std::uint8_t>(map.width));
-            w.u8(static_cast<std::uint8_t>(map.height));
-            w.be32(static_cast<std::uint32_t>(map.rows.size()));
-            for (const auto& row : map.rows) {
-              w.be32(static_cast<std::uint32_t>(row.size()));
-              for (const std::int8_t c : row)
-                w.u8(static_cast<std::uint8_t>(c));
-            }
-          },
-          [&](const LowFreqData& d) {
-            w.u8(static_cast<std::uint8_t>(d.state));
-            w.be32(d.timestamp_ms);
-            w.be32(1);
-            w.be32(d.motor_battery);
-            w.be32(2);
-            w.be32(d.computer_battery);
-            w.coded(3, d.temperature);
-          },
-          [&](const HighFreqData& d) {
-            w.be32(d.timestamp_ms);
-            w.coded(1, d.encoder);
-            w.coded(2, d.steering);
-            w.coded(3, d.x);
-            w.coded(4, d.y);
-            w.coded(5, d.angle);
-          },
-          [&](const Control& c) {
-            w.coded(1, c.x_axis);
-            w.coded(2, c.y_axis);
-          },
-      },
-      m);
+  std::visit(Overloaded{
+                 [&](const Auth& a) {
+                   require(a.text.size() < kLongestPrefixedPacket, "an AUTH text over 126 bytes");
+                   w.bytes(a.text);
+                 },
+                 [&](const AuthReply& r) {
+                   w.u8(r.device_code);
+                   w.u8(r.device_id);
+                   w.u8(static_cast<std::uint8_t>(r.state));
+                 },
+                 [&](const Task& t) {
+                   require(t.params.size() <= kMaxTaskParams, "a TASK of more than 31 parameters");
+                   w.u8(t.coi);
+                   w.u8(t.type);
+                   w.u8(static_cast<std::uint8_t>(t.params.size()));
+                   for (const std::int32_t p : t.params)
+                     w.le32(static_cast<std::uint32_t>(p));
+                 },
+                 [&](const Settings& s) {
+                   w.u8(s.coi);
+                   for (const std::int32_t v : s.values)
+                     w.le32(static_cast<std::uint32_t>(v));
+                 },
+                 [&](const Set& s) {
+                   for (const double v : s.values)
+                     w.real(v);
+                 },
+                 [&](const Answer& a) {
+                   require(a.coi.has_value() == (version == Version::v2019),
+                           version == Version::v2019 ? "a v2019 ANSWER needs its COI"
+                                                     : "a head ANSWER has no COI");
+                   if (a.coi) w.u8(*a.coi);
+                   w.u8(a.code);
+                 },
+                 [&](const SetRequest&) {},
+                 [&](const Data& d) {
+                   w.u8(static_cast<std::uint8_t>(d.state));
+                   w.be32(d.timestamp_ms);
+                   w.be32(1);
+                   w.be32(static_cast<std::uint32_t>(d.encoder));
+                   w.coded(2, d.steering);
+                   w.be32(3);
+                   w.be32(d.motor_battery);
+                   w.be32(4);
+                   w.be32(d.computer_battery);
+                 },
+                 [&](const Map& map) {
+                   w.u8(static_cast<std::uint8_t>(map.width));
+                   w.u8(static_cast<std::uint8_t>(map.height));
+                   w.be32(static_cast<std::uint32_t>(map.rows.size()));
+                   for (const auto& row : map.rows) {
+                     w.be32(static_cast<std::uint32_t>(row.size()));
+                     for (const std::int8_t c : row)
+                       w.u8(static_cast<std::uint8_t>(c));
+                   }
+                 },
+                 [&](const LowFreqData& d) {
+                   w.u8(static_cast<std::uint8_t>(d.state));
+                   w.be32(d.timestamp_ms);
+                   w.be32(1);
+                   w.be32(d.motor_battery);
+                   w.be32(2);
+                   w.be32(d.computer_battery);
+                   w.coded(3, d.temperature);
+                 },
+                 [&](const HighFreqData& d) {
+                   w.be32(d.timestamp_ms);
+                   w.coded(1, d.encoder);
+                   w.coded(2, d.steering);
+                   w.coded(3, d.x);
+                   w.coded(4, d.y);
+                   w.coded(5, d.angle);
+                 },
+                 [&](const Control& c) {
+                   w.coded(1, c.x_axis);
+                   w.coded(2, c.y_axis);
+                 },
+             },
+             m);
   Bytes out = w.take();
   require(out.size() <= kLongestPrefixedPacket,
           "a packet of " + std::to_string(out.size()) + " bytes; one length byte frames 127");
@@ -489,7 +511,8 @@ std::string describe(const Message& m) {
           [](const Auth& a) { return "Auth text=\"" + escape(a.text) + "\""; },
           [](const AuthReply& r) {
             return "AuthReply device=" + std::to_string(r.device_code) +
-                   " id=" + std::to_string(r.device_id) + " state=" + std::string(to_string(r.state));
+                   " id=" + std::to_string(r.device_id) +
+                   " state=" + std::string(to_string(r.state));
           },
           [](const Task& t) {
             std::string s = "Task coi=" + std::to_string(t.coi) + " type=" + std::to_string(t.type);
@@ -515,10 +538,10 @@ std::string describe(const Message& m) {
           [](const SetRequest&) { return std::string("SetRequest"); },
           [](const Data& d) {
             return "Data state=" + std::string(to_string(d.state)) +
-                   " t=" + std::to_string(d.timestamp_ms) + "ms encoder=" + std::to_string(d.encoder) +
-                   " steering=" + shortest(d.steering) + " motor-battery=" +
-                   std::to_string(d.motor_battery) + " computer-battery=" +
-                   std::to_string(d.computer_battery);
+                   " t=" + std::to_string(d.timestamp_ms) +
+                   "ms encoder=" + std::to_string(d.encoder) + " steering=" + shortest(d.steering) +
+                   " motor-battery=" + std::to_string(d.motor_battery) +
+                   " computer-battery=" + std::to_string(d.computer_battery);
           },
           [](const Map& map) {
             return "Map " + std::to_string(map.width) + "x" + std::to_string(map.height) + " (" +
@@ -526,9 +549,10 @@ std::string describe(const Message& m) {
           },
           [](const LowFreqData& d) {
             return "LowFreqData state=" + std::string(to_string(d.state)) +
-                   " t=" + std::to_string(d.timestamp_ms) + "ms motor-battery=" +
-                   std::to_string(d.motor_battery) + " computer-battery=" +
-                   std::to_string(d.computer_battery) + " temperature=" + shortest(d.temperature);
+                   " t=" + std::to_string(d.timestamp_ms) +
+                   "ms motor-battery=" + std::to_string(d.motor_battery) +
+                   " computer-battery=" + std::to_string(d.computer_battery) +
+                   " temperature=" + shortest(d.temperature);
           },
           [](const HighFreqData& d) {
             return "HighFreqData t=" + std::to_string(d.timestamp_ms) +

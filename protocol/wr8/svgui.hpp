@@ -30,6 +30,14 @@ enum class Version : std::uint8_t {
 
 std::string_view to_string(Version version);  ///< "v2019", "head"
 
+/// The real-program version a WR8 profile plays: nullopt for `document`
+/// (the PDF's packets, no length byte), v2019 for `svgui-2019`, head for
+/// `svgui-head`; empty is the default profile. Throws protocol::ProfileError
+/// for a name that is not a WR8 profile.
+std::optional<Version> version_of_profile(std::string_view profile);
+/// The profile that plays `version`: "svgui-2019" or "svgui-head".
+std::string_view profile_of(Version version);
+
 /// Code 1, GUI -> vehicle: the bytes after the code as sent. The v2019 GUI
 /// sends the ten letters of "konnichiwa", the head GUI the same and a NUL.
 struct Auth {

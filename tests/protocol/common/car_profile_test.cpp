@@ -36,6 +36,20 @@ TEST(CarProfiles, TheDefaultsAreTheBoardPeopleOwnAndTheReadme) {
   EXPECT_EQ(find_car_profile("arduino", "readme").car, "arduino");
 }
 
+TEST(CarProfiles, Wr8HasTheDocumentAndBothRealProgramsOnTheirOwnPort) {
+  EXPECT_EQ(default_car_profile("wr8").name, "document");
+  EXPECT_EQ(car_profile_names("wr8"), "document (the default), svgui-2019 and svgui-head");
+  EXPECT_EQ(default_car_profile("wr8").tcp_port, 0);  // hil's own port, 9100
+  for (const std::string_view name : {"svgui-2019", "svgui-head"}) {
+    const CarProfile& p = find_car_profile("wr8", name);
+    EXPECT_EQ(p.tcp_port, 5556) << name;  // the programs' test car listens there
+    EXPECT_EQ(p.baud, 0u) << name;
+    EXPECT_NE(p.source.find("smart_vehicle_gui"), std::string_view::npos) << name;
+  }
+  EXPECT_NE(find_car_profile("wr8", "svgui-2019").source.find("8d80e92"), std::string_view::npos);
+  EXPECT_NE(find_car_profile("wr8", "svgui-head").source.find("431e8d4"), std::string_view::npos);
+}
+
 TEST(CarProfiles, AWrongNameIsRefusedWithTheValidOnes) {
   try {
     find_car_profile("arduino", "firmwar");

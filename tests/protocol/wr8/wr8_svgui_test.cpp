@@ -7,6 +7,7 @@
 
 #include <stdexcept>
 
+#include "protocol/common/car_profile.hpp"
 #include "protocol/wr8/length_prefix.hpp"
 #include "protocol/wr8/svgui.hpp"
 #include "tests/support/hex.hpp"
@@ -74,6 +75,16 @@ Message decoded(std::string_view vector, Version version) {
 }
 
 const DecodeError& error_of(const Item& item) { return std::get<DecodeError>(item); }
+
+TEST(Wr8Svgui, EachRealProgramProfileNamesItsVersion) {
+  EXPECT_EQ(version_of_profile("svgui-2019"), Version::v2019);
+  EXPECT_EQ(version_of_profile("svgui-head"), Version::head);
+  EXPECT_EQ(version_of_profile("document"), std::nullopt);
+  EXPECT_EQ(version_of_profile(""), std::nullopt);  // the default: the document
+  EXPECT_THROW(version_of_profile("svgui"), ProfileError);
+  EXPECT_EQ(profile_of(Version::v2019), "svgui-2019");
+  EXPECT_EQ(profile_of(Version::head), "svgui-head");
+}
 
 TEST(Wr8Svgui, AuthIsTheTextAfterTheCodeInBothVersions) {
   const Auth v2019{to_bytes("konnichiwa")};
