@@ -64,7 +64,8 @@ void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view prof
       configs.logi.dialect = protocol::logi::dialect_named(p.name);
       break;
     case CarKind::wr8:
-      break;  // one profile
+      configs.svgui.version = protocol::wr8::svgui::version_of_profile(p.name);
+      break;
   }
 }
 
@@ -77,6 +78,8 @@ std::unique_ptr<Firmware> make_firmware_of_kind(CarKind kind, sim::World& world,
     case CarKind::logi:
       return std::make_unique<LogiFirmware>(world, vehicle, configs.logi);
     case CarKind::wr8:
+      if (configs.svgui.version)
+        return std::make_unique<SvguiFirmware>(world, vehicle, configs.svgui);
       return std::make_unique<Wr8Firmware>(world, vehicle, configs.wr8);
     case CarKind::arduino:
       return std::make_unique<ArduinoFirmware>(world, vehicle, configs.arduino);
@@ -116,8 +119,11 @@ unsigned profile_baud(CarKind kind) {
 }
 }  // namespace
 
-link::Endpoint default_endpoint(CarKind kind, std::size_t index) {
+link::Endpoint default_endpoint(CarKind kind, std::size_t index, std::string_view profile) {
   const auto n = static_cast<std::uint16_t>(index);
+  const protocol::CarProfile& p = protocol::find_car_profile(to_string(kind), profile);
+  if (p.tcp_port != 0)
+    return link::TcpEndpoint{"127.0.0.1", static_cast<std::uint16_t>(p.tcp_port + n)};
   switch (kind) {
     case CarKind::logi:
       return link::TcpEndpoint{"127.0.0.1", static_cast<std::uint16_t>(9000 + n)};

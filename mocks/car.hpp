@@ -15,6 +15,7 @@
 #include "mocks/leka.hpp"
 #include "mocks/logi.hpp"
 #include "mocks/wr8.hpp"
+#include "mocks/wr8_svgui.hpp"
 #include "sim/arena.hpp"
 #include "sim/world.hpp"
 
@@ -33,6 +34,9 @@ sim::VehicleDef vehicle_preset(CarKind kind);
 struct FirmwareConfigs {
   LogiConfig logi;
   Wr8Config wr8;
+  /// The WR8 car as a real smart_vehicle_gui vehicle program; used instead
+  /// of `wr8` when its version is set (profiles svgui-2019, svgui-head).
+  SvguiConfig svgui;
   ArduinoConfig arduino;
   LekaConfig leka;
   /// The firmware's processing time before each answer (Firmware::
@@ -89,7 +93,9 @@ std::uint64_t car_seed(std::uint64_t run_seed, std::size_t index);
 /// Where car number `index` (0-based) of a kind listens by default:
 /// tcp://127.0.0.1:9000+index (LOGI), tcp://127.0.0.1:9100+index (WR8),
 /// pty:///tmp/hil-arduino<index>?baud=9600, pty:///tmp/hil-leka<index>?baud=115200
-/// (the baud of the car's profiles).
-link::Endpoint default_endpoint(CarKind kind, std::size_t index);
+/// (the baud of the car's profiles). A profile with the real car's own TCP
+/// port (WR8 svgui-2019 and svgui-head: 5556) listens there plus `index`.
+/// Throws protocol::ProfileError for a profile the car does not have.
+link::Endpoint default_endpoint(CarKind kind, std::size_t index, std::string_view profile = {});
 
 }  // namespace hil::mocks

@@ -24,6 +24,22 @@ sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::st
   return *chassis;
 }
 
+sim::AckermannChassis& ackermann_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                            std::string_view hint) {
+  auto* chassis = vehicle.ackermann();
+  if (chassis == nullptr) {
+    std::string message =
+        std::string(firmware) + ": vehicle '" + vehicle.name() + "' has no Ackermann chassis";
+    if (!hint.empty()) message += " (" + std::string(hint) + ")";
+    throw std::invalid_argument(message);
+  }
+  return *chassis;
+}
+
+Time next_grid_point(Time now, Duration period) {
+  return (now / period + 1) * period;
+}
+
 Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), vehicle_(vehicle) {}
 
 Firmware::~Firmware() = default;

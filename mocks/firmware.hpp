@@ -34,6 +34,15 @@ void require_config(std::string_view config, bool ok, const std::string& what);
 sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
                                                   std::string_view hint = {});
 
+/// The vehicle's Ackermann chassis, or std::invalid_argument naming the
+/// firmware, the vehicle and `hint`.
+sim::AckermannChassis& ackermann_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                            std::string_view hint = {});
+
+/// The first whole multiple of `period` after `now`: the next tick of a
+/// timer that has run on that period since the vehicle started.
+Time next_grid_point(Time now, Duration period);
+
 struct FirmwareStats {
   std::uint64_t connections = 0;  ///< clients served so far
   std::uint64_t bytes_in = 0;

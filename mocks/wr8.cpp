@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "protocol/common/overloaded.hpp"
+#include "protocol/common/text.hpp"
 
 namespace hil::mocks {
 
@@ -16,15 +17,6 @@ namespace wr8 = protocol::wr8;
 namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
-sim::AckermannChassis& ackermann_of(sim::Vehicle& vehicle) {
-  sim::AckermannChassis* chassis = vehicle.ackermann();
-  if (chassis == nullptr) {
-    throw std::invalid_argument("Wr8Firmware: vehicle '" + vehicle.name() +
-                                "' has no Ackermann chassis (use sim::wr8_vehicle())");
-  }
-  return *chassis;
-}
 
 wr8::DecoderOptions decoder_options(const Wr8Config& config) {
   wr8::DecoderOptions options;
@@ -63,18 +55,8 @@ wr8::Word word_of(double value, wr8::ValueType type, std::size_t size_bytes = 4)
   return wr8::Word{static_cast<std::uint32_t>(v) & mask};
 }
 
-Time grid_after(Time t, Duration period) {
-  return (t / period + 1) * period;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
 std::string seconds_text(Duration d) {
-  return fixed(sim::to_seconds(d), 3) + " s";
+  return protocol::fixed_decimals(sim::to_seconds(d), 3) + " s";
 }
 
 }  // namespace
@@ -101,7 +83,7 @@ std::string_view to_string(Wr8Session session) {
 Wr8Firmware::Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config config)
     : Firmware(world, vehicle),
       config_(std::move(config)),
-      chassis_(ackermann_of(vehicle)),
+      chassis_(ackermann_chassis_of(vehicle, "Wr8Firmware", "use sim::wr8_vehicle()")),
       decoder_(decoder_options(config_)) {
   require_config("Wr8Config", config_.data_period > Duration::zero(),
                  "data_period must be positive");
@@ -195,14 +177,14 @@ std::string Wr8Firmware::summary() const {
     s += " " + std::string(to_string(state_.session));
   if (state_.auth_failures > 0) s += " AUTH FAILED " + std::to_string(state_.auth_failures);
   s += " ODO " + std::to_string(std::lround(vehicle_.odometry().distance_m * 100)) + "cm";
-  s += " SP " + fixed(chassis_.speed_mps(), 2);
-  s += " ANG " + fixed(chassis_.steering_rad() * kDegPerRad, 1);
+  s += " SP " + protocol::fixed_decimals(chassis_.speed_mps(), 2);
+  s += " ANG " + protocol::fixed_decimals(chassis_.steering_rad() * kDegPerRad, 1);
   s += " BAT " + std::to_string(vehicle_.battery().percent()) + "%";
   if (state_.drive) {
     s += " DRIVE " + std::to_string(std::lround(state_.drive->covered_m * 100)) + "/" +
          std::to_string(std::lround(state_.drive->target_m * 100)) + "cm";
   }
-  if (state_.turn) s += " TURN " + fixed(state_.turn->angle_deg, 0);
+  if (state_.turn) s += " TURN " + protocol::fixed_decimals(state_.turn->angle_deg, 0);
   if (state_.blink) s += " BLINK";
   return s;
 }
@@ -340,7 +322,7 @@ void Wr8Firmware::handle_auth(Time now, const wr8::Auth& auth) {
   }
   if (state_.session != Wr8Session::authenticated) {
     state_.session = Wr8Session::authenticated;
-    state_.next_data = grid_after(now, config_.data_period);
+    state_.next_data = next_grid_point(now, config_.data_period);
     if (state_.auth_failures_in_a_row > 0) {
       say("wr8: login accepted after " + std::to_string(state_.auth_failures_in_a_row) +
           " failed login(s) in a row");
@@ -539,10 +521,10 @@ void Wr8Firmware::on_tick(Time now) {
 
   if (control_needed()) {
     if (!state_.next_control) {
-      state_.next_control = grid_after(now, config_.control_period);
+      state_.next_control = next_grid_point(now, config_.control_period);
     } else if (now >= *state_.next_control) {
       control_step(now);
-      state_.next_control = grid_after(now, config_.control_period);
+      state_.next_control = next_grid_point(now, config_.control_period);
     }
   }
   if (!control_needed()) state_.next_control.reset();
@@ -558,7 +540,7 @@ void Wr8Firmware::on_tick(Time now) {
       answer(data_at(now));
       ++state_.data_sent;
     }
-    state_.next_data = grid_after(now, config_.data_period);
+    state_.next_data = next_grid_point(now, config_.data_period);
   }
 }
 

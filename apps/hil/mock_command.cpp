@@ -16,6 +16,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -162,8 +163,21 @@ bool write_ports_file(const std::string& path, const std::vector<std::string>& l
   return !ec;
 }
 
+/// The wall clock's time since local midnight: a real WR8 vehicle program
+/// stamps its DATA with it.
+link::Duration local_time_of_day() {
+  using namespace std::chrono;
+  const auto wall = system_clock::now();
+  const std::time_t seconds_now = system_clock::to_time_t(wall);
+  std::tm local{};
+  localtime_r(&seconds_now, &local);
+  return duration_cast<link::Duration>(hours(local.tm_hour) + minutes(local.tm_min) +
+                                       seconds(local.tm_sec) +
+                                       (wall - system_clock::from_time_t(seconds_now)));
+}
+
 link::Endpoint endpoint_for(const MockArgs& args, mocks::CarKind kind, std::size_t index) {
-  link::Endpoint e = mocks::default_endpoint(kind, index);
+  link::Endpoint e = mocks::default_endpoint(kind, index, args.profile);
   if (auto* tcp = std::get_if<link::TcpEndpoint>(&e)) {
     tcp->host = args.bind;
     if (args.port) {
@@ -421,6 +435,7 @@ int run_mock(const MockArgs& args) {
       return 2;
     }
     std::copy(args.auth.begin(), args.auth.end(), base.configs.wr8.profile.auth_text.begin());
+    base.configs.svgui.auth_suffix = args.auth;
   }
   if (!args.reply_latency.empty()) {
     const auto latency = link::parse_duration(args.reply_latency);
@@ -432,8 +447,15 @@ int run_mock(const MockArgs& args) {
     base.configs.reply_latency = *latency;
   }
   if (args.data_hz) {
-    base.configs.wr8.data_period = std::chrono::duration_cast<link::Duration>(
+    if (base.configs.svgui.version == protocol::wr8::svgui::Version::head) {
+      std::cerr << "hil mock: --data-hz: the svgui-head vehicle sends HIGH-FREQ DATA every 50 ms "
+                   "and LOW-FREQ every 1000 ms, as the real program does\n";
+      return 2;
+    }
+    const auto period = std::chrono::duration_cast<link::Duration>(
         std::chrono::duration<double>(1.0 / *args.data_hz));
+    base.configs.wr8.data_period = period;
+    base.configs.svgui.v2019_data_period = period;
   }
   const bool serial = std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(*kind, 0));
   if (serial && args.count > kMaxSerialCars) {
@@ -465,6 +487,11 @@ int run_mock(const MockArgs& args) {
   // cars run and then stops them cleanly, instead of killing the process.
   asio::signal_set signals(io, SIGINT, SIGTERM);
   link::AsioExecutor executor(io);
+  {
+    constexpr link::Duration kDay = std::chrono::hours(24);
+    base.configs.svgui.time_of_day_at_start =
+        ((local_time_of_day() - executor.now()) % kDay + kDay) % kDay;
+  }
   link::TransportContext context{executor, &io};
   StatusLine status(!args.no_status && ::isatty(STDOUT_FILENO) != 0);
   const auto log = [&status](const std::string& line) { status.log(line); };
@@ -491,6 +518,7 @@ int run_mock(const MockArgs& args) {
       options.configs.wr8.log = [log, name = options.name](const std::string& l) {
         log(name + ": " + l);
       };
+      options.configs.svgui.log = options.configs.wr8.log;
     }
     RunningCar running;
     try {
@@ -666,8 +694,11 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--auth", args->auth,
                   "WR8: the 10-character authentication string (a wrong one is refused "
                   "after 1 s, doubling per failure in a row up to 30 s; failures are logged "
-                  "without the string)");
-  cmd->add_option("--data-hz", args->data_hz, "WR8: DATA packets per second (default 10)")
+                  "without the string); svgui profiles: the text an AUTH must end with "
+                  "(default konnichiwa; a wrong one is left unanswered, the connection open)");
+  cmd->add_option("--data-hz", args->data_hz,
+                  "WR8: DATA packets per second (default 10; svgui-head: fixed, HIGH-FREQ "
+                  "20 and LOW-FREQ 1 per second)")
       ->check(CLI::Range(0.1, 1000.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No line per connection, fault and WR8 login failure");
   cmd->add_flag("-v,--verbose", args->verbose,

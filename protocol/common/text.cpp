@@ -1,5 +1,7 @@
 #include "protocol/common/text.hpp"
 
+#include <cstdio>
+
 namespace hil::protocol {
 
 std::optional<long long> parse_decimal(std::string_view text, bool allow_sign, bool allow_plus,
@@ -70,6 +72,12 @@ std::string ascii_upper(std::string_view text) {
     if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
   }
   return out;
+}
+
+std::string fixed_decimals(double value, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  return buf;
 }
 
 }  // namespace hil::protocol

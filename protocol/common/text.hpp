@@ -26,4 +26,8 @@ bool is_printable_ascii(std::string_view text);
 /// The text with a..z made A..Z and every other byte kept (no locale).
 std::string ascii_upper(std::string_view text);
 
+/// `value` with exactly `decimals` digits after the point ("0.50"), for
+/// status lines and logs.
+std::string fixed_decimals(double value, int decimals);
+
 }  // namespace hil::protocol
