@@ -13,6 +13,7 @@
 #include "protocol/leka/codec.hpp"
 #include "protocol/logi/codec.hpp"
 #include "protocol/wr8/codec.hpp"
+#include "protocol/wr8/svgui.hpp"
 
 namespace hil::link {
 namespace {
@@ -212,8 +213,8 @@ class SketchJudgedSplitter final : public FrameSplitter {
       if (f.raw.empty() || f.raw.front() != '^' || f.raw.back() != '$') continue;
       if (f.raw.size() > arduino::kSketchFrameBytes) {
         f.valid = false;
-        f.text = "oversized: dropped by the firmware: " + std::to_string(f.raw.size()) + " bytes pass its " +
-                 std::to_string(arduino::kSketchFrameBytes) + "-byte buffer";
+        f.text = "oversized: dropped by the firmware: " + std::to_string(f.raw.size()) +
+                 " bytes pass its " + std::to_string(arduino::kSketchFrameBytes) + "-byte buffer";
         continue;
       }
       const std::string_view text(reinterpret_cast<const char*>(f.raw.data()), f.raw.size());
@@ -242,8 +243,8 @@ class SketchJudgedSplitter final : public FrameSplitter {
   // The decode error a sketch's NACK stands for, so that a frame's error
   // kind (the text before ':') reads the same in both profiles.
   static std::string_view error_named_by(protocol::arduino::NackCode code) {
-    using protocol::arduino::NackCode;
     using protocol::ErrorKind;
+    using protocol::arduino::NackCode;
     switch (code) {
       case NackCode::bad_cs:
         return protocol::to_string(ErrorKind::bad_checksum);
@@ -375,6 +376,104 @@ class Wr8Adapter final : public ProtocolAdapter {
  private:
   // Shared with the splitters' describe functions, which outlive no adapter copy.
   std::shared_ptr<const protocol::wr8::Profile> profile_;
+};
+
+// ---------------------------------------------------------------- WR8, smart_vehicle_gui
+// length byte, code byte, body; no checksum (protocol/wr8/svgui.hpp).
+
+// The decoder names a packet it could not parse as the programs do
+// ("LOW-FREQ-DATA"); rules match the names of valid packets
+// ("LOW_FREQ_DATA"), so broken ones are spelled the same way.
+class UnderscoredKinds final : public FrameSplitter {
+ public:
+  explicit UnderscoredKinds(std::unique_ptr<FrameSplitter> inner) : inner_(std::move(inner)) {}
+  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
+    const std::size_t first = out.size();
+    inner_->feed(bytes, out);
+    respell(out, first);
+  }
+  void finish(std::vector<WireFrame>& out) override {
+    const std::size_t first = out.size();
+    inner_->finish(out);
+    respell(out, first);
+  }
+  std::size_t buffered() const override { return inner_->buffered(); }
+
+ private:
+  static void respell(std::vector<WireFrame>& out, std::size_t first) {
+    for (std::size_t i = first; i < out.size(); ++i)
+      std::replace(out[i].kind.begin(), out[i].kind.end(), '-', '_');
+  }
+  std::unique_ptr<FrameSplitter> inner_;
+};
+
+class SvguiAdapter final : public ProtocolAdapter {
+ public:
+  explicit SvguiAdapter(protocol::wr8::svgui::Version version) : version_(version) {}
+
+  std::string_view name() const override { return "wr8"; }
+  std::string_view profile() const override { return protocol::wr8::svgui::profile_of(version_); }
+
+  std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
+    namespace svgui = protocol::wr8::svgui;
+    return std::make_unique<UnderscoredKinds>(make_splitter<svgui::Message>(
+        svgui::Decoder{version_},
+        [](const svgui::Message& m, bool text) {
+          return KindAndText{std::string(kind_of(m)), text ? svgui::describe(m) : std::string()};
+        },
+        with_text));
+  }
+
+  std::optional<ByteRange> checksum_field(ByteView /*frame*/) const override {
+    return std::nullopt;
+  }
+
+  std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
+    if (frame.empty()) return std::nullopt;
+    if (name == "length") return ByteRange{0, 1};
+    // The rest needs a length byte that can frame a packet and the code after it.
+    if (frame.size() < 2 || frame[0] == 0 || frame[0] > protocol::wr8::kLongestPrefixedPacket) {
+      return std::nullopt;
+    }
+    if (name == "code") return ByteRange{1, 2};
+    if (name == "payload" || name == "body") return non_empty(2, frame.size());
+    if (name == "coi") {
+      // Only v2019's TASK (3), SETTINGS (4) and ANSWER (5) carry one, right after the code.
+      const bool has_coi =
+          version_ == protocol::wr8::svgui::Version::v2019 && frame[1] >= 3 && frame[1] <= 5;
+      return has_coi ? non_empty(2, std::min<std::size_t>(3, frame.size())) : std::nullopt;
+    }
+    return std::nullopt;
+  }
+
+  std::vector<std::string> field_names() const override {
+    std::vector<std::string> names{"length", "code", "payload", "body"};
+    if (version_ == protocol::wr8::svgui::Version::v2019) names.emplace_back("coi");
+    return names;
+  }
+
+ private:
+  /// The packet's name as fault rules match it: '-' written '_'.
+  static std::string_view kind_of(const protocol::wr8::svgui::Message& m) {
+    namespace svgui = protocol::wr8::svgui;
+    return std::visit(protocol::Overloaded{
+                          [](const svgui::Auth&) { return "AUTH"; },
+                          [](const svgui::AuthReply&) { return "AUTH_REPLY"; },
+                          [](const svgui::Task&) { return "TASK"; },
+                          [](const svgui::Settings&) { return "SETTINGS"; },
+                          [](const svgui::Set&) { return "SET"; },
+                          [](const svgui::Answer&) { return "ANSWER"; },
+                          [](const svgui::SetRequest&) { return "SET_REQUEST"; },
+                          [](const svgui::Data&) { return "DATA"; },
+                          [](const svgui::Map&) { return "MAP"; },
+                          [](const svgui::LowFreqData&) { return "LOW_FREQ_DATA"; },
+                          [](const svgui::HighFreqData&) { return "HIGH_FREQ_DATA"; },
+                          [](const svgui::Control&) { return "CONTROL"; },
+                      },
+                      m);
+  }
+
+  protocol::wr8::svgui::Version version_;
 };
 
 // ---------------------------------------------------------------- Leka
@@ -509,7 +608,10 @@ std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name,
   }
   if (name == "leka") return std::make_shared<LekaAdapter>(protocol::leka::dialect_named(p.name));
   if (name == "logi") return std::make_shared<LogiAdapter>(protocol::logi::dialect_named(p.name));
-  return protocol_adapter(name);  // WR8: one profile
+  if (const auto version = protocol::wr8::svgui::version_of_profile(p.name)) {
+    return std::make_shared<SvguiAdapter>(*version);
+  }
+  return std::make_shared<Wr8Adapter>();  // the document's packets
 }
 
 }  // namespace hil::link

@@ -22,7 +22,7 @@ struct WireFrame {
   protocol::Bytes raw;
   bool valid = false;  ///< decoded cleanly
   /// Hierarchical kind, ':'-separated, matched by prefix: "FB:ST", "MV:FWD",
-  /// "STAT" (LOGI); "V", "ACK" (Arduino); "TASK", "DATA" (WR8); the first
+  /// "STAT" (LOGI); "V", "ACK" (Arduino); "TASK", "HIGH_FREQ_DATA" (WR8); the first
   /// command's name (Leka). For invalid bytes, the decoder's context if any.
   std::string kind;
   std::string text;  ///< the decoded message or the error, one line
@@ -77,14 +77,17 @@ std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name);
 /// The adapter for a car's profile (protocol/common/car_profile.hpp); an
 /// empty profile is the car's default. Arduino `firmware` judges the frames
 /// towards the board as the real sketch does; Leka `comspecs-v3` decodes by
-/// the spec's YAML ids and checksum. Throws protocol::ProfileError for a
-/// profile the car does not have (or any profile for "raw").
+/// the spec's YAML ids and checksum; WR8 `svgui-2019` and `svgui-head` cut
+/// the stream by the length byte before every packet, so a frame is the
+/// length byte and its packet (protocol/wr8/svgui.hpp). Throws
+/// protocol::ProfileError for a profile the car does not have (or any
+/// profile for "raw").
 std::shared_ptr<const ProtocolAdapter> protocol_adapter(std::string_view name,
                                                         std::string_view profile);
 
-/// The WR8 adapter for a firmware whose byte order, block sizes or DATA
-/// table differ from the default profile (protocol_adapter("wr8") uses the
-/// default).
+/// The WR8 adapter of the `document` dialect for a firmware whose byte
+/// order, block sizes or DATA table differ from the default
+/// (protocol_adapter("wr8") uses the default).
 std::shared_ptr<const ProtocolAdapter> wr8_adapter(const protocol::wr8::Profile& profile);
 
 }  // namespace hil::link

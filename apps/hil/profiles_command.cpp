@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "apps/hil/cli_common.hpp"
 #include "link/time.hpp"
@@ -14,17 +15,42 @@
 namespace hil::apps {
 namespace {
 
+constexpr std::size_t kLineWidth = 100;
+
+/// `label` and `text` after `indent`, folded at spaces so that no line
+/// passes kLineWidth unless one word does; later lines start where the text
+/// of the first does.
+void print_folded(std::ostream& out, std::string_view indent, std::string_view label,
+                  std::string_view text) {
+  std::string line = std::string(indent) + std::string(label);
+  const std::size_t bare = line.size();
+  while (!text.empty()) {
+    const std::size_t space = text.find(' ');
+    const std::string_view word = text.substr(0, space);
+    if (line.size() > bare && line.size() + 1 + word.size() > kLineWidth) {
+      out << line << '\n';
+      line = std::string(bare, ' ');
+    } else if (line.size() > bare) {
+      line += ' ';
+    }
+    line += word;
+    text = space == std::string_view::npos ? std::string_view() : text.substr(space + 1);
+  }
+  out << line << '\n';
+}
+
 void print_car(std::ostream& out, std::string_view car) {
   out << car << '\n';
   for (const protocol::CarProfile& p : protocol::car_profiles_of(car)) {
-    out << "  " << p.name << (p.is_default ? " (default)" : "") << '\n'
-        << "    source: " << p.source << '\n'
-        << "    " << p.summary << '\n'
-        << "    reply latency: "
+    out << "  " << p.name << (p.is_default ? " (default)" : "") << '\n';
+    print_folded(out, "    ", "source: ", p.source);
+    print_folded(out, "    ", "", p.summary);
+    out << "    reply latency: "
         << link::format_ms(std::chrono::duration_cast<link::Duration>(p.reply_latency))
         << " processing";
     if (p.baud != 0) out << ", then the line at " << p.baud << " baud";
-    out << "\n      " << p.latency_basis << '\n';
+    out << '\n';
+    print_folded(out, "      ", "", p.latency_basis);
   }
 }
 

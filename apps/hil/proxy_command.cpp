@@ -57,6 +57,10 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       "            --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil proxy --protocol arduino --listen 'pty:///tmp/hil-arduino0?baud=9600' --upstream "
       "pty:///dev/ttyUSB0\n"
+      "  hil proxy --protocol wr8 --profile svgui-head --listen tcp://127.0.0.1:5557 \\\n"
+      "            --upstream tcp://127.0.0.1:5556 --log wire.ndjson   (the real vehicle program; "
+      "frames\n"
+      "            are its length byte and packet)\n"
       "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
   cmd->callback([&run, args] {
     run = [args]() -> int {

@@ -9,82 +9,17 @@
 #include <variant>
 #include <vector>
 
+#include "apps/common/program.hpp"
 #include "apps/hil/cli_common.hpp"
+#include "apps/hil/wr8_cli.hpp"
 #include "link/capture/wire_log.hpp"
 #include "protocol/wr8/codec.hpp"
+#include "protocol/wr8/svgui.hpp"
 
 namespace hil::apps {
-namespace {
+namespace wr8_cli {
 
 namespace wr8 = protocol::wr8;
-
-const char* const kWr8EncodeFooter = R"(Forms (prints the packet as spaced hex):
-  hil encode wr8 empty
-  hil encode wr8 auth [TEXT]               TEXT: exactly 10 characters (default: the
-                                           profile string HIL-WR8-01)
-  hil encode wr8 auth --text-hex HEX       any 10 bytes as hex
-  hil encode wr8 auth-reply DEVICE_CODE DEVICE_ID STATE
-  hil encode wr8 task COI TASK [VALUE...]  TASK: check | drive DISTANCE_CM | turn ANGLE_DEG
-                                           | blink | get-settings   (or 0..4)
-  hil encode wr8 settings COI NAME=VALUE...  NAME: p | i | d | servo-zero (or 0..3)
-  hil encode wr8 response COI CODE         CODE: error | started | completed (or 0..2)
-  hil encode wr8 data STATE TIMESTAMP_MS [NAME=VALUE...] [--unparsed HEX]
-                                           NAME: odometry (cm, int) | speed (m/s, float)
-                                           | wheel-angle or angle (deg, float)
-                                           | battery (percent, 0..255)   (or the code 0..3)
-  hil encode wr8 packet CODE [HEX...]      CODE then the bytes as given, no checks
-
-  STATE: fault | run | stop | wait (or 0..3). COI, DEVICE_CODE, DEVICE_ID, CODE: 0..255.
-  A VALUE is read as the profile types it (P, I, D floats; distance, angle, servo
-  zero integers); 0x followed by hex digits gives the exact bits instead.
-  Put '--' before the form when a value is negative and looks like an option.
-
-Examples:
-  hil encode wr8 auth                         01 48 49 4C 2D 57 52 38 2D 30 31
-  hil encode wr8 task 1 drive 100             03 01 01 04 64 00 00 00
-  hil encode wr8 task 2 turn -15              03 02 02 04 F1 FF FF FF
-  hil encode wr8 settings 5 p=1.5 servo-zero=90
-  hil encode wr8 response 1 completed         05 01 02
-  hil encode wr8 data run 1500 odometry=120 speed=0.5 angle=-10 battery=87
-  hil encode wr8 --big-endian task 1 drive 100
-  hil encode wr8 --unchecked task 1 drive     (a drive task with no distance)
-  hil encode wr8 packet 3 01 01 06 00 00 00 00 00 00   (a size byte not a multiple of 4)
-)";
-
-const char* const kWr8DecodeFooter = R"(Prints one line per packet or error, with the stream offset.
-Examples:
-  hil decode wr8 03 01 01 04 64 00 00 00
-  hil decode wr8 --sender vehicle 06 01 DC 05 00 00 07 00 78 00 00 00 03 57
-  hil decode wr8 --block-unit entries 03 01 01 01 64 00 00 00
-  hil decode wr8 --file capture.bin
-Exit status: 0 all packets decoded, 1 an error was reported, 2 nothing to decode.
-)";
-
-struct ProfileArgs {
-  bool big_endian = false;
-  std::string block_unit = "bytes";
-};
-
-void add_profile_options(CLI::App& cmd, ProfileArgs& args) {
-  cmd.add_flag("--big-endian", args.big_endian,
-               "Multi-byte values most significant byte first (default: little-endian)");
-  cmd.add_option("--block-unit", args.block_unit,
-                 "What TASK/SETTINGS/DATA size bytes count: bytes (default) or entries")
-      ->check(CLI::IsMember({"bytes", "entries"}));
-}
-
-wr8::Profile profile_of(const ProfileArgs& args) {
-  wr8::Profile p;
-  p.byte_order = args.big_endian ? wr8::ByteOrder::big : wr8::ByteOrder::little;
-  p.block_unit =
-      args.block_unit == "entries" ? wr8::BlockSizeUnit::entries : wr8::BlockSizeUnit::bytes;
-  return p;
-}
-
-// What was wrong with the command line, for stderr.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 std::uint32_t parse_unsigned(std::string_view text, std::uint32_t max, std::string_view what) {
   std::uint32_t value = 0;
@@ -112,20 +47,6 @@ wr8::State parse_state_arg(std::string_view text) {
   return *s;
 }
 
-wr8::Word parse_word(std::string_view text, wr8::ValueType type, std::size_t size,
-                     std::string_view what) {
-  const auto w = wr8::parse_value(text, type, size);
-  if (!w) {
-    const char* expected = type == wr8::ValueType::float32      ? "a number"
-                           : type == wr8::ValueType::signed_int ? "a whole number"
-                                                                : "a whole number >= 0";
-    throw UsageError(std::string(what) + " value '" + std::string(text) + "': expected " +
-                     expected + " that fits " + std::to_string(size) +
-                     " byte(s), or 0x and hex digits");
-  }
-  return *w;
-}
-
 std::pair<std::string_view, std::string_view> split_assignment(std::string_view arg) {
   const auto eq = arg.find('=');
   if (eq == std::string_view::npos || eq == 0) {
@@ -149,20 +70,136 @@ protocol::Bytes parse_hex_arg(std::string_view text, std::string_view what) {
   return *bytes;
 }
 
-struct Wr8EncodeArgs {
-  std::vector<std::string> words;
-  ProfileArgs profile;
-  bool unchecked = false;
-  std::string text_hex;
-  std::string unparsed;
-};
-
 void expect_count(const std::vector<std::string>& w, std::size_t min, std::size_t max,
                   std::string_view usage) {
   if (w.size() - 1 < min || w.size() - 1 > max) {
     throw UsageError(w[0] + " takes " + std::string(usage));
   }
 }
+
+}  // namespace wr8_cli
+
+namespace {
+
+using namespace wr8_cli;
+
+namespace wr8 = protocol::wr8;
+namespace svgui = protocol::wr8::svgui;
+
+const char* const kWr8EncodeFooter =
+    R"(Forms of --profile document, the default (the WR8 document's packets, no length byte;
+prints the packet as spaced hex):
+  hil encode wr8 empty
+  hil encode wr8 auth [TEXT]               TEXT: exactly 10 characters (default: the
+                                           profile string HIL-WR8-01)
+  hil encode wr8 auth --text-hex HEX       any 10 bytes as hex
+  hil encode wr8 auth-reply DEVICE_CODE DEVICE_ID STATE
+  hil encode wr8 task COI TASK [VALUE...]  TASK: check | drive DISTANCE_CM | turn ANGLE_DEG
+                                           | blink | get-settings   (or 0..4)
+  hil encode wr8 settings COI NAME=VALUE...  NAME: p | i | d | servo-zero (or 0..3)
+  hil encode wr8 response COI CODE         CODE: error | started | completed (or 0..2)
+  hil encode wr8 data STATE TIMESTAMP_MS [NAME=VALUE...] [--unparsed HEX]
+                                           NAME: odometry (cm, int) | speed (m/s, float)
+                                           | wheel-angle or angle (deg, float)
+                                           | battery (percent, 0..255)   (or the code 0..3)
+  hil encode wr8 packet CODE [HEX...]      CODE then the bytes as given, no checks
+
+  STATE: fault | run | stop | wait (or 0..3). COI, DEVICE_CODE, DEVICE_ID, CODE: 0..255.
+  A VALUE is read as the profile types it (P, I, D floats; distance, angle, servo
+  zero integers); 0x followed by hex digits gives the exact bits instead.
+  Put '--' before the form when a value is negative and looks like an option.)";
+
+const char* const kWr8EncodeExamples = R"(
+Examples:
+  hil encode wr8 auth                         01 48 49 4C 2D 57 52 38 2D 30 31
+  hil encode wr8 task 1 drive 100             03 01 01 04 64 00 00 00
+  hil encode wr8 task 2 turn -15              03 02 02 04 F1 FF FF FF
+  hil encode wr8 settings 5 p=1.5 servo-zero=90
+  hil encode wr8 response 1 completed         05 01 02
+  hil encode wr8 data run 1500 odometry=120 speed=0.5 angle=-10 battery=87
+  hil encode wr8 --big-endian task 1 drive 100
+  hil encode wr8 --unchecked task 1 drive     (a drive task with no distance)
+  hil encode wr8 packet 3 01 01 06 00 00 00 00 00 00   (a size byte not a multiple of 4)
+  hil encode wr8 --profile svgui-2019 auth              0B 01 6B 6F 6E 6E 69 63 68 69 77 61
+  hil encode wr8 --profile svgui-2019 task 7 forward 100
+                                                        08 03 07 01 01 64 00 00 00
+  hil encode wr8 --profile svgui-2019 answer 7 done     03 05 07 02
+  hil encode wr8 --profile svgui-head auth              0C 01 6B 6F 6E 6E 69 63 68 69 77 61 00
+  hil encode wr8 --profile svgui-head auth-reply        04 02 01 02 03
+  hil encode wr8 --profile svgui-head control 0.5 -1    19 0A 00 00 00 01 3F E0 00 00 00 00
+                                                        00 00 00 00 00 02 BF F0 00 00 00 00
+                                                        00 00
+  hil encode wr8 --profile svgui-head answer applied    02 05 01
+  hil encode wr8 --profile svgui-head set steering-p=1.5
+                                                        61 04 3F F8 00 00 ... (98 bytes: 0x61 = 97
+                                                        after the length byte)
+)";
+
+const char* const kWr8DecodeFooter = R"(Prints one line per packet or error, with the stream offset.
+Examples:
+  hil decode wr8 03 01 01 04 64 00 00 00
+  hil decode wr8 --sender vehicle 06 01 DC 05 00 00 07 00 78 00 00 00 03 57
+  hil decode wr8 --block-unit entries 03 01 01 01 64 00 00 00
+  hil decode wr8 --file capture.bin
+  hil decode wr8 --profile svgui-head 04 02 01 02 03 02 05 01
+      frame @0  AuthReply device=1 id=2 state=WAIT
+          raw: 04 02 01 02 03
+      frame @5  Answer code=1
+          raw: 02 05 01
+  hil decode wr8 --profile svgui-2019 --file capture.bin   (a length byte before every packet)
+In profiles svgui-2019 and svgui-head every packet is read after its length byte; a length
+byte of 00, or of 80 and above (128 bytes or more), is an error of that one byte.
+Exit status: 0 all packets decoded; 1 an error was reported, nothing to decode, or input
+that cannot be read; 2 a malformed command line.
+)";
+
+struct DocumentArgs {
+  bool big_endian = false;
+  std::string block_unit = "bytes";
+};
+
+// The document dialect's own choices (protocol/wr8/profile.hpp); the
+// options return so that the real programs' profiles can refuse them.
+std::vector<CLI::Option*> add_document_options(CLI::App& cmd, DocumentArgs& args) {
+  return {cmd.add_flag("--big-endian", args.big_endian,
+                       "Profile document: multi-byte values most significant byte first "
+                       "(default: little-endian)"),
+          cmd.add_option("--block-unit", args.block_unit,
+                         "Profile document: what TASK/SETTINGS/DATA size bytes count: bytes "
+                         "(default) or entries")
+              ->check(CLI::IsMember({"bytes", "entries"}))};
+}
+
+wr8::Profile profile_of(const DocumentArgs& args) {
+  wr8::Profile p;
+  p.byte_order = args.big_endian ? wr8::ByteOrder::big : wr8::ByteOrder::little;
+  p.block_unit =
+      args.block_unit == "entries" ? wr8::BlockSizeUnit::entries : wr8::BlockSizeUnit::bytes;
+  return p;
+}
+
+wr8::Word parse_word(std::string_view text, wr8::ValueType type, std::size_t size,
+                     std::string_view what) {
+  const auto w = wr8::parse_value(text, type, size);
+  if (!w) {
+    const char* expected = type == wr8::ValueType::float32      ? "a number"
+                           : type == wr8::ValueType::signed_int ? "a whole number"
+                                                                : "a whole number >= 0";
+    throw UsageError(std::string(what) + " value '" + std::string(text) + "': expected " +
+                     expected + " that fits " + std::to_string(size) +
+                     " byte(s), or 0x and hex digits");
+  }
+  return *w;
+}
+
+struct Wr8EncodeArgs {
+  std::vector<std::string> words;
+  std::string profile;  ///< --profile: document (empty), svgui-2019 or svgui-head
+  DocumentArgs document;
+  bool unchecked = false;
+  std::string text_hex;
+  std::string unparsed;
+};
 
 // Builds the packet the words describe; throws UsageError for bad words.
 protocol::Bytes build_packet(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
@@ -289,9 +326,39 @@ protocol::Bytes build_packet(const Wr8EncodeArgs& a, const wr8::Profile& profile
     }
     return wr8::raw_packet(parse_byte(w[1], "packet code"), body);
   }
-  throw UsageError("unknown form '" + w[0] +
-                   "': expected empty, auth, auth-reply, task, settings, response, data or packet "
-                   "(see --help)");
+  std::string message = "unknown form '" + w[0] +
+                        "': expected empty, auth, auth-reply, task, settings, response, data or "
+                        "packet (see --help)";
+  const std::string_view other = svgui_profile_with_form(w[0]);
+  if (!other.empty()) {
+    message += "; profile " + std::string(other) + " has it: --profile " + std::string(other);
+  }
+  throw UsageError(message);
+}
+
+constexpr std::string_view kWr8ProfileHelp =
+    "document (the default): the WR8 document's packets, no length byte; svgui-2019 or "
+    "svgui-head: the real smart_vehicle_gui programs, a length byte before every packet";
+
+// The first document-only option given with a profile of the real
+// programs, as an error to print; empty when there is none.
+std::string document_only_given(const std::vector<CLI::Option*>& options,
+                                std::string_view profile) {
+  for (const CLI::Option* o : options) {
+    if (o->count() > 0) {
+      return o->get_name() + " is an option of profile document, not of " + std::string(profile);
+    }
+  }
+  return {};
+}
+
+// The codec's words without its own "WR8 ... encode: " prefix, which ours repeats.
+std::string_view codec_words(std::string_view what) {
+  for (const std::string_view prefix :
+       {"WR8 encode: ", "WR8 (smart_vehicle_gui) encode: ", "WR8 length prefix: "}) {
+    if (what.starts_with(prefix)) return what.substr(prefix.size());
+  }
+  return what;
 }
 
 }  // namespace
@@ -301,28 +368,38 @@ void register_wr8(CommandSet& commands) {
   auto* enc = commands.encode.add_subcommand(
       "wr8", "WR8 packet from a form and its fields, e.g. task 1 drive 100");
   enc->add_option("form", enc_args->words, "FORM [ARGS...]: see the forms below")->required();
-  add_profile_options(*enc, enc_args->profile);
-  enc->add_flag(
+  add_profile_option(*enc, enc_args->profile, "wr8", std::string(kWr8ProfileHelp));
+  auto document_only = add_document_options(*enc, enc_args->document);
+  document_only.push_back(enc->add_flag(
       "--unchecked", enc_args->unchecked,
-      "Skip the profile's checks (parameter counts, codes outside the tables): fault injection");
-  enc->add_option("--text-hex", enc_args->text_hex, "auth: the 10 bytes of the string as hex");
-  enc->add_option(
+      "Profile document: skip the profile's checks (parameter counts, codes outside the "
+      "tables): fault injection"));
+  enc->add_option("--text-hex", enc_args->text_hex,
+                  "auth: the string as hex (10 bytes in profile document, the exact bytes "
+                  "after the code in the others)");
+  document_only.push_back(enc->add_option(
       "--unparsed", enc_args->unparsed,
-      "data: bytes appended to the block after the values (start with an unknown code)");
-  enc->footer(kWr8EncodeFooter);
-  enc->callback([&run = commands.run, enc_args] {
-    run = [enc_args]() -> int {
+      "Profile document, data: bytes appended to the block after the values (start with an "
+      "unknown code)"));
+  enc->footer(std::string(kWr8EncodeFooter) + kSvguiEncodeForms + kWr8EncodeExamples);
+  enc->callback([&run = commands.run, enc_args, document_only] {
+    run = [enc_args, document_only]() -> int {
       try {
-        const auto packet = build_packet(*enc_args, profile_of(enc_args->profile));
+        const auto version = svgui::version_of_profile(enc_args->profile);
+        protocol::Bytes packet;
+        if (version) {
+          const std::string refused = document_only_given(document_only, enc_args->profile);
+          if (!refused.empty()) throw UsageError(refused);
+          packet = build_svgui_packet(enc_args->words, enc_args->text_hex, *version);
+        } else {
+          packet = build_packet(*enc_args, profile_of(enc_args->document));
+        }
         std::cout << protocol::to_hex(packet) << '\n';
         return 0;
       } catch (const UsageError& e) {
         std::cerr << "hil encode wr8: " << e.what() << '\n';
       } catch (const std::invalid_argument& e) {
-        // The codec's own words; its "WR8 encode: " prefix repeats ours.
-        std::string_view what = e.what();
-        if (what.starts_with("WR8 encode: ")) what.remove_prefix(12);
-        std::cerr << "hil encode wr8: " << what << '\n';
+        std::cerr << "hil encode wr8: " << codec_words(e.what()) << '\n';
       }
       return 1;
     };
@@ -330,27 +407,39 @@ void register_wr8(CommandSet& commands) {
 
   struct DecodeArgs {
     DecodeInput input;
-    ProfileArgs profile;
+    std::string profile;
+    DocumentArgs document;
     std::string sender = "any";
     std::size_t max_packet = 0;
   };
   auto dec_args = std::make_shared<DecodeArgs>();
   auto* dec = commands.decode.add_subcommand("wr8", "Decode WR8 packets or a WR8 byte stream");
   add_decode_input(*dec, dec_args->input, true);
-  add_profile_options(*dec, dec_args->profile);
-  dec->add_option("--sender", dec_args->sender,
-                  "Whose packets to expect: any (default), gui or vehicle; the other side's codes "
-                  "are reported as unknown_code")
-      ->check(CLI::IsMember({"any", "gui", "vehicle"}));
-  dec->add_option("--max-packet", dec_args->max_packet,
-                  "Longest packet in bytes (at least 16); longer ones are reported as oversized. "
-                  "Default: the longest the profile can declare");
+  add_profile_option(*dec, dec_args->profile, "wr8", std::string(kWr8ProfileHelp));
+  auto dec_document_only = add_document_options(*dec, dec_args->document);
+  dec_document_only.push_back(
+      dec->add_option("--sender", dec_args->sender,
+                      "Profile document: whose packets to expect: any (default), gui or "
+                      "vehicle; the other side's codes are reported as unknown_code")
+          ->check(CLI::IsMember({"any", "gui", "vehicle"})));
+  dec_document_only.push_back(dec->add_option(
+      "--max-packet", dec_args->max_packet,
+      "Profile document: longest packet in bytes (at least 16); longer ones are reported as "
+      "oversized. Default: the longest the profile can declare"));
   dec->footer(kWr8DecodeFooter);
-  dec->callback([&run = commands.run, dec_args] {
-    run = [dec_args]() -> int {
+  dec->callback([&run = commands.run, dec_args, dec_document_only] {
+    run = [dec_args, dec_document_only]() -> int {
       const auto bytes = read_decode_input(dec_args->input, true);
+      if (const auto version = svgui::version_of_profile(dec_args->profile)) {
+        const std::string refused = document_only_given(dec_document_only, dec_args->profile);
+        if (!refused.empty()) {
+          std::cerr << "hil decode wr8: " << refused << '\n';
+          return 1;
+        }
+        return decode_svgui(bytes, dec_args->input, *version);
+      }
       wr8::DecoderOptions options;
-      options.profile = profile_of(dec_args->profile);
+      options.profile = profile_of(dec_args->document);
       options.sender = dec_args->sender == "gui"       ? wr8::Sender::gui
                        : dec_args->sender == "vehicle" ? wr8::Sender::vehicle
                                                        : wr8::Sender::any;

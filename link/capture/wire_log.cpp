@@ -219,6 +219,20 @@ void WireLog::write_line(const nlohmann::ordered_json& record) {
   ++records_written_;
 }
 
+std::shared_ptr<const ProtocolAdapter> adapter_of_log(const nlohmann::json& open_record) {
+  const auto text_field = [&](const char* name) -> std::string {
+    const auto it = open_record.find(name);
+    return it != open_record.end() && it->is_string() ? it->get<std::string>() : std::string();
+  };
+  if (text_field("event") != "open") {
+    throw std::invalid_argument("a wire log names its protocol in its \"open\" record, not in \"" +
+                                text_field("event") + "\"");
+  }
+  const std::string protocol = text_field("protocol");
+  if (protocol.empty()) throw std::invalid_argument("the wire log's open record has no protocol");
+  return protocol_adapter(protocol, text_field("profile"));
+}
+
 std::vector<nlohmann::json> read_wire_log(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path.string() + ": cannot open the wire log");

@@ -89,6 +89,15 @@ std::string masked_frame_text(std::string_view kind, std::string text);
 /// neither.
 protocol::Bytes bytes_of(const nlohmann::json& record);
 
+/// The adapter that frames a wire log's bytes as they were framed when it
+/// was written: protocol_adapter() of its open record's "protocol" and
+/// "profile" (a record with no "profile" gets the protocol's default). A
+/// WR8 log of profile svgui-2019 or svgui-head is cut by the length byte,
+/// a `document` one is not. Throws std::invalid_argument for a record that
+/// is not an open record or names no protocol hil knows, and
+/// protocol::ProfileError for a profile the protocol does not have.
+std::shared_ptr<const ProtocolAdapter> adapter_of_log(const nlohmann::json& open_record);
+
 /// Every record of a wire log, in file order. A final line with no newline
 /// that does not parse (a writer killed mid-line, or still writing) is
 /// skipped; any other line that does not parse throws std::runtime_error

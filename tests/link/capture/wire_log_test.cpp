@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "protocol/common/car_profile.hpp"
+#include "protocol/wr8/svgui.hpp"
 #include "tests/link/capture/capture_support.hpp"
 
 namespace hil::link {
@@ -271,6 +273,74 @@ TEST_F(WireLogTest, AppendsToAnExistingLog) {
   make()->on_open(Time{0}, "c", "k");
   make()->on_open(Time{0}, "c", "k");
   EXPECT_EQ(records().size(), 2u);
+}
+
+// A capture of the real WR8 programs (smart_vehicle_gui, profile
+// svgui-head) names its profile, its frames are the length byte and the
+// packet, and a reader of the file gets the adapter that framed them.
+TEST_F(WireLogTest, SvguiCaptureNamesItsProfileAndIsFramedByItsLengthBytes) {
+  namespace svgui = protocol::wr8::svgui;
+  const auto head = svgui::Version::head;
+  const protocol::Bytes auth =
+      svgui::encode_prefixed(svgui::Auth{to_bytes(std::string("konnichiwa\0", 11))}, head);
+  const protocol::Bytes reply = svgui::encode_prefixed(svgui::kProgramAuthReply, head);
+  const protocol::Bytes high =
+      svgui::encode_prefixed(svgui::HighFreqData{36000000, 1.5, -10, 0.25, 0.5, 90}, head);
+  auto log = make(protocol_adapter("wr8", "svgui-head"));
+  log->on_open(milliseconds(0), "client", "car");
+  log->on_sent(milliseconds(1), Direction::to_car, auth);
+  // The vehicle's reply and a DATA packet in one write, the DATA cut short.
+  protocol::Bytes write = reply;
+  write.insert(write.end(), high.begin(), high.begin() + 30);
+  log->on_sent(milliseconds(2), Direction::to_client, write);
+  log->on_sent(milliseconds(3), Direction::to_client, protocol::ByteView(high).subspan(30));
+  log.reset();
+
+  const auto r = records();
+  ASSERT_EQ(r.size(), 4u);
+  EXPECT_EQ(r[0]["protocol"], "wr8");
+  EXPECT_EQ(r[0]["profile"], "svgui-head");
+  ASSERT_EQ(r[1]["frames"].size(), 1u);
+  EXPECT_EQ(r[1]["frames"][0]["kind"], "AUTH");
+  EXPECT_EQ(r[1]["frames"][0]["valid"], true);
+  EXPECT_EQ(r[1]["frames"][0]["text"], "Auth text=**********");
+  EXPECT_EQ(r[1]["hex"], "0C 01 6B 6F 6E 6E 69 63 68 69 77 61 00");
+  ASSERT_EQ(r[2]["frames"].size(), 1u);
+  EXPECT_EQ(r[2]["frames"][0]["kind"], "AUTH_REPLY");
+  EXPECT_EQ(r[2]["held"], 30);
+  ASSERT_EQ(r[3]["frames"].size(), 1u);
+  EXPECT_EQ(r[3]["frames"][0]["kind"], "HIGH_FREQ_DATA");
+  EXPECT_EQ(r[3]["frames"][0]["text"],
+            svgui::describe(svgui::HighFreqData{36000000, 1.5, -10, 0.25, 0.5, 90}));
+
+  // Read back, the log gives the adapter it was written with, which finds
+  // the same frames in its bytes.
+  const auto adapter = adapter_of_log(r[0]);
+  EXPECT_EQ(adapter->name(), "wr8");
+  EXPECT_EQ(adapter->profile(), "svgui-head");
+  auto splitter = adapter->splitter_for(Direction::to_client);
+  std::vector<WireFrame> frames;
+  for (std::size_t i = 2; i < r.size(); ++i)
+    splitter->feed(bytes_of(r[i]), frames);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].raw, reply);
+  EXPECT_EQ(frames[1].raw, high);
+  EXPECT_TRUE(frames[1].valid) << frames[1].text;
+}
+
+TEST(AdapterOfLog, NamesTheProfileOrTheDefaultAndRefusesOtherRecords) {
+  using nlohmann::json;
+  EXPECT_EQ(adapter_of_log(json{{"event", "open"}, {"protocol", "wr8"}, {"profile", "svgui-2019"}})
+                ->profile(),
+            "svgui-2019");
+  // A log with no profile was written with the protocol's default.
+  EXPECT_EQ(adapter_of_log(json{{"event", "open"}, {"protocol", "wr8"}})->profile(), "document");
+  EXPECT_EQ(adapter_of_log(json{{"event", "open"}, {"protocol", "raw"}})->name(), "raw");
+  EXPECT_THROW(adapter_of_log(json{{"event", "sent"}, {"protocol", "wr8"}}), std::invalid_argument);
+  EXPECT_THROW(adapter_of_log(json{{"event", "open"}}), std::invalid_argument);
+  EXPECT_THROW(
+      adapter_of_log(json{{"event", "open"}, {"protocol", "wr8"}, {"profile", "svgui-2020"}}),
+      protocol::ProfileError);
 }
 
 TEST(WireLogOpen, UnwritablePathGivesAnErrorNotAnException) {

@@ -6,6 +6,7 @@
 #include <bit>
 
 #include "protocol/logi/codec.hpp"
+#include "protocol/wr8/svgui.hpp"
 #include "tests/link/faults/fault_test_support.hpp"
 
 namespace hil::link {
@@ -475,6 +476,109 @@ TEST(FaultInjector, AWr8PacketAndAStrayTrailingByteAreBothDelivered) {
   const Bytes delivered = joined(out);
   EXPECT_EQ(delivered, written);
   EXPECT_FALSE(injector->next_due());
+}
+
+// The real WR8 programs put a length byte before every packet
+// (smart_vehicle_gui 8d80e92 and 431e8d4): with their profiles, rules act
+// on the length byte and its packet as one frame.
+namespace svgui = protocol::wr8::svgui;
+
+std::shared_ptr<const ProtocolAdapter> svgui_head() {
+  return protocol_adapter("wr8", "svgui-head");
+}
+Bytes high_freq(std::uint32_t timestamp_ms) {
+  return svgui::encode_prefixed(svgui::HighFreqData{timestamp_ms, 1, 2, 3, 4, 5},
+                                svgui::Version::head);
+}
+Bytes low_freq() {
+  return svgui::encode_prefixed(svgui::LowFreqData{protocol::wr8::State::wait, 7, 87, 95, 40},
+                                svgui::Version::head);
+}
+Bytes program_reply() {
+  return svgui::encode_prefixed(svgui::kProgramAuthReply, svgui::Version::head);
+}
+
+TEST(FaultInjector, SvguiFragmentCutsTheMatchedPacketWithItsLengthByte) {
+  Fragment f;
+  f.piece_bytes = {10, 10};
+  f.gap = {1ms, 1ms};
+  Trigger t;
+  t.match = "HIGH_FREQ_DATA";
+  const Bytes high = high_freq(1000);
+  ASSERT_EQ(high.size(), 66U);
+  const auto run =
+      run_injector(svgui_head(), profile_of({rule(f, t)}), {{0ms, program_reply()}, {10ms, high}});
+  const auto d = run.deliveries();
+  ASSERT_EQ(d.size(), 8U);  // the reply whole, then 7 pieces of the 66 bytes
+  EXPECT_EQ(std::get<Delivery>(d[0].what).bytes, program_reply());
+  EXPECT_EQ(std::get<Delivery>(d[1].what).bytes.front(), 0x41)
+      << "the first piece opens with the length byte";
+  for (std::size_t i = 1; i < d.size(); ++i)
+    EXPECT_EQ(d[i].at, Time{10ms} + Time{1ms} * static_cast<int>(i - 1));
+  EXPECT_EQ(run.delivered(), concat({program_reply(), high}));
+  const auto events = run.events_of("fragment");
+  ASSERT_EQ(events.size(), 1U);
+  EXPECT_EQ(events[0].before, high);
+  EXPECT_EQ(events[0].frame, 2U);
+}
+
+TEST(FaultInjector, SvguiCoalesceAndDropWorkOnWholePrefixedPackets) {
+  Coalesce c;
+  c.count = 3;
+  const std::vector<Write> writes = {
+      {0ms, high_freq(0)}, {50ms, high_freq(50)}, {100ms, high_freq(100)}};
+  const auto coalesced = run_injector(svgui_head(), profile_of({rule(c)}), writes);
+  ASSERT_EQ(coalesced.deliveries().size(), 1U);
+  EXPECT_EQ(coalesced.deliveries()[0].at, Time{100ms});
+  const auto frames = decode(*svgui_head(), coalesced.delivered());
+  ASSERT_EQ(frames.size(), 3U);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(frames[i].valid) << frames[i].text;
+    EXPECT_EQ(frames[i].raw, writes[i].bytes);
+  }
+
+  Trigger t;
+  t.match = "LOW_FREQ_DATA";
+  const auto dropped = run_injector(svgui_head(), profile_of({rule(Drop{}, t)}),
+                                    {{0ms, high_freq(0)}, {1ms, low_freq()}, {2ms, high_freq(2)}});
+  EXPECT_EQ(dropped.delivered(), concat({high_freq(0), high_freq(2)}));
+  ASSERT_EQ(dropped.events.size(), 1U);
+  EXPECT_EQ(dropped.events[0].before, low_freq()) << "the length byte goes with its packet";
+}
+
+TEST(FaultInjector, SvguiCorruptTargetsTheLengthByteOrTheCoi) {
+  Corrupt length;
+  length.target = CorruptTarget::field;
+  length.field = "length";
+  const Bytes high = high_freq(0);
+  const auto run = run_injector(svgui_head(), profile_of({rule(length)}), {{0ms, high}});
+  const Bytes out = run.delivered();
+  ASSERT_EQ(out.size(), high.size());
+  EXPECT_NE(out[0], high[0]);
+  EXPECT_EQ(Bytes(out.begin() + 1, out.end()), Bytes(high.begin() + 1, high.end()));
+  ASSERT_EQ(run.events.size(), 1U);
+  EXPECT_EQ(run.events[0].detail, "field length: 1 byte changed");
+
+  Corrupt coi;
+  coi.target = CorruptTarget::field;
+  coi.field = "coi";
+  const Bytes task = svgui::encode_prefixed(svgui::Task{7, 1, {100}}, svgui::Version::v2019);
+  const auto v2019 =
+      run_injector(protocol_adapter("wr8", "svgui-2019"), profile_of({rule(coi)}), {{0ms, task}});
+  const Bytes changed = v2019.delivered();
+  ASSERT_EQ(changed.size(), task.size());
+  for (std::size_t i = 0; i < task.size(); ++i) {
+    if (i == 2) {
+      EXPECT_NE(changed[i], task[i]) << "the COI follows the length byte and the code";
+    } else {
+      EXPECT_EQ(changed[i], task[i]) << "byte " << i;
+    }
+  }
+  // The head programs' packets have no COI: the rule finds nothing to change.
+  const auto head = run_injector(
+      svgui_head(), profile_of({rule(coi)}),
+      {{0ms, svgui::encode_prefixed(svgui::Answer{std::nullopt, 1}, svgui::Version::head)}});
+  EXPECT_TRUE(head.events.empty());
 }
 
 TEST(FaultInjector, FinishReleasesAPartialFrame) {

@@ -15,6 +15,7 @@
 #include "protocol/leka/codec.hpp"
 #include "protocol/logi/codec.hpp"
 #include "protocol/wr8/codec.hpp"
+#include "protocol/wr8/svgui.hpp"
 #include "tests/link/faults/fault_test_support.hpp"
 #include "tests/protocol/arduino/arduino_generators.hpp"
 #include "tests/protocol/leka/leka_generators.hpp"
@@ -35,7 +36,95 @@ enum class Mix {
   all,         ///< every kind, blind corruption and byte drops included
 };
 
+/// "wr8/svgui-head" is WR8 in that profile; any other name the protocol's default.
+std::shared_ptr<const ProtocolAdapter> adapter_for(const std::string& protocol) {
+  const auto slash = protocol.find('/');
+  if (slash == std::string::npos) return protocol_adapter(protocol);
+  return protocol_adapter(protocol.substr(0, slash), protocol.substr(slash + 1));
+}
+
+/// A packet of the real WR8 programs of `version`, with its length byte.
+Bytes gen_svgui_packet(protocol::wr8::svgui::Version version) {
+  namespace svgui = protocol::wr8::svgui;
+  const auto state = [] { return static_cast<protocol::wr8::State>(*gen::inRange(0, 4)); };
+  const auto byte = [] { return *gen::arbitrary<std::uint8_t>(); };
+  const auto real = [] { return *gen::arbitrary<double>(); };
+  const auto u32 = [] { return *gen::arbitrary<std::uint32_t>(); };
+  const auto i32 = [] { return *gen::arbitrary<std::int32_t>(); };
+  svgui::Message m;
+  const bool v2019 = version == svgui::Version::v2019;
+  switch (*gen::inRange(0, v2019 ? 6 : 10)) {
+    case 0:
+      m = svgui::Auth{*gen::container<Bytes>(*gen::inRange<std::size_t>(0, 20),
+                                             gen::arbitrary<std::uint8_t>())};
+      break;
+    case 1:
+      m = svgui::AuthReply{byte(), byte(), state()};
+      break;
+    case 2:
+      if (v2019) {
+        m = svgui::Answer{byte(), byte()};
+      } else {
+        m = svgui::Answer{std::nullopt, byte()};
+      }
+      break;
+    case 3:
+      if (v2019) {
+        m = svgui::Task{byte(), byte(),
+                        *gen::container<std::vector<std::int32_t>>(*gen::inRange<std::size_t>(0, 6),
+                                                                   gen::arbitrary<std::int32_t>())};
+      } else {
+        svgui::Set set;
+        for (auto& v : set.values)
+          v = real();
+        m = set;
+      }
+      break;
+    case 4:
+      if (v2019) {
+        m = svgui::Settings{byte(), {i32(), i32(), i32(), i32()}};
+      } else {
+        m = svgui::SetRequest{};
+      }
+      break;
+    case 5:
+      if (v2019) {
+        m = svgui::Data{state(), u32(), i32(), real(), u32(), u32()};
+      } else {
+        m = svgui::HighFreqData{u32(), real(), real(), real(), real(), real()};
+      }
+      break;
+    case 6:
+      m = svgui::LowFreqData{state(), u32(), u32(), u32(), real()};
+      break;
+    case 7:
+      m = svgui::Control{real(), real()};
+      break;
+    default: {
+      const int width = *gen::inRange(0, 9);
+      const int height = *gen::inRange(0, 7);
+      svgui::Map map{static_cast<std::int8_t>(width), static_cast<std::int8_t>(height), {}};
+      for (int r = 0; r < height; ++r) {
+        map.rows.push_back(*gen::container<std::vector<std::int8_t>>(
+            static_cast<std::size_t>(width), gen::arbitrary<std::int8_t>()));
+      }
+      m = map;
+      break;
+    }
+  }
+  return svgui::encode_prefixed(m, version);
+}
+
 rc::Gen<std::vector<Bytes>> gen_frames(const std::string& protocol) {
+  if (protocol.starts_with("wr8/")) {
+    const auto version = *protocol::wr8::svgui::version_of_profile(protocol.substr(4));
+    return gen::exec([version] {
+      std::vector<Bytes> frames(static_cast<std::size_t>(*gen::inRange(1, 41)));
+      for (auto& f : frames)
+        f = gen_svgui_packet(version);
+      return frames;
+    });
+  }
   const auto encoded = [](auto message_gen, auto encode) {
     return gen::map(
         gen::resize(40, gen::nonEmpty(
@@ -112,8 +201,9 @@ FaultRule gen_rule(Mix mix, const std::string& protocol, const std::vector<std::
   if (mix != Mix::lossless) {
     choices.insert(choices.end(), {FaultKind::drop, FaultKind::duplicate, FaultKind::corrupt,
                                    FaultKind::disconnect, FaultKind::reset});
-    // WR8 has no resynchronisation: any byte may start a packet.
-    if (mix == Mix::all || protocol != "wr8") choices.push_back(FaultKind::garbage);
+    // WR8 has no resynchronisation: any byte may start a packet (or be
+    // read as a length byte).
+    if (mix == Mix::all || !protocol.starts_with("wr8")) choices.push_back(FaultKind::garbage);
   }
   if (mix == Mix::all) choices.push_back(FaultKind::refuse);
 
@@ -175,7 +265,7 @@ FaultRule gen_rule(Mix mix, const std::string& protocol, const std::vector<std::
         c.target = CorruptTarget::field;
       }
       if (c.target == CorruptTarget::field) {
-        c.field = *gen::elementOf(protocol_adapter(protocol)->field_names());
+        c.field = *gen::elementOf(adapter_for(protocol)->field_names());
       }
       r.action = c;
       break;
@@ -216,11 +306,12 @@ struct Case {
 /// times, and a random profile of `mix`.
 Case gen_case(Mix mix) {
   Case c;
-  c.protocol = *gen::element<std::string>("logi", "arduino", "wr8", "leka");
+  c.protocol = *gen::element<std::string>("logi", "arduino", "wr8", "leka", "wr8/svgui-2019",
+                                          "wr8/svgui-head");
   c.frames = *gen_frames(c.protocol);
   const Bytes stream = concat(c.frames);
   std::vector<std::string> kinds;
-  for (const auto& f : decode(c.protocol, stream)) {
+  for (const auto& f : decode(*adapter_for(c.protocol), stream)) {
     RC_ASSERT(f.valid);
     kinds.push_back(f.kind);
   }
@@ -255,7 +346,7 @@ struct Outcome {
 
 Outcome run_case(const Case& c) {
   std::vector<FaultEvent> events;
-  auto injector = make_injector(c.protocol, c.profile, events, c.seed);
+  auto injector = make_injector(adapter_for(c.protocol), c.profile, events, c.seed);
   Outcome o{drive(*injector, c.writes), injector->frames_seen()};
   o.run.events = std::move(events);
   return o;
@@ -332,7 +423,7 @@ RC_GTEST_PROP(FaultProperties, FarSideDecodesExactlyTheFramesTheEventsLeave, ())
       expected.push_back(c.frames[n - 1]);
   }
   std::vector<Bytes> decoded;
-  for (const auto& f : decode(c.protocol, run.delivered())) {
+  for (const auto& f : decode(*adapter_for(c.protocol), run.delivered())) {
     if (f.valid) decoded.push_back(f.raw);
   }
   RC_ASSERT(decoded == expected);

@@ -104,35 +104,56 @@ inline Run drive(FaultInjector& injector, const std::vector<Write>& writes, bool
   return run;
 }
 
-/// An injector whose events land in `run_events`.
-inline std::unique_ptr<FaultInjector> make_injector(const std::string& protocol,
+/// An injector framing by `adapter` whose events land in `run_events`.
+inline std::unique_ptr<FaultInjector> make_injector(std::shared_ptr<const ProtocolAdapter> adapter,
                                                     FaultProfile profile,
                                                     std::vector<FaultEvent>& run_events,
                                                     std::uint64_t seed = 1,
                                                     Direction direction = Direction::to_car) {
   return std::make_unique<FaultInjector>(
-      direction, protocol_adapter(protocol), std::move(profile), seed,
+      direction, std::move(adapter), std::move(profile), seed,
       [&run_events](const FaultEvent& e) { run_events.push_back(e); });
 }
 
-/// Drives a fresh injector and returns the run with its events.
-inline Run run_injector(const std::string& protocol, FaultProfile profile,
+/// An injector for `protocol`'s default profile.
+inline std::unique_ptr<FaultInjector> make_injector(const std::string& protocol,
+                                                    FaultProfile profile,
+                                                    std::vector<FaultEvent>& run_events,
+                                                    std::uint64_t seed = 1,
+                                                    Direction direction = Direction::to_car) {
+  return make_injector(protocol_adapter(protocol), std::move(profile), run_events, seed, direction);
+}
+
+/// Drives a fresh injector framing by `adapter` and returns the run with its events.
+inline Run run_injector(std::shared_ptr<const ProtocolAdapter> adapter, FaultProfile profile,
                         const std::vector<Write>& writes, std::uint64_t seed = 1,
                         bool finish = true) {
   std::vector<FaultEvent> events;
-  auto injector = make_injector(protocol, std::move(profile), events, seed);
+  auto injector = make_injector(std::move(adapter), std::move(profile), events, seed);
   Run run = drive(*injector, writes, finish);
   run.events = std::move(events);
   return run;
 }
 
-/// What a receiver of `protocol` makes of a byte stream.
-inline std::vector<WireFrame> decode(const std::string& protocol, const Bytes& stream) {
-  auto splitter = protocol_adapter(protocol)->splitter();
+/// The same for `protocol`'s default profile.
+inline Run run_injector(const std::string& protocol, FaultProfile profile,
+                        const std::vector<Write>& writes, std::uint64_t seed = 1,
+                        bool finish = true) {
+  return run_injector(protocol_adapter(protocol), std::move(profile), writes, seed, finish);
+}
+
+/// What a receiver framing by `adapter` makes of a byte stream.
+inline std::vector<WireFrame> decode(const ProtocolAdapter& adapter, const Bytes& stream) {
+  auto splitter = adapter.splitter();
   std::vector<WireFrame> frames;
   splitter->feed(stream, frames);
   splitter->finish(frames);
   return frames;
+}
+
+/// What a receiver of `protocol`'s default profile makes of a byte stream.
+inline std::vector<WireFrame> decode(const std::string& protocol, const Bytes& stream) {
+  return decode(*protocol_adapter(protocol), stream);
 }
 
 inline FaultRule rule(FaultAction action, Trigger trigger = {}, TimeWindow window = {}) {

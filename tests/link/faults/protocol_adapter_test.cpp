@@ -10,6 +10,7 @@
 #include "protocol/leka/codec.hpp"
 #include "protocol/logi/codec.hpp"
 #include "protocol/wr8/codec.hpp"
+#include "protocol/wr8/svgui.hpp"
 #include "tests/link/faults/fault_test_support.hpp"
 
 namespace hil::link {
@@ -132,6 +133,10 @@ TEST(ProtocolAdapter, EachAdapterNamesItsProfile) {
   EXPECT_EQ(protocol_adapter("arduino", "readme")->profile(), "readme");
   EXPECT_EQ(protocol_adapter("leka", "comspecs-v3")->profile(), "comspecs-v3");
   EXPECT_EQ(protocol_adapter("leka", "")->profile(), "readme");
+  EXPECT_EQ(protocol_adapter("wr8", "document")->profile(), "document");
+  EXPECT_EQ(protocol_adapter("wr8", "svgui-2019")->profile(), "svgui-2019");
+  EXPECT_EQ(protocol_adapter("wr8", "svgui-head")->profile(), "svgui-head");
+  EXPECT_EQ(protocol_adapter("wr8", "svgui-head")->name(), "wr8");
   try {
     protocol_adapter("leka", "yaml");
     FAIL() << "no exception";
@@ -289,6 +294,212 @@ TEST(ProtocolAdapter, Wr8AdapterFramesByTheVehiclesOwnProfile) {
   // packets in the wrong places.
   const auto standard = split(protocol_adapter("wr8"));
   EXPECT_FALSE(standard.size() == 2U && standard[0].valid && standard[1].valid);
+}
+
+// ---- WR8 as the real programs send it (smart_vehicle_gui 8d80e92 and
+// 431e8d4): a length byte before every packet, which the adapter frames by.
+
+namespace svgui = protocol::wr8::svgui;
+
+Bytes hex(std::string_view text) {
+  return *protocol::parse_hex(text);
+}
+
+const svgui::Data kData{protocol::wr8::State::run, 36000000, 120, 1.5, 87, 95};
+const svgui::HighFreqData kHighFreq{36000000, 1.5, -10, 0.25, 0.5, 90};
+const svgui::LowFreqData kLowFreq{protocol::wr8::State::wait, 36000000, 87, 95, 41.5};
+
+std::vector<WireFrame> decode_with(std::string_view profile, const Bytes& stream) {
+  return decode(*protocol_adapter("wr8", profile), stream);
+}
+
+TEST(ProtocolAdapter, SvguiPacketsAreFramedWithTheirLengthByte) {
+  // The GUIs' logins and the vehicles' fixed reply, byte for byte.
+  const Bytes auth_2019 = hex("0B 01 6B 6F 6E 6E 69 63 68 69 77 61");  // 0B 01 konnichiwa
+  const Bytes auth_head = hex("0C 01 6B 6F 6E 6E 69 63 68 69 77 61 00");
+  const Bytes reply = hex("04 02 01 02 03");
+  ASSERT_EQ(
+      svgui::encode_prefixed(svgui::Auth{protocol::to_bytes("konnichiwa")}, svgui::Version::v2019),
+      auth_2019);
+  ASSERT_EQ(svgui::encode_prefixed(svgui::kProgramAuthReply, svgui::Version::head), reply);
+
+  const auto old = decode_with("svgui-2019", concat({auth_2019, reply}));
+  ASSERT_EQ(old.size(), 2U);
+  EXPECT_EQ(kinds(old), (std::vector<std::string>{"AUTH", "AUTH_REPLY"}));
+  EXPECT_TRUE(old[0].valid && old[1].valid) << old[0].text << " / " << old[1].text;
+  EXPECT_EQ(old[0].raw, auth_2019) << "the length byte is part of the frame";
+  EXPECT_EQ(old[1].raw, reply);
+  EXPECT_EQ(old[1].text, "AuthReply device=1 id=2 state=WAIT");
+
+  const auto head = decode_with("svgui-head", concat({auth_head, reply}));
+  ASSERT_EQ(head.size(), 2U);
+  EXPECT_TRUE(head[0].valid) << head[0].text;
+  EXPECT_EQ(head[0].raw, auth_head);
+  EXPECT_EQ(head[0].text, "Auth text=\"konnichiwa\\x00\"");
+  EXPECT_EQ(head[1].kind, "AUTH_REPLY");
+}
+
+TEST(ProtocolAdapter, SvguiDataPacketsAreWholeFramesOfTheirDocumentedSizes) {
+  const Bytes data = svgui::encode_prefixed(kData, svgui::Version::v2019);
+  const Bytes high = svgui::encode_prefixed(kHighFreq, svgui::Version::head);
+  const Bytes low = svgui::encode_prefixed(kLowFreq, svgui::Version::head);
+  // 42, 65 and 34 packet bytes after the length byte; big-endian values.
+  EXPECT_EQ(Bytes(data.begin(), data.begin() + 15),
+            hex("2A 06 01 02 25 51 00 00 00 00 01 00 00 00 78"));
+  EXPECT_EQ(data.size(), 43U);
+  EXPECT_EQ(Bytes(high.begin(), high.begin() + 14),
+            hex("41 09 02 25 51 00 00 00 00 01 3F F8 00 00"));
+  EXPECT_EQ(high.size(), 66U);
+  EXPECT_EQ(Bytes(low.begin(), low.begin() + 15),
+            hex("22 08 03 02 25 51 00 00 00 00 01 00 00 00 57"));
+  EXPECT_EQ(low.size(), 35U);
+
+  const auto v2019 = decode_with("svgui-2019", concat({data, data}));
+  EXPECT_EQ(kinds(v2019), (std::vector<std::string>{"DATA", "DATA"}));
+  EXPECT_EQ(v2019[0].raw, data);
+  EXPECT_EQ(v2019[0].text, svgui::describe(kData));
+
+  const Bytes map = svgui::encode_prefixed(
+      svgui::Map{8, 6, std::vector<std::vector<std::int8_t>>(6, std::vector<std::int8_t>(8, 0))},
+      svgui::Version::head);
+  ASSERT_EQ(map.size(), 80U);  // 79 packet bytes for 8 x 6
+  const Bytes head_stream = concat(
+      {map, low, high, high, svgui::encode_prefixed(svgui::SetRequest{}, svgui::Version::head),
+       svgui::encode_prefixed(svgui::Set{}, svgui::Version::head),
+       svgui::encode_prefixed(svgui::Answer{std::nullopt, 1}, svgui::Version::head),
+       svgui::encode_prefixed(svgui::Control{0.5, -0.5}, svgui::Version::head)});
+  const auto head = decode_with("svgui-head", head_stream);
+  EXPECT_EQ(kinds(head),
+            (std::vector<std::string>{"MAP", "LOW_FREQ_DATA", "HIGH_FREQ_DATA", "HIGH_FREQ_DATA",
+                                      "SET_REQUEST", "SET", "ANSWER", "CONTROL"}));
+  for (const auto& f : head)
+    EXPECT_TRUE(f.valid) << f.kind << ": " << f.text;
+  EXPECT_EQ(head[2].raw, high);
+  EXPECT_EQ(head[1].raw, low);
+}
+
+TEST(ProtocolAdapter, SvguiStreamsAreNeverReadAsUnframedPackets) {
+  // A HIGH-FREQ DATA whose timestamp bytes read 02 01 02 03: unframed, that
+  // is an AUTH-REPLY. Framed by its length byte it is one DATA packet,
+  // however the bytes arrive.
+  const svgui::HighFreqData tricky{0x02010203, 0, 0, 0, 0, 0};
+  const Bytes packet = svgui::encode_prefixed(tricky, svgui::Version::head);
+  ASSERT_EQ(Bytes(packet.begin(), packet.begin() + 6), hex("41 09 02 01 02 03"));
+  const Bytes stream = concat({packet, packet, packet});
+  for (const std::string_view profile : {"svgui-2019", "svgui-head"}) {
+    auto splitter = protocol_adapter("wr8", profile)->splitter();
+    std::vector<WireFrame> bytewise;
+    for (const auto b : stream)
+      splitter->feed(protocol::ByteView(&b, 1), bytewise);
+    splitter->finish(bytewise);
+    ASSERT_EQ(bytewise.size(), 3U) << profile;
+    for (const auto& f : bytewise) {
+      EXPECT_EQ(f.raw, packet) << profile;
+      EXPECT_NE(f.kind, "AUTH_REPLY") << profile;
+    }
+  }
+  // v2019 has no code 9: the frame is cut right and reported, not re-read.
+  const auto old = decode_with("svgui-2019", packet);
+  ASSERT_EQ(old.size(), 1U);
+  EXPECT_FALSE(old[0].valid);
+  EXPECT_THAT(old[0].text, testing::StartsWith("unknown_code"));
+  // The document dialect, which has no length byte, reads the same bytes as
+  // other packets entirely.
+  const auto document = decode("wr8", stream);
+  EXPECT_FALSE(document.size() == 3U && document[0].raw == packet);
+}
+
+TEST(ProtocolAdapter, SvguiLengthBytesThatCannotBeRightAreInvalidFrames) {
+  // 0 frames nothing; 0x80 and above is a negative signed char (a body of
+  // 128 bytes or more). Each is a one-byte invalid frame, and the next
+  // byte is read as a length byte again.
+  const Bytes reply = hex("04 02 01 02 03");
+  const auto frames = decode_with("svgui-head", concat({hex("00 80 FF"), reply}));
+  ASSERT_EQ(frames.size(), 4U);
+  EXPECT_FALSE(frames[0].valid);
+  EXPECT_EQ(frames[0].raw, hex("00"));
+  EXPECT_THAT(frames[0].text, testing::StartsWith("bad_format: "));
+  for (const std::size_t i : {1U, 2U}) {
+    EXPECT_FALSE(frames[i].valid);
+    EXPECT_EQ(frames[i].raw.size(), 1U);
+    EXPECT_THAT(frames[i].text, testing::StartsWith("oversized: "));
+    EXPECT_THAT(frames[i].text, testing::HasSubstr("128 bytes or more"));
+  }
+  EXPECT_TRUE(frames[3].valid);
+  EXPECT_EQ(frames[3].raw, reply);
+
+  // A stream of nothing but bad length bytes holds nothing.
+  auto splitter = protocol_adapter("wr8", "svgui-2019")->splitter();
+  std::vector<WireFrame> out;
+  splitter->feed(Bytes(1000, 0x9C), out);
+  EXPECT_EQ(out.size(), 1000U);
+  EXPECT_EQ(splitter->buffered(), 0U);
+}
+
+TEST(ProtocolAdapter, SvguiBrokenPacketsKeepTheirNameAndTheirBytes) {
+  // A LOW-FREQ DATA cut to 5 bytes by its length byte: the name rules match
+  // (with '_'), the decoder's error, and the bytes with the length byte.
+  const Bytes short_low = hex("05 08 03 00 00 00");
+  const auto frames = decode_with("svgui-head", concat({short_low, hex("05 02 01")}));
+  ASSERT_EQ(frames.size(), 2U);
+  EXPECT_FALSE(frames[0].valid);
+  EXPECT_EQ(frames[0].kind, "LOW_FREQ_DATA");
+  EXPECT_THAT(frames[0].text, testing::StartsWith("bad_format: "));
+  EXPECT_EQ(frames[0].raw, short_low);
+  // The stream ended two bytes into a five-byte packet.
+  EXPECT_FALSE(frames[1].valid);
+  EXPECT_THAT(frames[1].text, testing::StartsWith("truncated: "));
+  EXPECT_EQ(frames[1].raw, hex("05 02 01"));
+  // TASK is a v2019 packet; the head programs have no code 3.
+  const Bytes task = svgui::encode_prefixed(svgui::Task{7, 1, {100}}, svgui::Version::v2019);
+  EXPECT_EQ(decode_with("svgui-2019", task)[0].kind, "TASK");
+  EXPECT_FALSE(decode_with("svgui-head", task)[0].valid);
+}
+
+TEST(ProtocolAdapter, SvguiFieldsCountTheLengthByte) {
+  const auto old = protocol_adapter("wr8", "svgui-2019");
+  const auto head = protocol_adapter("wr8", "svgui-head");
+  const Bytes task = svgui::encode_prefixed(svgui::Task{7, 1, {100}}, svgui::Version::v2019);
+  ASSERT_EQ(task, hex("08 03 07 01 01 64 00 00 00"));  // little-endian, as the v2019 GUI writes
+  EXPECT_FALSE(old->checksum_field(task));
+  EXPECT_EQ(old->field(task, "length"), (ByteRange{0, 1}));
+  EXPECT_EQ(old->field(task, "code"), (ByteRange{1, 2}));
+  EXPECT_EQ(old->field(task, "coi"), (ByteRange{2, 3}));
+  EXPECT_EQ(old->field(task, "body"), (ByteRange{2, 9}));
+  EXPECT_EQ(old->field(task, "payload"), (ByteRange{2, 9}));
+  EXPECT_FALSE(old->field(task, "seq"));
+
+  const Bytes settings =
+      svgui::encode_prefixed(svgui::Settings{9, {1, 2, 3, 90}}, svgui::Version::v2019);
+  EXPECT_EQ(settings.size(), 19U);  // 18 packet bytes
+  EXPECT_EQ(old->field(settings, "coi"), (ByteRange{2, 3}));
+  const Bytes answer = svgui::encode_prefixed(svgui::Answer{9, 2}, svgui::Version::v2019);
+  EXPECT_EQ(answer, hex("03 05 09 02"));
+  EXPECT_EQ(old->field(answer, "coi"), (ByteRange{2, 3}));
+  const Bytes data = svgui::encode_prefixed(kData, svgui::Version::v2019);
+  EXPECT_FALSE(old->field(data, "coi")) << "DATA has no COI";
+  EXPECT_EQ(old->field(data, "body"), (ByteRange{2, 43}));
+
+  // The head ANSWER has no COI; nor has any head packet.
+  const Bytes head_answer =
+      svgui::encode_prefixed(svgui::Answer{std::nullopt, 1}, svgui::Version::head);
+  EXPECT_EQ(head_answer, hex("02 05 01"));
+  EXPECT_FALSE(head->field(head_answer, "coi"));
+  EXPECT_EQ(head->field(head_answer, "body"), (ByteRange{2, 3}));
+  // SET-REQUEST is a code and nothing else.
+  const Bytes request = svgui::encode_prefixed(svgui::SetRequest{}, svgui::Version::head);
+  EXPECT_EQ(request, hex("01 06"));
+  EXPECT_EQ(head->field(request, "code"), (ByteRange{1, 2}));
+  EXPECT_FALSE(head->field(request, "body"));
+  // A bad length byte is a length and nothing more.
+  EXPECT_EQ(head->field(hex("9C"), "length"), (ByteRange{0, 1}));
+  EXPECT_FALSE(head->field(hex("9C"), "code"));
+  EXPECT_FALSE(head->field(Bytes{}, "length"));
+
+  EXPECT_THAT(old->field_names(),
+              testing::UnorderedElementsAre("length", "code", "payload", "body", "coi"));
+  EXPECT_THAT(head->field_names(),
+              testing::UnorderedElementsAre("length", "code", "payload", "body"));
 }
 
 TEST(ProtocolAdapter, RawMakesEachWriteOneFrameAndHoldsNothing) {
