@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <optional>
 #include <regex>
@@ -212,6 +213,45 @@ TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
   client.send(std::string("\x01") + "0123456789");
   ASSERT_TRUE(client.read_until(std::string("\x02", 1))) << client.received.size();
   EXPECT_EQ(mock.interrupt(), 0);
+}
+
+TEST(HilMock, Wr8SvguiHeadStreamsDataStampedWithTheTimeOfDayAndAnswersTheRealGuisLogin) {
+  HilProcess mock({"mock", "wr8", "--profile", "svgui-head", "--port", "0"});
+  const auto line = mock.wait_for_line("connect to tcp://");
+  ASSERT_TRUE(line) << mock.output();
+  Fd client(connect_loopback(port_in(*line)));
+  // HIGH-FREQ DATA flows before any login: length byte 0x41, code 9, then
+  // the big-endian milliseconds since local midnight.
+  const std::string high_freq("\x41\x09", 2);
+  ASSERT_TRUE(client.read_until(high_freq)) << client.received.size();
+  const auto at = client.received.find(high_freq);
+  // LOW-FREQ (0x22, code 8) follows within a second: by then the first
+  // HIGH-FREQ is whole.
+  ASSERT_TRUE(client.read_until(std::string("\x22\x08", 2))) << client.received.size();
+  ASSERT_GE(client.received.size(), at + 6);
+  std::uint32_t stamp = 0;
+  for (std::size_t k = 0; k < 4; ++k)
+    stamp = (stamp << 8) | static_cast<std::uint8_t>(client.received[at + 2 + k]);
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  const std::int64_t day_ms = 86'400'000;
+  const std::int64_t local_ms = (local.tm_hour * 3600 + local.tm_min * 60 + local.tm_sec) * 1000LL;
+  const std::int64_t off =
+      ((static_cast<std::int64_t>(stamp) - local_ms) % day_ms + day_ms) % day_ms;
+  EXPECT_LT(std::min(off, day_ms - off), 10'000) << stamp << " vs " << local_ms;
+  // The head GUI's AUTH is answered with the fixed AUTH-REPLY.
+  client.received.clear();
+  client.send(std::string("\x0C\x01konnichiwa", 12) + std::string(1, '\0'));
+  EXPECT_TRUE(client.read_until(std::string("\x04\x02\x01\x02\x03", 5))) << client.received.size();
+  EXPECT_EQ(mock.interrupt(), 0);
+}
+
+TEST(HilMock, Wr8SvguiHeadKeepsItsDataRates) {
+  const auto r = run_hil("mock wr8 --profile svgui-head --data-hz 5");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("svgui-head vehicle sends HIGH-FREQ DATA every 50 ms"), std::string::npos)
+      << r.output;
 }
 
 TEST(HilMock, DeskCommandsDropAParcelThatLocksTheCarAndTakeItAway) {
