@@ -418,8 +418,9 @@ class SvguiAdapter final : public ProtocolAdapter {
     namespace svgui = protocol::wr8::svgui;
     return std::make_unique<UnderscoredKinds>(make_splitter<svgui::Message>(
         svgui::Decoder{version_},
-        [](const svgui::Message& m, bool text) {
-          return KindAndText{std::string(kind_of(m)), text ? svgui::describe(m) : std::string()};
+        [version = version_](const svgui::Message& m, bool text) {
+          return KindAndText{svgui::kind_name(svgui::code_of(m), version),
+                             text ? svgui::describe(m) : std::string()};
         },
         with_text));
   }
@@ -453,26 +454,6 @@ class SvguiAdapter final : public ProtocolAdapter {
   }
 
  private:
-  /// The packet's name as fault rules match it: '-' written '_'.
-  static std::string_view kind_of(const protocol::wr8::svgui::Message& m) {
-    namespace svgui = protocol::wr8::svgui;
-    return std::visit(protocol::Overloaded{
-                          [](const svgui::Auth&) { return "AUTH"; },
-                          [](const svgui::AuthReply&) { return "AUTH_REPLY"; },
-                          [](const svgui::Task&) { return "TASK"; },
-                          [](const svgui::Settings&) { return "SETTINGS"; },
-                          [](const svgui::Set&) { return "SET"; },
-                          [](const svgui::Answer&) { return "ANSWER"; },
-                          [](const svgui::SetRequest&) { return "SET_REQUEST"; },
-                          [](const svgui::Data&) { return "DATA"; },
-                          [](const svgui::Map&) { return "MAP"; },
-                          [](const svgui::LowFreqData&) { return "LOW_FREQ_DATA"; },
-                          [](const svgui::HighFreqData&) { return "HIGH_FREQ_DATA"; },
-                          [](const svgui::Control&) { return "CONTROL"; },
-                      },
-                      m);
-  }
-
   protocol::wr8::svgui::Version version_;
 };
 

@@ -83,25 +83,6 @@ bool covers(const sim::Obstacle& obstacle, sim::Vec2 p) {
   return std::hypot(p.x_m - circle.center_m.x_m, p.y_m - circle.center_m.y_m) <= circle.radius_m;
 }
 
-/// The packet's name as the link's WR8 adapters and behaviours call it.
-std::string_view kind_of(std::uint8_t code, svgui::Version version) {
-  const bool v2019 = version == svgui::Version::v2019;
-  switch (code) {
-    case kAuthCode:
-      return "AUTH";
-    case kTaskCode:
-      return "TASK";
-    case kSettingsCode:
-      return v2019 ? "SETTINGS" : "SET";
-    case kSetRequestCode:
-      return "SET_REQUEST";
-    case kControlCode:
-      return "CONTROL";
-    default:
-      return "";
-  }
-}
-
 }  // namespace
 
 std::string_view to_string(SvguiState::Task task) {
@@ -464,8 +445,10 @@ void SvguiFirmware::handle_settings(Time now, ByteView packet) {
 }
 
 void SvguiFirmware::handle_head(Time now, ByteView packet) {
-  const std::string_view kind = kind_of(packet[0], version_);
-  if (kind.empty() || kind == "TASK") {
+  // The head program acts on SET, SET-REQUEST and CONTROL alone.
+  const std::uint8_t code = packet[0];
+  const std::string kind = svgui::kind_name(code, version_);
+  if (code != kSettingsCode && code != kSetRequestCode && code != kControlCode) {
     unusable("code " + std::to_string(packet[0]) + " is no packet the head vehicle reads");
     return;
   }

@@ -1,5 +1,6 @@
 #include "protocol/wr8/svgui.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <stdexcept>
@@ -134,6 +135,24 @@ std::optional<State> state_of(std::uint8_t b) {
   return static_cast<State>(b);
 }
 
+Item error(ErrorKind kind, ByteView packet, std::string detail, std::string_view context) {
+  return DecodeError{kind, Bytes(packet.begin(), packet.end()), std::move(detail),
+                     std::string(context)};
+}
+
+/// The shortest text that reads back as exactly `v`.
+std::string shortest(double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc{} ? std::string(buf, end) : std::string("?");
+}
+
+}  // namespace
+
+const std::array<std::string_view, 12> kSetNames = {
+    "steering-p", "steering-i",  "steering-d", "steering-zero", "forward-p",  "forward-i",
+    "forward-d",  "forward-int", "backward-p", "backward-i",    "backward-d", "backward-int"};
+
 std::string_view packet_name(std::uint8_t code, Version version) {
   switch (code) {
     case kAuth:
@@ -161,23 +180,11 @@ std::string_view packet_name(std::uint8_t code, Version version) {
   }
 }
 
-Item error(ErrorKind kind, ByteView packet, std::string detail, std::string_view context) {
-  return DecodeError{kind, Bytes(packet.begin(), packet.end()), std::move(detail),
-                     std::string(context)};
+std::string kind_name(std::uint8_t code, Version version) {
+  std::string kind(packet_name(code, version));
+  std::replace(kind.begin(), kind.end(), '-', '_');
+  return kind;
 }
-
-/// The shortest text that reads back as exactly `v`.
-std::string shortest(double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc{} ? std::string(buf, end) : std::string("?");
-}
-
-}  // namespace
-
-const std::array<std::string_view, 12> kSetNames = {
-    "steering-p", "steering-i",  "steering-d", "steering-zero", "forward-p",  "forward-i",
-    "forward-d",  "forward-int", "backward-p", "backward-i",    "backward-d", "backward-int"};
 
 std::string_view to_string(Version version) {
   return version == Version::v2019 ? "v2019" : "head";

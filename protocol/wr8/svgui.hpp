@@ -141,6 +141,13 @@ struct Control {
 using Message = std::variant<Auth, AuthReply, Task, Settings, Set, Answer, SetRequest, Data, Map,
                              LowFreqData, HighFreqData, Control>;
 
+/// The packet's name in `version` ("AUTH-REPLY", "SETTINGS", "SET"); empty
+/// for a code the version does not have.
+std::string_view packet_name(std::uint8_t code, Version version);
+/// The name fault rules, behaviours and scenario matchers know a packet by:
+/// packet_name with '_' for '-' ("HIGH_FREQ_DATA"); empty for an unknown code.
+std::string kind_name(std::uint8_t code, Version version);
+
 /// The packet code of a message, and whether `version` has that packet.
 std::uint8_t code_of(const Message& m);
 bool has_packet(Version version, const Message& m);
