@@ -12,70 +12,35 @@
 #include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
 #include "link/transport.hpp"
+#include "protocol/common/car_profile.hpp"
+#include "protocol/wr8/svgui.hpp"
 
 namespace hil::apps::wr8_client {
 
 namespace wr8 = client::wr8;
 
-ParsedArguments parse_arguments(int argc, const char* const* argv) {
-  AppOptions o;
-  CLI::App app{"wr8-client: drive the WR8 vehicle over TCP (actions, a script, or interactively)"};
-  app.add_option("--host", o.host, "The vehicle's address (default 127.0.0.1)");
-  app.add_option("--port", o.port, "The vehicle's TCP port (default 9100)");
-  app.add_option("--auth", o.auth, "The 10-character authentication string (default HIL-WR8-01)");
-  add_log_and_script_options(app, o.log_path,
-                             "Write the communication log here at exit: .txt, .csv or .ndjson",
-                             o.script, "Run the actions of this file, one per line");
-  app.add_flag("--data", o.data,
-               "Batch: print DATA as it arrives (on a change of state, else once a second)");
-  app.add_flag("--keep-going", o.keep_going,
-               "Batch: run every action even after one failed (exit 1 at the end)");
-  app.add_option("--connect-timeout", o.connect_timeout_s,
-                 "Seconds a connect action may take to log in (default 10)")
-      ->check(CLI::Range(0.001, 3600.0));
-  app.add_option("actions", o.actions,
-                 "Actions to run, one per argument: connect \"drive 30\" \"turn 10\" get-settings "
-                 "(no actions and no script: interactive)");
-  app.footer(
-      "Actions: connect, disconnect, drive CM, turn DEG, task CODE [VALUE...], get-settings,\n"
-      "  set NAME=VALUE... (p, i, d, servo-zero), wait 500ms|1s, wait-data; '#' starts a comment.\n"
-      "Interactive only: state, log [N], history, save-log PATH, help, quit.\n"
-      "Exit codes: 0 all went well, 1 an action failed, 2 bad usage or a script line that does\n"
-      "  not parse (file:line:col), 130 interrupted.\n"
-      "Examples:\n"
-      "  wr8-client connect \"drive 30\" \"turn 10\" get-settings\n"
-      "  wr8-client --port 9101 --script scenarios/clients/wr8-client/drive-and-turn.wr8\n"
-      "  wr8-client --log session.csv          # interactive\n");
-  return parse_options<AppOptions>(
-      app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
-        if (!given.script.empty() && !given.actions.empty())
-          return "wr8-client: give either --script or actions, not both";
-        if (!given.auth.empty() && given.auth.size() != wr8::proto::kAuthTextBytes)
-          return "wr8-client: --auth must be exactly " +
-                 std::to_string(wr8::proto::kAuthTextBytes) + " characters, got " +
-                 std::to_string(given.auth.size()) + " (\"" + given.auth + "\")";
-        return std::nullopt;
-      });
+namespace {
+
+constexpr std::uint16_t kDocumentPort = 9100;
+
+/// The real-program version of --profile, or nullopt for document.
+std::optional<wr8::svgui::Version> version_of(const AppOptions& options) {
+  return wr8::svgui::version_of_profile(options.profile);
 }
 
-wr8::ClientConfig client_config(const AppOptions& options) {
-  wr8::ClientConfig config;
-  if (options.auth.size() == wr8::proto::kAuthTextBytes)
-    std::copy(options.auth.begin(), options.auth.end(), config.profile.auth_text.begin());
-  return config;
-}
-
-std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& options,
-                                                              const wr8::proto::Profile& profile,
-                                                              std::ostream& errors) {
-  std::vector<wr8::OperatorAction> actions;
+/// Parses every argument (or the script) with `parse_line` / `parse_script`;
+/// nullopt after printing every bad one.
+template <class Action, class ParseLine, class ParseScript>
+std::optional<std::vector<Action>> parse_batch(const AppOptions& options, std::ostream& errors,
+                                               ParseLine parse_line, ParseScript parse_script) {
+  std::vector<Action> actions;
   if (!options.script.empty()) {
     const auto text = read_script_text(options.script, std::cin);
     if (!text) {
       errors << options.script << ": cannot open the script\n";
       return std::nullopt;
     }
-    const auto script = wr8::parse_operator_script(*text, options.script, profile);
+    const auto script = parse_script(*text, options.script);
     for (const auto& e : script.errors)
       errors << e.to_string() << '\n';
     if (!script.errors.empty()) return std::nullopt;
@@ -85,7 +50,7 @@ std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& 
   }
   bool ok = true;
   for (std::size_t i = 0; i < options.actions.size(); ++i) {
-    const auto parsed = wr8::parse_operator_line(options.actions[i], profile);
+    const auto parsed = parse_line(options.actions[i]);
     if (parsed.error) {
       errors << "argument " << i + 1 << ":" << parsed.error->column << ": " << parsed.error->message
              << '\n';
@@ -98,19 +63,14 @@ std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& 
   return actions;
 }
 
-int run(const AppOptions& options) {
-  const wr8::ClientConfig config = client_config(options);
+/// The program's loop for one dialect's session, runner and console.
+template <class Kit, class Config>
+int run_with(const AppOptions& options, Config config, std::vector<typename Kit::Action> actions) {
   const bool interactive = options.actions.empty() && options.script.empty();
-  std::vector<wr8::OperatorAction> actions;
-  if (!interactive) {
-    auto parsed = batch_actions(options, config.profile, std::cerr);
-    if (!parsed) return kExitUsage;
-    actions = std::move(*parsed);
-  }
-
+  const std::uint16_t port = effective_port(options);
   link::Endpoint endpoint;
   try {
-    endpoint = link::parse_endpoint("tcp://" + options.host + ":" + std::to_string(options.port));
+    endpoint = link::parse_endpoint("tcp://" + options.host + ":" + std::to_string(port));
   } catch (const std::exception& e) {
     std::cerr << "wr8-client: bad --host/--port: " << e.what() << '\n';
     return kExitUsage;
@@ -120,16 +80,17 @@ int run(const AppOptions& options) {
   link::AsioExecutor executor(io);
   link::TransportContext context{executor, &io};
 
-  wr8::OperatorRunner* runner_ptr = nullptr;
-  Wr8Console* console_ptr = nullptr;
-  wr8::Wr8Session session(context, endpoint, config, [&](link::Time now, const wr8::Event& e) {
-    if (runner_ptr != nullptr) runner_ptr->on_event(now, e);
-    if (console_ptr != nullptr) console_ptr->on_event(now, e);
-  });
+  typename Kit::Runner* runner_ptr = nullptr;
+  BasicConsole<Kit>* console_ptr = nullptr;
+  typename Kit::Session session(context, endpoint, std::move(config),
+                                [&](link::Time now, const typename Kit::Event& e) {
+                                  if (runner_ptr != nullptr) runner_ptr->on_event(now, e);
+                                  if (console_ptr != nullptr) console_ptr->on_event(now, e);
+                                });
   wr8::RunnerOptions runner_options;
   runner_options.connect_timeout =
       link::Duration(static_cast<link::Duration::rep>(options.connect_timeout_s * 1e9));
-  wr8::OperatorRunner runner(executor, session, runner_options);
+  typename Kit::Runner runner(executor, session, runner_options);
   runner_ptr = &runner;
 
   int exit_code = kExitOk;
@@ -139,7 +100,7 @@ int run(const AppOptions& options) {
   console_options.print_data = options.data;
   console_options.keep_going = options.keep_going;
   console_options.log_path = options.log_path;
-  Wr8Console console(executor, session, runner, std::cout, console_options, [&](int code) {
+  BasicConsole<Kit> console(executor, session, runner, std::cout, console_options, [&](int code) {
     exit_code = code;
     // Let the close reach the socket before the loop ends.
     asio::post(io, [&io] { io.stop(); });
@@ -157,8 +118,9 @@ int run(const AppOptions& options) {
                              },
                          .more = [&] { return !console.exited(); }});
   if (interactive) {
-    std::cout << "wr8-client: vehicle at " << options.host << ":" << options.port
-              << "; type 'help' for the commands, 'connect' to log in\n"
+    const std::string profile = options.profile.empty() ? "document" : options.profile;
+    std::cout << "wr8-client: vehicle at " << options.host << ":" << port << " (profile " << profile
+              << "); type 'help' for the commands, 'connect' to log in\n"
               << std::flush;
     console.start();
     reader.start();
@@ -167,6 +129,124 @@ int run(const AppOptions& options) {
   }
   io.run();
   return exit_code;
+}
+
+}  // namespace
+
+ParsedArguments parse_arguments(int argc, const char* const* argv) {
+  AppOptions o;
+  CLI::App app{"wr8-client: drive the WR8 vehicle over TCP (actions, a script, or interactively)"};
+  app.add_option("--host", o.host, "The vehicle's address (default 127.0.0.1)");
+  app.add_option("--port", o.port,
+                 "The vehicle's TCP port (default 9100 for profile document, 5556 for "
+                 "svgui-2019 and svgui-head)")
+      ->check(CLI::Range(1, 65535));
+  add_profile_option(app, o.profile, "wr8",
+                     "The vehicle's dialect: document (the protocol PDF, the default), svgui-2019 "
+                     "or svgui-head (the real smart_vehicle_gui programs)");
+  app.add_option("--auth", o.auth,
+                 "Profile document: the 10-character authentication string (default HIL-WR8-01)");
+  add_log_and_script_options(app, o.log_path,
+                             "Write the communication log here at exit: .txt, .csv or .ndjson",
+                             o.script, "Run the actions of this file, one per line");
+  app.add_flag("--data", o.data,
+               "Batch: print DATA as it arrives (on a change of state, else once a second)");
+  app.add_flag("--keep-going", o.keep_going,
+               "Batch: run every action even after one failed (exit 1 at the end)");
+  app.add_option("--connect-timeout", o.connect_timeout_s,
+                 "Seconds a connect action may take to log in (default 10)")
+      ->check(CLI::Range(0.001, 3600.0));
+  app.add_option("actions", o.actions,
+                 "Actions to run, one per argument: connect \"drive 30\" \"turn 10\" get-settings "
+                 "(no actions and no script: interactive)");
+  app.footer(
+      "Actions of profile document: connect, disconnect, drive CM, turn DEG, task CODE "
+      "[VALUE...],\n"
+      "  get-settings, set NAME=VALUE... (p, i, d, servo-zero), wait 500ms|1s, wait-data.\n"
+      "Actions of profile svgui-2019: connect, disconnect, forward CM, wheels DEG, signals,\n"
+      "  settings p=P i=I d=D servo-zero=Z, wait DURATION, wait-data.\n"
+      "Actions of profile svgui-head: connect, disconnect, control X Y, control off,\n"
+      "  set NAME=VALUE... (steering-p ... backward-int), set-request, wait DURATION, wait-data.\n"
+      "'#' starts a comment. Interactive only: state, log [N], history, save-log PATH, help, "
+      "quit.\n"
+      "Exit codes: 0 all went well, 1 an action failed, 2 bad usage or a script line that does\n"
+      "  not parse (file:line:col), 130 interrupted.\n"
+      "Examples:\n"
+      "  wr8-client connect \"drive 30\" \"turn 10\" get-settings\n"
+      "  wr8-client --port 9101 --script scenarios/clients/wr8-client/drive-and-turn.wr8\n"
+      "  wr8-client --profile svgui-head connect set-request \"control 0 0.3\" \"wait 2s\" "
+      "\"control off\"\n"
+      "  wr8-client --log session.csv          # interactive\n");
+  return parse_options<AppOptions>(
+      app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
+        if (!given.script.empty() && !given.actions.empty())
+          return "wr8-client: give either --script or actions, not both";
+        if (!given.auth.empty() && version_of(given))
+          return "wr8-client: --auth is for profile document; " + given.profile +
+                 " always sends the real programs' \"konnichiwa\"";
+        if (!given.auth.empty() && given.auth.size() != wr8::proto::kAuthTextBytes)
+          return "wr8-client: --auth must be exactly " +
+                 std::to_string(wr8::proto::kAuthTextBytes) + " characters, got " +
+                 std::to_string(given.auth.size()) + " (\"" + given.auth + "\")";
+        return std::nullopt;
+      });
+}
+
+wr8::ClientConfig client_config(const AppOptions& options) {
+  wr8::ClientConfig config;
+  if (options.auth.size() == wr8::proto::kAuthTextBytes)
+    std::copy(options.auth.begin(), options.auth.end(), config.profile.auth_text.begin());
+  return config;
+}
+
+std::uint16_t effective_port(const AppOptions& options) {
+  if (options.port != 0) return options.port;
+  const auto& profile = protocol::find_car_profile("wr8", options.profile);
+  return profile.tcp_port != 0 ? profile.tcp_port : kDocumentPort;
+}
+
+std::optional<std::vector<wr8::OperatorAction>> batch_actions(const AppOptions& options,
+                                                              const wr8::proto::Profile& profile,
+                                                              std::ostream& errors) {
+  return parse_batch<wr8::OperatorAction>(
+      options, errors,
+      [&](std::string_view line) { return wr8::parse_operator_line(line, profile); },
+      [&](std::string_view text, const std::string& file) {
+        return wr8::parse_operator_script(text, file, profile);
+      });
+}
+
+std::optional<std::vector<wr8::SvguiAction>> svgui_batch_actions(const AppOptions& options,
+                                                                 wr8::svgui::Version version,
+                                                                 std::ostream& errors) {
+  return parse_batch<wr8::SvguiAction>(
+      options, errors, [&](std::string_view line) { return wr8::parse_svgui_line(line, version); },
+      [&](std::string_view text, const std::string& file) {
+        return wr8::parse_svgui_script(text, file, version);
+      });
+}
+
+int run(const AppOptions& options) {
+  const bool interactive = options.actions.empty() && options.script.empty();
+  if (const auto version = version_of(options)) {
+    std::vector<wr8::SvguiAction> actions;
+    if (!interactive) {
+      auto parsed = svgui_batch_actions(options, *version, std::cerr);
+      if (!parsed) return kExitUsage;
+      actions = std::move(*parsed);
+    }
+    wr8::SvguiConfig config;
+    config.version = *version;
+    return run_with<SvguiKit>(options, config, std::move(actions));
+  }
+  const wr8::ClientConfig config = client_config(options);
+  std::vector<wr8::OperatorAction> actions;
+  if (!interactive) {
+    auto parsed = batch_actions(options, config.profile, std::cerr);
+    if (!parsed) return kExitUsage;
+    actions = std::move(*parsed);
+  }
+  return run_with<DocumentKit>(options, config, std::move(actions));
 }
 
 }  // namespace hil::apps::wr8_client

@@ -9,13 +9,19 @@
 
 #include "apps/common/program.hpp"
 #include "client/wr8/operator.hpp"
+#include "client/wr8/svgui_operator.hpp"
 
 namespace hil::apps::wr8_client {
 
 struct AppOptions {
   std::string host = "127.0.0.1";
-  std::uint16_t port = 9100;
-  std::string auth;  ///< empty: the profile's default string
+  /// 0: the profile's port (9100, hil's WR8 port, for document; 5556, the
+  /// real programs' port, for svgui-2019 and svgui-head).
+  std::uint16_t port = 0;
+  /// The WR8 dialect: document (the protocol PDF), svgui-2019 or svgui-head
+  /// (the real smart_vehicle_gui programs); empty is document.
+  std::string profile;
+  std::string auth;  ///< empty: the profile's default string (document only)
   std::string log_path;
   std::string script;
   bool data = false;
@@ -37,6 +43,13 @@ std::optional<std::vector<client::wr8::OperatorAction>> batch_actions(
 
 /// The session's configuration from the options (the login string).
 client::wr8::ClientConfig client_config(const AppOptions& options);
+
+/// The port to connect to: --port, else the profile's.
+std::uint16_t effective_port(const AppOptions& options);
+
+/// The batch's actions for a real program's profile, as batch_actions.
+std::optional<std::vector<client::wr8::SvguiAction>> svgui_batch_actions(
+    const AppOptions& options, client::wr8::svgui::Version version, std::ostream& errors);
 
 /// Runs the program; returns its exit code.
 int run(const AppOptions& options);

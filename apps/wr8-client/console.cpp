@@ -23,18 +23,11 @@ std::string optional_value(const std::optional<double>& v, int decimals, std::st
   return fixed(*v, decimals) + " " + std::string(unit);
 }
 
-std::string spaced(std::string_view s) {
-  std::string out(s);
-  for (char& c : out)
-    if (c == '_') c = ' ';
-  return out;
-}
-
 std::string trim(std::string_view s) {
   return std::string(client::trim(s));
 }
 
-constexpr std::string_view kHelp =
+constexpr std::string_view kDocumentHelp =
     "actions (run in order; each waits for its answer):\n"
     "  connect                 open the connection and log in\n"
     "  disconnect              close the connection\n"
@@ -45,6 +38,11 @@ constexpr std::string_view kHelp =
     "  set NAME=VALUE...       change settings (p, i, d, servo-zero)\n"
     "  wait DURATION           pause (500ms, 1s, 1.5s)\n"
     "  wait-data               wait for the next DATA packet\n"
+    "(profile document; svgui-2019 and svgui-head have their own words)\n";
+
+}  // namespace
+
+const std::string_view kConsoleCommands =
     "commands:\n"
     "  state                   the live state from DATA\n"
     "  log [N]                 the last N (20) lines of the communication log\n"
@@ -53,7 +51,20 @@ constexpr std::string_view kHelp =
     "  help                    this text\n"
     "  quit                    disconnect and leave (end of input does the same)\n";
 
-}  // namespace
+std::string underscores_to_spaces(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    if (c == '_') c = ' ';
+  return out;
+}
+
+std::optional<std::string> connection_text(const wr8::ConnectionEvent& e) {
+  if (e.state == wr8::ConnectionState::waiting_to_reconnect)
+    return "connection lost; reconnecting (attempt " + std::to_string(e.attempt + 1) + ")";
+  if (e.state == wr8::ConnectionState::connecting && e.attempt > 0)
+    return "reconnect attempt " + std::to_string(e.attempt);
+  return std::nullopt;
+}
 
 std::string format_live(const wr8::LiveState& live) {
   return std::string(wr8::proto::to_string(live.state)) + "  odometry " +
@@ -64,7 +75,7 @@ std::string format_live(const wr8::LiveState& live) {
 }
 
 std::string format_state(const wr8::Wr8ClientCore& core, link::Time now) {
-  std::string out = "connection: " + spaced(wr8::to_string(core.state())) + "\n";
+  std::string out = "connection: " + underscores_to_spaces(wr8::to_string(core.state())) + "\n";
   const auto& live = core.live();
   if (!live) return out + "no DATA received yet\n";
   out += "vehicle:    " + std::string(wr8::proto::to_string(live->state)) + ", timestamp " +
@@ -78,9 +89,69 @@ std::string format_state(const wr8::Wr8ClientCore& core, link::Time now) {
   return out;
 }
 
-Wr8Console::Wr8Console(link::Executor& executor, wr8::Wr8Session& session,
-                       wr8::OperatorRunner& runner, std::ostream& out, ConsoleOptions options,
-                       Exit exit)
+// ---- the document dialect ----
+
+wr8::ParsedLine DocumentKit::parse(const Session& session, std::string_view line) {
+  return wr8::parse_operator_line(line, session.core().config().profile);
+}
+
+std::string DocumentKit::to_text(const Session& session, const Action& action) {
+  return wr8::to_text(action, session.core().config().profile);
+}
+
+std::string DocumentKit::state_text(const Session& session, link::Time now) {
+  return format_state(session.core(), now);
+}
+
+std::string DocumentKit::help(const Session&) {
+  return std::string(kDocumentHelp) + std::string(kConsoleCommands);
+}
+
+std::optional<DataLine> DocumentKit::data_line(const Event& event) {
+  const auto* t = std::get_if<wr8::TelemetryEvent>(&event);
+  if (t == nullptr) return std::nullopt;
+  return DataLine{0, static_cast<int>(t->live.state), format_live(t->live)};
+}
+
+std::optional<std::string> DocumentKit::event_text(const Session& session, const Event& event) {
+  return std::visit(
+      Overloaded{
+          [&](const wr8::ConnectionEvent& e) -> std::optional<std::string> {
+            return connection_text(e);
+          },
+          [&](const wr8::LoginFailedEvent& e) -> std::optional<std::string> {
+            return "login failed: " + e.reason;
+          },
+          [&](const wr8::StaleEvent& e) -> std::optional<std::string> {
+            return e.stale ? "DATA stale: none for " +
+                                 wr8::format_duration(session.core().config().stale_after)
+                           : std::string("DATA flowing again");
+          },
+          [&](const wr8::RequestEvent& e) -> std::optional<std::string> {
+            if (e.state == wr8::RequestState::sent) return std::nullopt;
+            const std::string what = e.kind == wr8::RequestKind::task
+                                         ? "task " + std::string(wr8::proto::to_string(e.task))
+                                         : std::string("settings");
+            return what + " (COI " + std::to_string(e.coi) + ") " +
+                   underscores_to_spaces(wr8::to_string(e.state));
+          },
+          [&](const wr8::IgnoredEvent& e) -> std::optional<std::string> {
+            return "ignored (late or unknown COI): " +
+                   wr8::proto::describe(e.message, session.core().config().profile);
+          },
+          [&](const wr8::ParseErrorEvent& e) -> std::optional<std::string> {
+            return "bad bytes received: " + e.error.detail;
+          },
+          [](const auto&) -> std::optional<std::string> { return std::nullopt; },
+      },
+      event);
+}
+
+// ---- the console ----
+
+template <class Kit>
+BasicConsole<Kit>::BasicConsole(link::Executor& executor, Session& session, Runner& runner,
+                                std::ostream& out, ConsoleOptions options, Exit exit)
     : executor_(executor),
       session_(session),
       runner_(runner),
@@ -88,78 +159,48 @@ Wr8Console::Wr8Console(link::Executor& executor, wr8::Wr8Session& session,
       options_(std::move(options)),
       exit_(std::move(exit)) {}
 
-std::string Wr8Console::stamp(link::Time t) const {
+template <class Kit>
+std::string BasicConsole<Kit>::stamp(link::Time t) const {
   return seconds_stamp(t, 8);
 }
 
-void Wr8Console::print(const std::string& text) {
+template <class Kit>
+void BasicConsole<Kit>::print(const std::string& text) {
   if (prompted_) out_ << '\n';  // the prompt was waiting on its own line
   prompted_ = false;
   out_ << text << '\n' << std::flush;
 }
 
-void Wr8Console::prompt() {
+template <class Kit>
+void BasicConsole<Kit>::prompt() {
   if (!options_.prompt || exited_ || running_ || !pending_.empty() || prompted_) return;
   out_ << "wr8> " << std::flush;
   prompted_ = true;
 }
 
-void Wr8Console::on_event(link::Time now, const wr8::Event& event) {
+template <class Kit>
+void BasicConsole<Kit>::on_event(link::Time now, const typename Kit::Event& event) {
   if (exited_) return;
   if (!options_.interactive) {
-    const auto* t = std::get_if<wr8::TelemetryEvent>(&event);
-    if (!options_.print_data || t == nullptr) return;
-    // On a change of state code, else at most once a second.
-    if (data_printed_at_ && data_printed_state_ == t->live.state &&
-        now - *data_printed_at_ < link::seconds(1))
+    if (!options_.print_data) return;
+    const auto line = Kit::data_line(event);
+    if (!line) return;
+    // On a change of state code, else at most once a second, per stream.
+    auto it = data_printed_.find(line->stream);
+    if (it != data_printed_.end() && it->second.state == line->state &&
+        now - it->second.at < link::seconds(1))
       return;
-    data_printed_at_ = now;
-    data_printed_state_ = t->live.state;
-    print(stamp(now) + "  data  " + format_live(t->live));
+    data_printed_[line->stream] = Printed{now, line->state};
+    print(stamp(now) + "  data  " + line->text);
     return;
   }
-  std::visit(Overloaded{
-                 [&](const wr8::ConnectionEvent& e) {
-                   if (e.state == wr8::ConnectionState::waiting_to_reconnect)
-                     print(stamp(now) + "  connection lost; reconnecting (attempt " +
-                           std::to_string(e.attempt + 1) + ")");
-                   else if (e.state == wr8::ConnectionState::connecting && e.attempt > 0)
-                     print(stamp(now) + "  reconnect attempt " + std::to_string(e.attempt));
-                 },
-                 [&](const wr8::LoginEvent&) {},  // the connect action's result says it
-                 [&](const wr8::LoginFailedEvent& e) {
-                   print(stamp(now) + "  login failed: " + e.reason);
-                 },
-                 [&](const wr8::StaleEvent& e) {
-                   print(stamp(now) +
-                         (e.stale ? "  DATA stale: none for " +
-                                        wr8::format_duration(session_.core().config().stale_after)
-                                  : "  DATA flowing again"));
-                 },
-                 [&](const wr8::RequestEvent& e) {
-                   if (e.state == wr8::RequestState::sent) return;
-                   const std::string what =
-                       e.kind == wr8::RequestKind::task
-                           ? "task " + std::string(wr8::proto::to_string(e.task))
-                           : std::string("settings");
-                   print(stamp(now) + "  " + what + " (COI " + std::to_string(e.coi) + ") " +
-                         spaced(wr8::to_string(e.state)));
-                 },
-                 [&](const wr8::IgnoredEvent& e) {
-                   print(stamp(now) + "  ignored (late or unknown COI): " +
-                         wr8::proto::describe(e.message, session_.core().config().profile));
-                 },
-                 [&](const wr8::ParseErrorEvent& e) {
-                   print(stamp(now) + "  bad bytes received: " + e.error.detail);
-                 },
-                 [](const auto&) {},
-             },
-             event);
+  if (const auto text = Kit::event_text(session_, event)) print(stamp(now) + "  " + *text);
   prompt();
 }
 
-void Wr8Console::result(const wr8::ActionResult& r) {
-  const std::string text = wr8::to_text(r.action, session_.core().config().profile);
+template <class Kit>
+void BasicConsole<Kit>::result(const typename Kit::Result& r) {
+  const std::string text = Kit::to_text(session_, r.action);
   char head[64];
   std::snprintf(head, sizeof head, "%-24s %-4s", text.c_str(), r.ok ? "ok" : "FAIL");
   std::string line = stamp(r.finished) + "  " + head;
@@ -168,47 +209,53 @@ void Wr8Console::result(const wr8::ActionResult& r) {
   print(line);
 }
 
-void Wr8Console::run_batch(std::vector<wr8::OperatorAction> actions) {
+template <class Kit>
+void BasicConsole<Kit>::run_batch(std::vector<Action> actions) {
   runner_.run(
-      std::move(actions), options_.keep_going, [this](const wr8::ActionResult& r) { result(r); },
+      std::move(actions), options_.keep_going, [this](const typename Kit::Result& r) { result(r); },
       [this](bool all_ok) { exit(all_ok ? kExitOk : kExitFailed); });
 }
 
-void Wr8Console::start() {
+template <class Kit>
+void BasicConsole<Kit>::start() {
   prompt();
 }
 
-void Wr8Console::line(std::string text) {
+template <class Kit>
+void BasicConsole<Kit>::line(std::string text) {
   if (exited_) return;
   prompted_ = false;  // the user's newline ended the prompt's line
   pending_.push_back(std::move(text));
   process();
 }
 
-void Wr8Console::end_of_input() {
+template <class Kit>
+void BasicConsole<Kit>::end_of_input() {
   input_ended_ = true;
   process();
 }
 
-void Wr8Console::interrupt() {
+template <class Kit>
+void BasicConsole<Kit>::interrupt() {
   if (exited_) return;
   print("interrupted; disconnecting");
   exit(kExitInterrupted);
 }
 
-void Wr8Console::process() {
+template <class Kit>
+void BasicConsole<Kit>::process() {
   while (!exited_ && !running_ && !pending_.empty()) {
     const std::string text = std::move(pending_.front());
     pending_.pop_front();
     if (builtin(text)) continue;
-    auto parsed = wr8::parse_operator_line(text, session_.core().config().profile);
+    auto parsed = Kit::parse(session_, text);
     if (parsed.error) {
       print("error: column " + std::to_string(parsed.error->column) + ": " + parsed.error->message);
       continue;
     }
     if (!parsed.action) continue;
     running_ = true;
-    runner_.execute(std::move(*parsed.action), [this](const wr8::ActionResult& r) {
+    runner_.execute(std::move(*parsed.action), [this](const typename Kit::Result& r) {
       running_ = false;
       result(r);
       process();
@@ -222,13 +269,14 @@ void Wr8Console::process() {
   prompt();
 }
 
-bool Wr8Console::builtin(const std::string& raw) {
+template <class Kit>
+bool BasicConsole<Kit>::builtin(const std::string& raw) {
   const std::string text = trim(raw);
   const std::string word = wr8::first_word(text);
   const std::string rest = trim(text.substr(std::min(text.size(), word.size())));
   const auto& core = session_.core();
   if (word == "state") {
-    std::string s = format_state(core, executor_.now());
+    std::string s = Kit::state_text(session_, executor_.now());
     s.pop_back();
     print(s);
   } else if (word == "log") {
@@ -262,7 +310,7 @@ bool Wr8Console::builtin(const std::string& raw) {
     else
       print("error: cannot write " + rest);
   } else if (word == "help" || word == "?") {
-    std::string s(kHelp);
+    std::string s = Kit::help(session_);
     s.pop_back();
     print(s);
   } else if (word == "quit" || word == "exit") {
@@ -273,7 +321,8 @@ bool Wr8Console::builtin(const std::string& raw) {
   return true;
 }
 
-void Wr8Console::exit(int code) {
+template <class Kit>
+void BasicConsole<Kit>::exit(int code) {
   if (exited_) return;
   exited_ = true;
   if (session_.core().state() != wr8::ConnectionState::disconnected) session_.disconnect();
@@ -281,5 +330,8 @@ void Wr8Console::exit(int code) {
     print("error: cannot write " + options_.log_path);
   if (exit_) exit_(code);
 }
+
+template class BasicConsole<DocumentKit>;
+template class BasicConsole<SvguiKit>;
 
 }  // namespace hil::apps::wr8_client

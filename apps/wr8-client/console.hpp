@@ -1,18 +1,22 @@
 #pragma once
 // What wr8-client does with actions, lines and session events, apart from
 // any I/O loop: batch runs, the interactive command loop, the printed
-// lines, log saving and the exit code (docs/clients/wr8-client.md).
+// lines, log saving and the exit code (docs/clients/wr8-client.md). One
+// console serves both dialects' clients; a kit says what differs.
 
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "apps/common/program.hpp"
 #include "client/wr8/operator.hpp"
+#include "client/wr8/svgui_operator.hpp"
 
 namespace hil::apps::wr8_client {
 
@@ -36,18 +40,73 @@ std::string format_state(const wr8::Wr8ClientCore& core, link::Time now);
 /// One DATA as a line: "STOP odo 12 cm  speed 0.00 m/s  angle 0.0 deg  battery 100 %".
 std::string format_live(const wr8::LiveState& live);
 
-class Wr8Console {
+/// The interactive-mode command words both dialects share, for help.
+extern const std::string_view kConsoleCommands;
+/// What a connection change prints interactively, if anything.
+std::optional<std::string> connection_text(const wr8::ConnectionEvent& e);
+/// "timed_out" -> "timed out".
+std::string underscores_to_spaces(std::string_view s);
+
+/// What `--data` prints of one DATA packet: the stream it belongs to (each
+/// is printed on its own once-a-second schedule), its state code (a change
+/// prints at once; -1 for a stream without one), and the line.
+struct DataLine {
+  int stream = 0;
+  int state = -1;
+  std::string text;
+};
+
+/// The console's view of the document dialect's client (Wr8Session).
+struct DocumentKit {
+  using Session = wr8::Wr8Session;
+  using Runner = wr8::OperatorRunner;
+  using Action = wr8::OperatorAction;
+  using Event = wr8::Event;
+  using Result = wr8::ActionResult;
+  static wr8::ParsedLine parse(const Session& session, std::string_view line);
+  static std::string to_text(const Session& session, const Action& action);
+  static std::string state_text(const Session& session, link::Time now);
+  /// The interactive line an event prints (without its time), if any.
+  static std::optional<std::string> event_text(const Session& session, const Event& event);
+  static std::optional<DataLine> data_line(const Event& event);
+  static std::string help(const Session& session);
+};
+
+/// The console's view of the real programs' dialects (SvguiSession).
+struct SvguiKit {
+  using Session = wr8::SvguiSession;
+  using Runner = wr8::SvguiRunner;
+  using Action = wr8::SvguiAction;
+  using Event = wr8::SvguiEvent;
+  using Result = wr8::SvguiActionResult;
+  static wr8::ParsedSvguiLine parse(const Session& session, std::string_view line);
+  static std::string to_text(const Session& session, const Action& action);
+  static std::string state_text(const Session& session, link::Time now);
+  static std::optional<std::string> event_text(const Session& session, const Event& event);
+  static std::optional<DataLine> data_line(const Event& event);
+  static std::string help(const Session& session);
+};
+
+/// The state command's text for a real program's vehicle.
+std::string format_svgui_state(const wr8::SvguiClientCore& core, link::Time now);
+
+/// wr8-client's console over one dialect's session and runner.
+template <class Kit>
+class BasicConsole {
  public:
   using Exit = std::function<void(int code)>;
+  using Session = typename Kit::Session;
+  using Runner = typename Kit::Runner;
+  using Action = typename Kit::Action;
 
-  Wr8Console(link::Executor& executor, wr8::Wr8Session& session, wr8::OperatorRunner& runner,
-             std::ostream& out, ConsoleOptions options, Exit exit);
+  BasicConsole(link::Executor& executor, Session& session, Runner& runner, std::ostream& out,
+               ConsoleOptions options, Exit exit);
 
   /// Every session event, after the runner has seen it.
-  void on_event(link::Time now, const wr8::Event& event);
+  void on_event(link::Time now, const typename Kit::Event& event);
 
   /// Batch: runs the actions in order, stops at the first failure, exits.
-  void run_batch(std::vector<wr8::OperatorAction> actions);
+  void run_batch(std::vector<Action> actions);
 
   /// Interactive: the first prompt.
   void start();
@@ -61,17 +120,22 @@ class Wr8Console {
   bool exited() const { return exited_; }
 
  private:
+  struct Printed {
+    link::Time at{0};
+    int state = -1;
+  };
+
   void process();
   bool builtin(const std::string& text);
-  void result(const wr8::ActionResult& r);
+  void result(const typename Kit::Result& r);
   void print(const std::string& text);
   void prompt();
   void exit(int code);
   std::string stamp(link::Time t) const;
 
   link::Executor& executor_;
-  wr8::Wr8Session& session_;
-  wr8::OperatorRunner& runner_;
+  Session& session_;
+  Runner& runner_;
   std::ostream& out_;
   ConsoleOptions options_;
   Exit exit_;
@@ -83,9 +147,14 @@ class Wr8Console {
   bool running_ = false;  // an action of ours is under way (until its result is printed)
   std::vector<std::string> history_;  // the actions run, with their results
 
-  // --data: the last DATA printed.
-  std::optional<link::Time> data_printed_at_;
-  std::optional<wr8::proto::State> data_printed_state_;
+  // --data: the last line printed of each stream.
+  std::map<int, Printed> data_printed_;
 };
+
+using Wr8Console = BasicConsole<DocumentKit>;
+using SvguiConsole = BasicConsole<SvguiKit>;
+
+extern template class BasicConsole<DocumentKit>;
+extern template class BasicConsole<SvguiKit>;
 
 }  // namespace hil::apps::wr8_client

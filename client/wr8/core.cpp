@@ -43,6 +43,18 @@ std::string_view to_string(RequestState s) {
   return "?";
 }
 
+std::string_view to_string(DataStream s) {
+  switch (s) {
+    case DataStream::data:
+      return "DATA";
+    case DataStream::high_freq:
+      return "HIGH-FREQ DATA";
+    case DataStream::low_freq:
+      return "LOW-FREQ DATA";
+  }
+  return "?";
+}
+
 std::string_view to_string(Refusal r) {
   switch (r) {
     case Refusal::none:

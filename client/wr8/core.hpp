@@ -94,8 +94,14 @@ struct LoginFailedEvent {
 struct TelemetryEvent {
   LiveState live;
 };
+/// Which DATA stream a stale flag is about: the document's and v2019's one
+/// DATA packet, or one of the two rates of the head programs.
+enum class DataStream : std::uint8_t { data, high_freq, low_freq };
+std::string_view to_string(DataStream s);  ///< "DATA", "HIGH-FREQ DATA", "LOW-FREQ DATA"
+
 struct StaleEvent {
   bool stale = false;  ///< true: raised, false: cleared by fresh DATA
+  DataStream stream = DataStream::data;
 };
 
 enum class RequestKind : std::uint8_t { task, settings };
@@ -114,6 +120,10 @@ struct RequestEvent {
   RequestKind kind = RequestKind::task;
   proto::TaskCode task = proto::TaskCode::check;  ///< with kind task
   RequestState state = RequestState::sent;
+  /// What a person should know beyond the state, or empty: for a dialect
+  /// whose vehicle answers some requests never or drops them silently, why
+  /// no answer will come or what a timeout most likely means.
+  std::string note = {};
 };
 /// The settings a get-settings task returned.
 struct SettingsEvent {

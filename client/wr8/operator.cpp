@@ -166,8 +166,37 @@ ParsedLine parse_operator_line(std::string_view line, const proto::Profile& prof
     }
     return ok(std::move(set));
   }
-  return fail(tokens[0].column, "unknown action '" + std::string(tokens[0].text) + "'; expected " +
-                                    std::string(kVocabulary));
+  return fail(tokens[0].column, word_not_in_profile(tokens[0].text, "document", kVocabulary));
+}
+
+std::string word_not_in_profile(std::string_view word, std::string_view profile,
+                                std::string_view vocabulary) {
+  struct Owner {
+    std::string_view word;
+    std::string_view profiles;
+  };
+  static constexpr Owner kOwners[] = {
+      {"drive", "document"},
+      {"turn", "document"},
+      {"task", "document"},
+      {"get-settings", "document"},
+      {"forward", "svgui-2019"},
+      {"wheels", "svgui-2019"},
+      {"signals", "svgui-2019"},
+      {"settings", "svgui-2019"},
+      {"control", "svgui-head"},
+      {"set-request", "svgui-head"},
+      {"set", "document and svgui-head"},
+  };
+  const std::string lower = to_lower(word);
+  for (const auto& o : kOwners) {
+    if (o.word == lower) {
+      return "'" + std::string(word) + "' is not a word of profile " + std::string(profile) + " (" +
+             std::string(o.profiles) + " only); " + std::string(profile) + " takes " +
+             std::string(vocabulary);
+    }
+  }
+  return "unknown action '" + std::string(word) + "'; expected " + std::string(vocabulary);
 }
 
 std::string ScriptError::to_string() const {

@@ -75,9 +75,16 @@ struct ParsedLine {
   std::optional<LineError> error;
 };
 
-/// Parses one line of the vocabulary. Never throws on input.
+/// Parses one line of the document profile's vocabulary. Never throws on
+/// input. A word only the real programs' profiles have is an error naming
+/// the profiles that take it.
 ParsedLine parse_operator_line(std::string_view line,
                                const proto::Profile& profile = proto::default_profile());
+
+/// The error for `word`, a word `profile` does not take: which profiles
+/// take it, if any, and the words `profile` takes (`vocabulary`).
+std::string word_not_in_profile(std::string_view word, std::string_view profile,
+                                std::string_view vocabulary);
 
 /// Splits a line into its first word (lowercased) and the column after it,
 /// so a program can add its own commands in front of the vocabulary.
@@ -106,9 +113,10 @@ struct Script {
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile = proto::default_profile());
 
-/// How one action ended.
-struct ActionResult {
-  OperatorAction action;
+/// How one action ended (of either dialect's vocabulary).
+template <class Action>
+struct BasicActionResult {
+  Action action;
   Time started{0};
   Time finished{0};
   bool ok = false;
@@ -116,6 +124,7 @@ struct ActionResult {
   /// "P=1.5 I=0.25 ..."), for a failure the reason.
   std::string detail;
 };
+using ActionResult = BasicActionResult<OperatorAction>;
 
 struct RunnerOptions {
   /// A `connect` that has not logged in this long after it was given fails.
