@@ -153,6 +153,9 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
                "Batch: print DATA as it arrives (on a change of state, else once a second)");
   app.add_flag("--keep-going", o.keep_going,
                "Batch: run every action even after one failed (exit 1 at the end)");
+  app.add_flag("--no-login-wait", o.no_login_wait,
+               "svgui profiles: use the connection as soon as AUTH is sent, as the real v2019 "
+               "GUI does (the real v2019 vehicle answers no login)");
   app.add_option("--connect-timeout", o.connect_timeout_s,
                  "Seconds a connect action may take to log in (default 10)")
       ->check(CLI::Range(0.001, 3600.0));
@@ -181,6 +184,10 @@ ParsedArguments parse_arguments(int argc, const char* const* argv) {
       app, argc, argv, o, [](const AppOptions& given) -> std::optional<std::string> {
         if (!given.script.empty() && !given.actions.empty())
           return "wr8-client: give either --script or actions, not both";
+        if (given.no_login_wait && !version_of(given))
+          return std::string(
+              "wr8-client: --no-login-wait is for profiles svgui-2019 and svgui-head; the "
+              "document vehicle drops everything before a login");
         if (!given.auth.empty() && version_of(given))
           return "wr8-client: --auth is for profile document; " + given.profile +
                  " always sends the real programs' \"konnichiwa\"";
@@ -237,6 +244,7 @@ int run(const AppOptions& options) {
     }
     wr8::SvguiConfig config;
     config.version = *version;
+    config.wait_for_login = !options.no_login_wait;
     return run_with<SvguiKit>(options, config, std::move(actions));
   }
   const wr8::ClientConfig config = client_config(options);

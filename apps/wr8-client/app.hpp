@@ -26,6 +26,9 @@ struct AppOptions {
   std::string script;
   bool data = false;
   bool keep_going = false;
+  /// svgui profiles: use the connection once AUTH is out, without waiting
+  /// for AUTH-REPLY (the real v2019 vehicle answers no login).
+  bool no_login_wait = false;
   double connect_timeout_s = 10;
   std::vector<std::string> actions;  ///< one action per argument
 };

@@ -149,9 +149,24 @@ void SvguiClientCore::on_connected(Time now) {
   decoder_ = svgui::Decoder(config_.version);
   outbox_.clear();
   last_sent_.reset();
+  logged_in_ = false;
+  if (!config_.wait_for_login) {
+    send(now, svgui::Auth{svgui_auth_text(config_.version)});
+    note(now, "AUTH sent; the connection is used without waiting for AUTH-REPLY");
+    become_connected(now);
+    return;
+  }
   set_state(ConnectionState::authenticating, reconnect_attempt_);
   login_deadline_ = now + config_.login_timeout;
   send(now, svgui::Auth{svgui_auth_text(config_.version)});
+}
+
+void SvguiClientCore::become_connected(Time /*now*/) {
+  login_deadline_.reset();
+  reconnect_attempt_ = 0;
+  for (auto& s : streams_)
+    s.last.reset();
+  set_state(ConnectionState::connected);
 }
 
 void SvguiClientCore::on_connect_failed(Time now) {
@@ -220,17 +235,17 @@ void SvguiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
 
 void SvguiClientCore::handle(Time now, const svgui::Message& message) {
   if (const auto* reply = std::get_if<svgui::AuthReply>(&message)) {
-    if (state_ != ConnectionState::authenticating) {
+    const bool awaited = state_ == ConnectionState::authenticating;
+    const bool late =
+        state_ == ConnectionState::connected && !config_.wait_for_login && !logged_in_;
+    if (!awaited && !late) {
       ignored(now, message, "AUTH-REPLY after login");
       return;
     }
     if (*reply != svgui::kProgramAuthReply)
       note(now, "AUTH-REPLY differs from the real vehicles' fixed 1 2 WAIT");
-    login_deadline_.reset();
-    reconnect_attempt_ = 0;
-    for (auto& s : streams_)
-      s.last.reset();
-    set_state(ConnectionState::connected);
+    if (awaited) become_connected(now);
+    logged_in_ = true;
     emit(LoginEvent{*reply});
     return;
   }

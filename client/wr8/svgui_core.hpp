@@ -32,6 +32,11 @@ struct SvguiConfig {
   /// Without AUTH-REPLY this long after AUTH went out, the connection has
   /// failed: it is closed and retried. The head GUI gives up after 3 s.
   Duration login_timeout = link::seconds(3);
+  /// false: the connection is usable as soon as AUTH is out, as the real
+  /// v2019 GUI uses it (it sends tasks without waiting for a reply); an
+  /// AUTH-REPLY that comes later is still reported as the login. For the
+  /// real v2019 vehicle, which answers no login (docs/clients/wr8-client.md).
+  bool wait_for_login = true;
   /// v2019: a task must end (ANSWER done or error) this long after it was
   /// sent, per task type (0 none, 1 forward, 2 wheels, 3 turn signals,
   /// 4 none). The vehicle sends no "started" and drops a task while busy
@@ -201,6 +206,7 @@ class SvguiClientCore {
   void end_connection(Time now);
   void schedule_reconnect(Time now);
   void set_state(ConnectionState s, int attempt = 0);
+  void become_connected(Time now);
   void note(Time now, std::string text);
   void emit(SvguiEvent e) { events_.push_back(std::move(e)); }
   Duration stale_after(DataStream s) const;
@@ -217,6 +223,7 @@ class SvguiClientCore {
   int reconnect_attempt_ = 0;
   std::optional<Time> reconnect_at_;
   std::optional<Time> login_deadline_;
+  bool logged_in_ = false;  ///< an AUTH-REPLY came on this connection
 
   // v2019: tasks by COI.
   std::uint8_t next_coi_ = kFirstSvguiCoi;

@@ -501,6 +501,10 @@ void SvguiRunner::on_event(Time, const SvguiEvent& event) {
                  [&](const ConnectionEvent& e) {
                    if (waits_data && e.state == ConnectionState::disconnected)
                      finish(false, "disconnected");
+                   if (e.state == ConnectionState::connected &&
+                       std::holds_alternative<op::Connect>(current_->action) &&
+                       !session_.core().config().wait_for_login)
+                     finish(true, "connected; AUTH sent, its answer not awaited");
                  },
                  [&](const RequestEvent& r) { on_request(r); },
                  [](const auto&) {},

@@ -127,6 +127,30 @@ TEST(SvguiCore, V2019LogsInWithTheTenLetterAuthAndTheFixedReply) {
   EXPECT_EQ(core.next_wakeup(), std::nullopt);
 }
 
+TEST(SvguiCore, WithoutWaitingForLoginTheConnectionIsUsedOnceAuthIsOut) {
+  // The real v2019 vehicle answers no login; its own GUI sends tasks anyway.
+  SvguiConfig config = config_for(Version::v2019);
+  config.wait_for_login = false;
+  SvguiClientCore core(config);
+  core.connect(Time{0});
+  core.take_actions();
+  core.on_connected(milliseconds(2));
+  EXPECT_EQ(sent(core.take_actions()), std::vector<protocol::Bytes>{hex(kAuth2019)});
+  EXPECT_EQ(core.state(), ConnectionState::connected);
+  EXPECT_TRUE(events_of<LoginEvent>(core.take_events()).empty());  // no phantom login
+  EXPECT_EQ(core.next_wakeup(), std::nullopt);                     // no login timeout
+  const auto f = core.forward(milliseconds(60), 10);
+  EXPECT_EQ(f.refusal, Refusal::none);
+  core.on_timer(milliseconds(60));
+  EXPECT_EQ(sent(core.take_actions()),
+            std::vector<protocol::Bytes>{hex("08 03 01 01 01 0A 00 00 00")});
+  // A reply that does come is still the login, once.
+  core.on_bytes(milliseconds(70), hex(kAuthReply));
+  EXPECT_EQ(events_of<LoginEvent>(core.take_events()).size(), 1u);
+  core.on_bytes(milliseconds(80), hex(kAuthReply));
+  EXPECT_TRUE(events_of<LoginEvent>(core.take_events()).empty());
+}
+
 TEST(SvguiCore, HeadAuthCarriesTheTrailingNul) {
   SvguiClientCore core(config_for(Version::head));
   core.connect(Time{0});
