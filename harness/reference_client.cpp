@@ -14,6 +14,7 @@
 #include "client/leka/operator.hpp"
 #include "client/logi/operator.hpp"
 #include "client/wr8/operator.hpp"
+#include "client/wr8/svgui_operator.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "protocol/common/overloaded.hpp"
 
@@ -262,6 +263,121 @@ class Wr8Reference final : public ReferenceSession {
   client::wr8::Wr8Session session_;
   std::unique_ptr<client::wr8::OperatorRunner> runner_;
   std::vector<std::unique_ptr<client::wr8::OperatorRunner>> retired_;
+  std::uint64_t generation_ = 0;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+// ------------------------------------------ WR8, the real programs' dialects
+
+/// The WR8 client of profiles svgui-2019 and svgui-head: the same client
+/// records as the document's client, with the real programs' requests
+/// (forward, wheels, signals, settings; set, set-request) as commands.
+class SvguiReference final : public ReferenceSession {
+ public:
+  SvguiReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+                 client::wr8::SvguiConfig config)
+      : executor_(context.executor),
+        timeline_(timeline),
+        version_(config.version),
+        session_(context, std::move(endpoint), std::move(config),
+                 [this](Time now, const client::wr8::SvguiEvent& e) { on_event(now, e); }),
+        runner_(std::make_unique<client::wr8::SvguiRunner>(executor_, session_)) {}
+  ~SvguiReference() override { *alive_ = false; }
+
+  void execute(const std::string& text, Done done) override {
+    auto parsed = client::wr8::parse_svgui_line(text, version_);
+    if (parsed.error || !parsed.action) {
+      const std::string why =
+          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
+      later(executor_, alive_, [done, why] { done(false, why); });
+      return;
+    }
+    retired_.clear();
+    const std::uint64_t generation = ++generation_;
+    runner_->execute(std::move(*parsed.action),
+                     [this, generation, done](const client::wr8::SvguiActionResult& r) {
+                       if (generation != generation_) return;
+                       const bool ok = r.ok;
+                       const std::string reason = r.ok ? std::string() : r.detail;
+                       later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
+                     });
+  }
+
+  void cancel() override {
+    ++generation_;
+    if (runner_->busy()) {
+      retired_.push_back(std::move(runner_));
+      runner_ = std::make_unique<client::wr8::SvguiRunner>(executor_, session_);
+    }
+  }
+
+  void stop() override {
+    cancel();
+    session_.disconnect();
+  }
+
+ private:
+  std::string command_of(const client::wr8::RequestEvent& e) const {
+    namespace proto = protocol::wr8;
+    if (e.kind == client::wr8::RequestKind::settings)
+      return version_ == protocol::wr8::svgui::Version::v2019 ? "settings" : "set";
+    switch (e.task) {
+      case proto::TaskCode::drive:
+        return "forward";
+      case proto::TaskCode::turn:
+        return "wheels";
+      case proto::TaskCode::blink:
+        return "signals";
+      case proto::TaskCode::get_settings:
+        return "set-request";
+      case proto::TaskCode::check:
+        break;
+    }
+    return std::string(proto::to_string(e.task));
+  }
+
+  void on_event(Time now, const client::wr8::SvguiEvent& event) {
+    namespace cw = client::wr8;
+    std::visit(
+        protocol::Overloaded{
+            [&](const cw::ConnectionEvent& e) {
+              static constexpr const char* kStates[] = {
+                  "disconnected", "connecting", "authenticating", "connected", "reconnecting"};
+              timeline_.add(Source::client, "connection",
+                            connection(kStates[static_cast<int>(e.state)], cw::to_string(e.state),
+                                       e.attempt));
+            },
+            [&](const cw::LoginEvent&) {
+              timeline_.add(Source::client, "login", {{"ok", true}});
+            },
+            [&](const cw::LoginFailedEvent& e) {
+              timeline_.add(Source::client, "login", {{"ok", false}, {"reason", e.reason}});
+            },
+            [&](const cw::StaleEvent& e) {
+              timeline_.add(Source::client, e.stale ? "stale" : "fresh",
+                            {{"stream", std::string(cw::to_string(e.stream))}});
+            },
+            [&](const cw::RequestEvent& e) {
+              timeline_.add(Source::client, "command",
+                            {{"command", command_of(e)},
+                             {"state", std::string(cw::to_string(e.state))},
+                             {"request", e.coi}});
+            },
+            [&](const cw::ParseErrorEvent& e) {
+              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
+            },
+            [](const auto&) {},  // DATA, MAP and read-backs are on the wire
+        },
+        event);
+    if (runner_) runner_->on_event(now, event);
+  }
+
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  protocol::wr8::svgui::Version version_;
+  client::wr8::SvguiSession session_;
+  std::unique_ptr<client::wr8::SvguiRunner> runner_;
+  std::vector<std::unique_ptr<client::wr8::SvguiRunner>> retired_;
   std::uint64_t generation_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
@@ -577,6 +693,25 @@ const std::vector<Option<client::wr8::ClientConfig>>& wr8_options() {
   return options;
 }
 
+const std::vector<Option<client::wr8::SvguiConfig>>& svgui_options() {
+  using C = client::wr8::SvguiConfig;
+  static const std::vector<Option<C>> options = {
+      duration_option("login_timeout", &C::login_timeout,
+                      "how long the login waits for AUTH-REPLY before the connection fails"),
+      flag_option("wait_for_login", &C::wait_for_login,
+                  "false: use the connection once AUTH is sent, as the real v2019 GUI does"),
+      duration_option("answer_timeout", &C::answer_timeout,
+                      "head: how long SET waits for an ANSWER and SET-REQUEST for its SET"),
+      duration_option("send_gap", &C::send_gap,
+                      "the least time between two packets sent (0: send at once)", true),
+      duration_option("control_period", &C::control_period,
+                      "head: how often a held CONTROL is repeated"),
+      delays_option(&C::reconnect_delays,
+                    "the waits before reconnect attempts 1, 2, 3, ...; the last repeats"),
+  };
+  return options;
+}
+
 const std::vector<Option<client::arduino::ClientConfig>>& arduino_options() {
   using C = client::arduino::ClientConfig;
   static const std::vector<Option<C>> options = {
@@ -637,14 +772,25 @@ Config configured(const std::vector<Option<Config>>& options, const Json& settin
   return config;
 }
 
+/// The real-program version a WR8 scenario's client speaks, if any.
+std::optional<protocol::wr8::svgui::Version> svgui_version(mocks::CarKind car,
+                                                           std::string_view profile) {
+  if (car != mocks::CarKind::wr8) return std::nullopt;
+  return protocol::wr8::svgui::version_of_profile(profile);
+}
+
 }  // namespace
 
-std::vector<ReferenceSetting> reference_settings(mocks::CarKind car) {
+std::vector<ReferenceSetting> reference_settings(mocks::CarKind car, std::string_view profile) {
   std::vector<ReferenceSetting> out;
   const auto docs = [&](const auto& options) {
     for (const auto& o : options)
       out.push_back(o.doc);
   };
+  if (svgui_version(car, profile)) {
+    docs(svgui_options());
+    return out;
+  }
   switch (car) {
     case mocks::CarKind::logi:
       docs(logi_options());
@@ -663,7 +809,12 @@ std::vector<ReferenceSetting> reference_settings(mocks::CarKind car) {
 }
 
 std::optional<std::string> reference_setting_problem(mocks::CarKind car, const std::string& name,
-                                                     const nlohmann::json& value) {
+                                                     const nlohmann::json& value,
+                                                     std::string_view profile) {
+  if (svgui_version(car, profile)) {
+    client::wr8::SvguiConfig c;
+    return set_option(svgui_options(), c, name, value);
+  }
   switch (car) {
     case mocks::CarKind::logi: {
       client::logi::ClientConfig c;
@@ -693,9 +844,15 @@ std::unique_ptr<ReferenceSession> make_reference_session(
     case mocks::CarKind::logi:
       return std::make_unique<LogiReference>(context, std::move(endpoint), timeline,
                                              configured(logi_options(), settings));
-    case mocks::CarKind::wr8:
+    case mocks::CarKind::wr8: {
+      if (const auto version = svgui_version(car, named.name)) {
+        auto config = configured(svgui_options(), settings);
+        config.version = *version;
+        return std::make_unique<SvguiReference>(context, std::move(endpoint), timeline, config);
+      }
       return std::make_unique<Wr8Reference>(context, std::move(endpoint), timeline,
                                             configured(wr8_options(), settings));
+    }
     case mocks::CarKind::arduino: {
       auto config = configured(arduino_options(), settings);
       config.dialect = protocol::arduino::dialect_named(named.name);

@@ -61,13 +61,16 @@ struct ReferenceSetting {
   std::string what;   ///< what it changes, for people
 };
 
-/// The options the car's reference client takes, in a fixed order.
-std::vector<ReferenceSetting> reference_settings(mocks::CarKind car);
+/// The options the car's reference client takes in profile `profile`
+/// (empty: the default), in a fixed order.
+std::vector<ReferenceSetting> reference_settings(mocks::CarKind car, std::string_view profile = {});
 
 /// Why `value` (a text, or an array of texts for a list) cannot be the
-/// option `name` of the car's reference client; nullopt when it can.
+/// option `name` of the car's reference client in `profile`; nullopt when
+/// it can.
 std::optional<std::string> reference_setting_problem(mocks::CarKind car, const std::string& name,
-                                                     const nlohmann::json& value);
+                                                     const nlohmann::json& value,
+                                                     std::string_view profile = {});
 
 /// The car's reference client on `endpoint`, writing client records to
 /// `timeline`, its library's defaults changed by `settings` (names to values

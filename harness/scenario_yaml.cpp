@@ -16,11 +16,13 @@
 #include "client/leka/operator.hpp"
 #include "client/logi/operator.hpp"
 #include "client/wr8/operator.hpp"
+#include "client/wr8/svgui_operator.hpp"
 #include "harness/reference_client.hpp"
 #include "harness/timeline_recorder.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/behaviour_yaml.hpp"
 #include "protocol/wr8/profile.hpp"
+#include "protocol/wr8/svgui.hpp"
 
 namespace hil::harness {
 
@@ -105,7 +107,16 @@ std::string car_title(mocks::CarKind car) {
 /// What the car's operator-language parser says about one action: nullopt
 /// when it is an action, else the 1-based column and the message.
 std::optional<std::pair<int, std::string>> check_action(mocks::CarKind car,
+                                                        std::string_view profile,
                                                         const std::string& text) {
+  if (car == mocks::CarKind::wr8) {
+    if (const auto version = protocol::wr8::svgui::version_of_profile(profile)) {
+      const auto r = client::wr8::parse_svgui_line(text, *version);
+      if (r.error) return std::pair{static_cast<int>(r.error->column), r.error->message};
+      if (!r.action) return std::pair{1, std::string("an empty action")};
+      return std::nullopt;
+    }
+  }
   switch (car) {
     case mocks::CarKind::logi: {
       const auto r = client::logi::parse_operator_action(text);
@@ -161,10 +172,9 @@ std::string format_duration(Duration d) {
   return std::to_string(ns) + "ns";
 }
 
-const Keys kTopKeys = {"name",     "description",   "tags",     "car",     "profile",
-                       "reply_latency", "world", "seed",   "timeout", "settle",
-                       "variables", "faults",  "client",   "setup",   "steps",
-                       "teardown",  "schedule", "expect"};
+const Keys kTopKeys = {"name",   "description", "tags",    "car",      "profile",   "reply_latency",
+                       "world",  "seed",        "timeout", "settle",   "variables", "faults",
+                       "client", "setup",       "steps",   "teardown", "schedule",  "expect"};
 const Keys kStepKeys = {"do", "wait", "wait_until", "car", "faults", "obstacle"};
 const Keys kMatcherSources = {"wire", "client", "sim", "step", "fault", "car"};
 const Keys kWireDirections = {"received", "sent_by_client", "sent_by_car", "received_by_client"};
@@ -603,7 +613,7 @@ class Loader {
     const std::string where = "'client: reference: settings'";
     if (!n.IsMap()) fail(n, where + " must be a map like {max_retries: 0}");
     Keys names;
-    for (const auto& s : reference_settings(scenario_.car))
+    for (const auto& s : reference_settings(scenario_.car, scenario_.profile))
       names.push_back(s.name);
     check_keys(n, names, where + " (" + car_title(scenario_.car) + ")");
     auto out = nlohmann::json::object();
@@ -617,7 +627,7 @@ class Loader {
       } else {
         value = scalar(it.second, where + ": '" + name + "'");
       }
-      if (auto problem = reference_setting_problem(scenario_.car, name, value)) {
+      if (auto problem = reference_setting_problem(scenario_.car, name, value, scenario_.profile)) {
         fail(it.second, where + ": " + *problem);
       }
       out[name] = std::move(value);
@@ -801,7 +811,7 @@ class Loader {
   ActionStep action(const YAML::Node& n, const std::string& where) const {
     const std::string raw = scalar(n, where + ": the action");
     const std::string text = trim(raw);
-    if (const auto problem = check_action(scenario_.car, text)) {
+    if (const auto problem = check_action(scenario_.car, scenario_.profile, text)) {
       const std::string message =
           where + ": " + car_title(scenario_.car) + " action '" + text + "': " + problem->second;
       if (was_substituted(n)) fail(n, message);

@@ -172,7 +172,7 @@ svgui::HighFreqData SvguiFirmware::high_freq_at(Time now) const {
   // and turns its picture clockwise by `angle` degrees.
   data.x = grid.ring + pose.x_m / grid.cell_m;
   data.y = grid.ring + (world_.arena().height_m - pose.y_m) / grid.cell_m;
-  data.angle = sim::rad_to_deg(-pose.heading_rad);
+  data.angle = 0.0 - sim::rad_to_deg(pose.heading_rad);  // never -0
   return data;
 }
 

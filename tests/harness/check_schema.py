@@ -50,12 +50,15 @@ WRONG = {
     ),
     "an unknown behaviour": "name: t\ncar: logi\nsteps:\n  - car: {rejct: MV}\n",
     "another car's profile": "name: t\ncar: arduino\nprofile: comspecs-v3\nsteps: [connect]\n",
+    "a WR8 profile misspelt": "name: t\ncar: wr8\nprofile: svgui-2020\nsteps: [connect]\n",
     "a reply latency without a unit": "name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n",
 }
 
 # And these are right in ways that are easy to get wrong in a schema.
 RIGHT = {
     "the Leka spec's own table": "name: t\ncar: leka\nprofile: comspecs-v3\nsteps: [connect]\n",
+    "the real WR8 head program": "name: t\ncar: wr8\nprofile: svgui-head\nsteps: [connect]\n",
+    "the LOGI guide, named": "name: t\ncar: logi\nprofile: guide\nsteps: [connect]\n",
     "a reply latency": "name: t\ncar: arduino\nreply_latency: 20ms\nsteps: [PING]\n",
     "variables in a duration and a count": (
         "name: t\ncar: logi\nvariables: {t: 2s, n: 3}\ntimeout: ${t}\nsteps: [connect]\n"

@@ -841,6 +841,30 @@ TEST(ScenarioYamlProfiles, TheCarsProfileIsReadAndAWrongOneNamesTheValidOnes) {
             "(the default) and firmware");
 }
 
+TEST(ScenarioYamlProfiles, AWr8ProgramProfileChecksActionsAndSettingsByItsOwnWords) {
+  EXPECT_EQ(
+      parse("name: t\ncar: wr8\nprofile: svgui-head\nsteps: [connect, control 0 0.5]\n").profile,
+      "svgui-head");
+  // The document's words are not the real programs'.
+  const std::string drive =
+      error_of("name: t\ncar: wr8\nprofile: svgui-2019\nsteps: [connect, drive 30]\n");
+  EXPECT_NE(drive.find("t.yaml:4:18: step 2: WR8 action 'drive 30': "), std::string::npos) << drive;
+  EXPECT_NE(drive.find("forward"), std::string::npos) << drive;
+  // Nor is a head word a v2019 one.
+  EXPECT_NE(
+      error_of("name: t\ncar: wr8\nprofile: svgui-2019\nsteps: [control 0 1]\n").find("svgui-head"),
+      std::string::npos);
+  // The client's settings are the real-program client's.
+  EXPECT_EQ(parse("name: t\ncar: wr8\nprofile: svgui-2019\nclient: {reference: {settings: "
+                  "{wait_for_login: false, login_timeout: 5s}}}\nsteps: [connect]\n")
+                .profile,
+            "svgui-2019");
+  const std::string auth = error_of(
+      "name: t\ncar: wr8\nprofile: svgui-head\nclient: {reference: {settings: {auth: "
+      "HIL-WR8-01}}}\nsteps: [connect]\n");
+  EXPECT_NE(auth.find("login_timeout"), std::string::npos) << auth;
+}
+
 // -------------------------------------------------------------------- errors
 
 TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
