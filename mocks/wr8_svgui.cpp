@@ -463,9 +463,15 @@ void SvguiFirmware::handle_head(Time now, ByteView packet) {
     unusable("CONTROL with an axis that is not a number");
     return;
   }
+  const auto* set = std::get_if<svgui::Set>(&frame->message);
+  if (set && !std::all_of(set->values.begin(), set->values.end(),
+                          [](double v) { return std::isfinite(v); })) {
+    unusable("SET with a value that is not a number");
+    return;
+  }
   count_frame_in();
   if (dispose(now, kind) == Disposition::handle) {
-    if (const auto* set = std::get_if<svgui::Set>(&frame->message)) {
+    if (set != nullptr) {
       state_.head_settings = set->values;
       apply_steering(commanded_wheel_deg_);
     } else if (std::holds_alternative<svgui::SetRequest>(frame->message)) {

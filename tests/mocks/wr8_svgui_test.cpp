@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -477,6 +479,21 @@ TEST(Wr8SvguiHead, SetChangesTheSettingsAndSetRequestReadsThemBack) {
   EXPECT_EQ(std::get<svgui::Set>(sets[0].message), set);
   EXPECT_EQ(sets[0].raw.size(), 98u);  // 0x61 and 97 bytes
   EXPECT_EQ(sets[0].raw[0], 0x61);
+}
+
+TEST(Wr8SvguiHead, ASetOrControlThatIsNotANumberIsDroppedAndTheCarStaysFinite) {
+  Gui gui(svgui::Version::head);
+  svgui::Set set;
+  set.values.fill(1.0);
+  set.values[3] = std::numeric_limits<double>::quiet_NaN();  // steering zero
+  gui.send(set);
+  gui.send(svgui::Control{std::numeric_limits<double>::infinity(), 0.5});
+  EXPECT_EQ(gui.state().unusable_reads, 2u);
+  EXPECT_EQ(gui.state().head_settings, SvguiConfig{}.head_settings);
+  EXPECT_FALSE(gui.state().control.has_value());
+  gui.run_for(seconds(1));
+  EXPECT_TRUE(std::isfinite(gui.vehicle().pose().x_m));
+  EXPECT_TRUE(std::isfinite(gui.chassis().steering_rad()));
 }
 
 TEST(Wr8SvguiHead, TheMapDescribesTheArenaWithItsWallsAndObstacles) {
