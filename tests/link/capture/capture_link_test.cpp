@@ -6,6 +6,7 @@
 #include "link/capture/pcap.hpp"
 #include "link/capture/wire_log.hpp"
 #include "link/mem_pipe.hpp"
+#include "protocol/wr8/svgui.hpp"
 #include "tests/link/capture/capture_support.hpp"
 
 namespace hil::link {
@@ -121,6 +122,80 @@ TEST_F(CaptureLinkTest, PcapHoldsTheDeliveredPiecesAtWallTimePlusVirtualTime) {
             "1700000000.011000000\t40000\t5\n"
             "1700000000.012000000\t40000\t5\n"
             "1700000000.020000000\t9000\t16\n");
+}
+
+TEST(CaptureLinkSvgui, APcapOfTheRealWr8ProgramsDecodesByTheLengthByteWhateverTheSegments) {
+  if (std::system("command -v tshark >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "tshark is not installed (ci/install-deps.sh installs it)";
+  }
+  namespace svgui = protocol::wr8::svgui;
+  test::ScratchFile pcap_file{".pcap"};
+  VirtualExecutor ex;
+  std::error_code ec;
+  PcapOptions pcap_options;
+  pcap_options.wall_clock_us = [] { return kWallUs; };
+  auto pcap = PcapWriter::open(pcap_file.path(), pcap_options, ec);
+  ASSERT_TRUE(pcap) << ec.message();
+  // The head vehicle's AUTH-REPLY and a HIGH-FREQ DATA, cut into 3-byte
+  // segments on their way to the client.
+  FaultRule fragment;
+  fragment.name = "split";
+  fragment.action = Fragment{{3, 3}, {milliseconds(1), milliseconds(1)}};
+  LinkOptions options;
+  options.protocol = protocol_adapter("wr8", "svgui-head");
+  options.to_client.rules.push_back(fragment);
+  options.observers = {pcap};
+  auto [client_app, link_client] = make_mem_pipe(ex, "client");
+  auto [link_car, car_app] = make_mem_pipe(ex, "car");
+  auto link = Link::create(ex, link_client, link_car, std::move(options));
+  Collected at_client;
+  Collected at_car;
+  client_app->start(at_client.handlers());
+  car_app->start(at_car.handlers());
+  link->start();
+  protocol::Bytes sent = svgui::encode_prefixed(svgui::kProgramAuthReply, svgui::Version::head);
+  const protocol::Bytes data = svgui::encode_prefixed(
+      svgui::HighFreqData{36000050, 1.5, -0.25, 2, 0.5, 90}, svgui::Version::head);
+  sent.insert(sent.end(), data.begin(), data.end());
+  ex.run_until(milliseconds(10));
+  car_app->write(sent);
+  ex.run_until(milliseconds(200));
+  client_app->close();
+  ex.run_until_idle();
+  ASSERT_FALSE(pcap->error());
+
+  // tshark gives the payload of each segment; joined, the length byte cuts
+  // them back into the two packets.
+  const std::string command = "tshark -n -r '" + pcap_file.path().string() +
+                              "' -Y 'tcp.len > 0' -T fields -e tcp.payload 2>/dev/null";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  char buf[1024];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe))
+    out.append(buf, n);
+  ASSERT_EQ(::pclose(pipe), 0);
+  std::string hex;
+  int segments = 0;
+  for (const char c : out) {
+    if (c == '\n') {
+      ++segments;
+    } else if (c != ':') {
+      hex += c;
+    }
+  }
+  EXPECT_EQ(segments, 24);  // 5 + 66 bytes in 3-byte pieces
+  const auto payload = protocol::parse_hex(hex);
+  ASSERT_TRUE(payload) << hex;
+  EXPECT_EQ(*payload, sent);
+  std::vector<WireFrame> frames;
+  auto splitter = protocol_adapter("wr8", "svgui-head")->splitter();
+  splitter->feed(*payload, frames);
+  splitter->finish(frames);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].kind, "AUTH_REPLY");
+  EXPECT_EQ(frames[1].kind, "HIGH_FREQ_DATA");
+  EXPECT_TRUE(frames[0].valid && frames[1].valid);
 }
 
 }  // namespace
