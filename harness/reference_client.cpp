@@ -172,19 +172,59 @@ class LogiReference final : public ReferenceSession {
 
 // ------------------------------------------------------------------- WR8
 
+/// The document's dialect for Wr8Reference.
+struct DocumentWr8 {
+  using Session = client::wr8::Wr8Session;
+  using Runner = client::wr8::OperatorRunner;
+  using Event = client::wr8::Event;
+  using Config = client::wr8::ClientConfig;
+
+  auto parse(const std::string& text) const { return client::wr8::parse_operator_line(text); }
+  static std::string command(const client::wr8::RequestEvent& e) {
+    return e.kind == client::wr8::RequestKind::settings
+               ? std::string("settings")
+               : std::string(protocol::wr8::to_string(e.task));
+  }
+  static nlohmann::json stale_fields(const client::wr8::StaleEvent&) {
+    return nlohmann::json::object();
+  }
+};
+
+/// The real smart_vehicle_gui programs' dialects (svgui-2019, svgui-head).
+struct ProgramWr8 {
+  using Session = client::wr8::SvguiSession;
+  using Runner = client::wr8::SvguiRunner;
+  using Event = client::wr8::SvguiEvent;
+  using Config = client::wr8::SvguiConfig;
+
+  protocol::wr8::svgui::Version version;
+  auto parse(const std::string& text) const { return client::wr8::parse_svgui_line(text, version); }
+  static std::string command(const client::wr8::RequestEvent& e) {
+    return client::wr8::svgui_request_name(e);
+  }
+  static nlohmann::json stale_fields(const client::wr8::StaleEvent& e) {
+    return {{"stream", std::string(client::wr8::to_string(e.stream))}};
+  }
+};
+
+/// The WR8 reference client in one of its dialects: the same client
+/// records whichever it speaks, its requests named as the operator types
+/// them.
+template <class Dialect>
 class Wr8Reference final : public ReferenceSession {
  public:
   Wr8Reference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
-               client::wr8::ClientConfig config)
+               typename Dialect::Config config, Dialect dialect = {})
       : executor_(context.executor),
         timeline_(timeline),
+        dialect_(dialect),
         session_(context, std::move(endpoint), std::move(config),
-                 [this](Time now, const client::wr8::Event& e) { on_event(now, e); }),
-        runner_(std::make_unique<client::wr8::OperatorRunner>(executor_, session_)) {}
+                 [this](Time now, const typename Dialect::Event& e) { on_event(now, e); }),
+        runner_(std::make_unique<Runner>(executor_, session_)) {}
   ~Wr8Reference() override { *alive_ = false; }
 
   void execute(const std::string& text, Done done) override {
-    auto parsed = client::wr8::parse_operator_line(text);
+    auto parsed = dialect_.parse(text);
     if (parsed.error || !parsed.action) {
       const std::string why =
           parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
@@ -194,7 +234,7 @@ class Wr8Reference final : public ReferenceSession {
     retired_.clear();
     const std::uint64_t generation = ++generation_;
     runner_->execute(std::move(*parsed.action),
-                     [this, generation, done](const client::wr8::ActionResult& r) {
+                     [this, generation, done](const typename Runner::Result& r) {
                        if (generation != generation_) return;
                        const bool ok = r.ok;
                        const std::string reason = r.ok ? std::string() : r.detail;
@@ -208,7 +248,7 @@ class Wr8Reference final : public ReferenceSession {
       // The runner has no cancel; a fresh one takes over and the old one's
       // answer is ignored.
       retired_.push_back(std::move(runner_));
-      runner_ = std::make_unique<client::wr8::OperatorRunner>(executor_, session_);
+      runner_ = std::make_unique<Runner>(executor_, session_);
     }
   }
 
@@ -218,7 +258,9 @@ class Wr8Reference final : public ReferenceSession {
   }
 
  private:
-  void on_event(Time now, const client::wr8::Event& event) {
+  using Runner = typename Dialect::Runner;
+
+  void on_event(Time now, const typename Dialect::Event& event) {
     namespace cw = client::wr8;
     std::visit(
         protocol::Overloaded{
@@ -236,23 +278,18 @@ class Wr8Reference final : public ReferenceSession {
               timeline_.add(Source::client, "login", {{"ok", false}, {"reason", e.reason}});
             },
             [&](const cw::StaleEvent& e) {
-              timeline_.add(Source::client, e.stale ? "stale" : "fresh");
+              timeline_.add(Source::client, e.stale ? "stale" : "fresh", Dialect::stale_fields(e));
             },
             [&](const cw::RequestEvent& e) {
-              const std::string command = e.kind == cw::RequestKind::settings
-                                              ? std::string("settings")
-                                              : std::string(protocol::wr8::to_string(e.task));
               timeline_.add(Source::client, "command",
-                            {{"command", command},
+                            {{"command", Dialect::command(e)},
                              {"state", std::string(cw::to_string(e.state))},
                              {"request", e.coi}});
             },
             [&](const cw::ParseErrorEvent& e) {
               timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
             },
-            [](const cw::TelemetryEvent&) {},  // DATA frames are on the wire
-            [](const cw::SettingsEvent&) {},
-            [](const cw::IgnoredEvent&) {},
+            [](const auto&) {},  // DATA, MAP, settings read back: the wire shows them
         },
         event);
     if (runner_) runner_->on_event(now, event);
@@ -260,124 +297,10 @@ class Wr8Reference final : public ReferenceSession {
 
   link::Executor& executor_;
   RunTimeline& timeline_;
-  client::wr8::Wr8Session session_;
-  std::unique_ptr<client::wr8::OperatorRunner> runner_;
-  std::vector<std::unique_ptr<client::wr8::OperatorRunner>> retired_;
-  std::uint64_t generation_ = 0;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
-};
-
-// ------------------------------------------ WR8, the real programs' dialects
-
-/// The WR8 client of profiles svgui-2019 and svgui-head: the same client
-/// records as the document's client, with the real programs' requests
-/// (forward, wheels, signals, settings; set, set-request) as commands.
-class SvguiReference final : public ReferenceSession {
- public:
-  SvguiReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
-                 client::wr8::SvguiConfig config)
-      : executor_(context.executor),
-        timeline_(timeline),
-        version_(config.version),
-        session_(context, std::move(endpoint), std::move(config),
-                 [this](Time now, const client::wr8::SvguiEvent& e) { on_event(now, e); }),
-        runner_(std::make_unique<client::wr8::SvguiRunner>(executor_, session_)) {}
-  ~SvguiReference() override { *alive_ = false; }
-
-  void execute(const std::string& text, Done done) override {
-    auto parsed = client::wr8::parse_svgui_line(text, version_);
-    if (parsed.error || !parsed.action) {
-      const std::string why =
-          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
-      later(executor_, alive_, [done, why] { done(false, why); });
-      return;
-    }
-    retired_.clear();
-    const std::uint64_t generation = ++generation_;
-    runner_->execute(std::move(*parsed.action),
-                     [this, generation, done](const client::wr8::SvguiActionResult& r) {
-                       if (generation != generation_) return;
-                       const bool ok = r.ok;
-                       const std::string reason = r.ok ? std::string() : r.detail;
-                       later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
-                     });
-  }
-
-  void cancel() override {
-    ++generation_;
-    if (runner_->busy()) {
-      retired_.push_back(std::move(runner_));
-      runner_ = std::make_unique<client::wr8::SvguiRunner>(executor_, session_);
-    }
-  }
-
-  void stop() override {
-    cancel();
-    session_.disconnect();
-  }
-
- private:
-  std::string command_of(const client::wr8::RequestEvent& e) const {
-    namespace proto = protocol::wr8;
-    if (e.kind == client::wr8::RequestKind::settings)
-      return version_ == protocol::wr8::svgui::Version::v2019 ? "settings" : "set";
-    switch (e.task) {
-      case proto::TaskCode::drive:
-        return "forward";
-      case proto::TaskCode::turn:
-        return "wheels";
-      case proto::TaskCode::blink:
-        return "signals";
-      case proto::TaskCode::get_settings:
-        return "set-request";
-      case proto::TaskCode::check:
-        break;
-    }
-    return std::string(proto::to_string(e.task));
-  }
-
-  void on_event(Time now, const client::wr8::SvguiEvent& event) {
-    namespace cw = client::wr8;
-    std::visit(
-        protocol::Overloaded{
-            [&](const cw::ConnectionEvent& e) {
-              static constexpr const char* kStates[] = {
-                  "disconnected", "connecting", "authenticating", "connected", "reconnecting"};
-              timeline_.add(Source::client, "connection",
-                            connection(kStates[static_cast<int>(e.state)], cw::to_string(e.state),
-                                       e.attempt));
-            },
-            [&](const cw::LoginEvent&) {
-              timeline_.add(Source::client, "login", {{"ok", true}});
-            },
-            [&](const cw::LoginFailedEvent& e) {
-              timeline_.add(Source::client, "login", {{"ok", false}, {"reason", e.reason}});
-            },
-            [&](const cw::StaleEvent& e) {
-              timeline_.add(Source::client, e.stale ? "stale" : "fresh",
-                            {{"stream", std::string(cw::to_string(e.stream))}});
-            },
-            [&](const cw::RequestEvent& e) {
-              timeline_.add(Source::client, "command",
-                            {{"command", command_of(e)},
-                             {"state", std::string(cw::to_string(e.state))},
-                             {"request", e.coi}});
-            },
-            [&](const cw::ParseErrorEvent& e) {
-              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
-            },
-            [](const auto&) {},  // DATA, MAP and read-backs are on the wire
-        },
-        event);
-    if (runner_) runner_->on_event(now, event);
-  }
-
-  link::Executor& executor_;
-  RunTimeline& timeline_;
-  protocol::wr8::svgui::Version version_;
-  client::wr8::SvguiSession session_;
-  std::unique_ptr<client::wr8::SvguiRunner> runner_;
-  std::vector<std::unique_ptr<client::wr8::SvguiRunner>> retired_;
+  Dialect dialect_;
+  typename Dialect::Session session_;
+  std::unique_ptr<Runner> runner_;
+  std::vector<std::unique_ptr<Runner>> retired_;
   std::uint64_t generation_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
@@ -848,10 +771,11 @@ std::unique_ptr<ReferenceSession> make_reference_session(
       if (const auto version = svgui_version(car, named.name)) {
         auto config = configured(svgui_options(), settings);
         config.version = *version;
-        return std::make_unique<SvguiReference>(context, std::move(endpoint), timeline, config);
+        return std::make_unique<Wr8Reference<ProgramWr8>>(context, std::move(endpoint), timeline,
+                                                          config, ProgramWr8{*version});
       }
-      return std::make_unique<Wr8Reference>(context, std::move(endpoint), timeline,
-                                            configured(wr8_options(), settings));
+      return std::make_unique<Wr8Reference<DocumentWr8>>(context, std::move(endpoint), timeline,
+                                                         configured(wr8_options(), settings));
     }
     case mocks::CarKind::arduino: {
       auto config = configured(arduino_options(), settings);

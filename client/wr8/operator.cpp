@@ -223,6 +223,13 @@ std::string format_duration(Duration d) {
   return duration_text(d);
 }
 
+std::string refusal_text(Refusal refusal) {
+  std::string why(to_string(refusal));
+  for (char& c : why)
+    if (c == '_') c = ' ';
+  return "refused: " + why;
+}
+
 std::string format_settings(const std::vector<proto::Setting>& settings,
                             const proto::Profile& profile) {
   std::string out;
@@ -259,103 +266,41 @@ std::string to_text(const OperatorAction& action, const proto::Profile& profile)
 
 // ---- runner ----
 
-OperatorRunner::OperatorRunner(link::Executor& executor, Wr8Session& session, RunnerOptions options)
-    : executor_(executor), session_(session), options_(options) {}
-
-OperatorRunner::~OperatorRunner() {
-  *alive_ = false;
-  if (current_ && current_->timer) executor_.cancel(*current_->timer);
-}
-
 void OperatorRunner::execute(OperatorAction action, Done done) {
-  if (current_) throw std::logic_error("OperatorRunner::execute while an action runs");
-  current_ = Current{std::move(action), executor_.now(), std::move(done), {}, false, {}, {}};
-  const auto& core = session_.core();
+  if (begin(std::move(action), std::move(done))) return;
   std::visit(
       Overloaded{
-          [&](const op::Connect&) {
-            if (core.state() == ConnectionState::connected) {
-              finish(true, "already logged in");
-              return;
-            }
-            session_.connect();
-            arm_timer(options_.connect_timeout, [this] {
-              session_.disconnect();
-              finish(false, "not logged in within " + format_duration(options_.connect_timeout));
-            });
-          },
-          [&](const op::Disconnect&) {
-            session_.disconnect();
-            finish(true, "disconnected");
-          },
           [&](const op::Drive& a) { start_request(session_.drive(a.distance_cm)); },
           [&](const op::Turn& a) { start_request(session_.turn(a.angle_deg)); },
           [&](const op::RawTask& a) { start_request(session_.task(a.code, a.params)); },
           [&](const op::GetSettings&) { start_request(session_.get_settings()); },
           [&](const op::SetSettings& a) { start_request(session_.set_settings(a.settings)); },
-          [&](const op::Wait& a) { arm_timer(a.duration, [this] { finish(true, ""); }); },
-          [&](const op::WaitData&) {
-            if (core.state() == ConnectionState::disconnected) {
-              finish(false, "not connected");
-              return;
-            }
-            arm_timer(options_.data_timeout, [this] {
-              finish(false, "no DATA within " + format_duration(options_.data_timeout));
-            });
-          },
+          [](const auto&) {},  // the shared words, which begin() carried out
       },
       current_->action);
 }
 
 void OperatorRunner::start_request(SubmitResult submitted) {
   if (!submitted) {
-    std::string why(to_string(submitted.refusal));
-    for (char& c : why)
-      if (c == '_') c = ' ';
-    finish(false, "refused: " + why);
+    refuse(submitted.refusal);
     return;
   }
-  current_->coi = submitted.coi;
-}
-
-void OperatorRunner::arm_timer(Duration after, std::function<void()> fire) {
-  std::weak_ptr<bool> alive = alive_;
-  current_->timer = executor_.call_after(after, [this, alive, fire = std::move(fire)] {
-    if (const auto a = alive.lock(); !a || !*a) return;
-    if (!current_) return;
-    current_->timer.reset();
-    fire();
-  });
-}
-
-void OperatorRunner::finish(bool ok, std::string detail) {
-  if (!current_) return;
-  if (current_->timer) executor_.cancel(*current_->timer);
-  ActionResult result{std::move(current_->action), current_->started, executor_.now(), ok,
-                      std::move(detail)};
-  Done done = std::move(current_->done);
-  current_.reset();
-  // Handed on from the executor, not from inside the session's event sink,
-  // so the next action never starts in the middle of the session's work.
-  std::weak_ptr<bool> alive = alive_;
-  executor_.post([alive, done = std::move(done), result = std::move(result)] {
-    if (const auto a = alive.lock(); !a || !*a) return;
-    if (done) done(result);
-  });
+  current_->pending.coi = submitted.coi;
 }
 
 void OperatorRunner::on_request(const RequestEvent& r) {
-  if (!current_ || !current_->coi || *current_->coi != r.coi) return;
+  if (!current_ || !current_->pending.coi || *current_->pending.coi != r.coi) return;
   const auto& config = session_.core().config();
+  RequestWait& wait = current_->pending;
   switch (r.state) {
     case RequestState::sent:
       return;
     case RequestState::started:
-      current_->request_started = true;
+      wait.started = true;
       return;
     case RequestState::completed: {
       std::string detail = "completed";
-      if (!current_->settings.empty()) detail = format_settings(current_->settings, config.profile);
+      if (!wait.settings.empty()) detail = format_settings(wait.settings, config.profile);
       finish(true, detail);
       return;
     }
@@ -363,7 +308,7 @@ void OperatorRunner::on_request(const RequestEvent& r) {
       finish(false, "the vehicle answered error");
       return;
     case RequestState::timed_out: {
-      if (current_->request_started || !current_->settings.empty()) {
+      if (wait.started || !wait.settings.empty()) {
         const Duration limit = r.kind == RequestKind::task
                                    ? config.completion_timeout[static_cast<std::size_t>(r.task)]
                                    : config.answer_timeout;
@@ -382,59 +327,21 @@ void OperatorRunner::on_request(const RequestEvent& r) {
 void OperatorRunner::on_event(Time, const Event& event) {
   if (!current_) return;
   std::visit(Overloaded{
-                 [&](const LoginEvent& e) {
-                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
-                   finish(true, "logged in: device " + std::to_string(e.reply.device_code) +
-                                    ", id " + std::to_string(e.reply.device_id) + ", " +
-                                    std::string(proto::to_string(e.reply.state)));
-                 },
-                 [&](const LoginFailedEvent& e) {
-                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
-                   // A failed login is the operator's answer: stop the retries.
-                   session_.disconnect();
-                   finish(false, e.reason);
-                 },
+                 [&](const LoginEvent& e) { on_login(e); },
+                 [&](const LoginFailedEvent& e) { on_login_failed(e); },
                  [&](const TelemetryEvent& e) {
-                   if (!std::holds_alternative<op::WaitData>(current_->action)) return;
-                   finish(true, "DATA " + std::string(proto::to_string(e.live.state)) + " at " +
-                                    std::to_string(e.live.timestamp_ms) + " ms");
+                   on_data("DATA " + std::string(proto::to_string(e.live.state)) + " at " +
+                           std::to_string(e.live.timestamp_ms) + " ms");
                  },
-                 [&](const ConnectionEvent& e) {
-                   if (std::holds_alternative<op::WaitData>(current_->action) &&
-                       e.state == ConnectionState::disconnected)
-                     finish(false, "disconnected");
-                 },
+                 [&](const ConnectionEvent& e) { on_connection(e); },
                  [&](const SettingsEvent& e) {
-                   if (current_->coi && *current_->coi == e.coi) current_->settings = e.settings;
+                   RequestWait& wait = current_->pending;
+                   if (wait.coi && *wait.coi == e.coi) wait.settings = e.settings;
                  },
                  [&](const RequestEvent& r) { on_request(r); },
                  [](const auto&) {},
              },
              event);
-}
-
-void OperatorRunner::run(std::vector<OperatorAction> actions, bool keep_going, Done each,
-                         std::function<void(bool)> finished) {
-  queue_ = std::move(actions);
-  next_ = 0;
-  keep_going_ = keep_going;
-  all_ok_ = true;
-  each_ = std::move(each);
-  finished_ = std::move(finished);
-  run_next();
-}
-
-void OperatorRunner::run_next() {
-  if (next_ >= queue_.size() || (!all_ok_ && !keep_going_)) {
-    auto finished = std::move(finished_);
-    if (finished) finished(all_ok_);
-    return;
-  }
-  execute(queue_[next_++], [this](const ActionResult& r) {
-    if (!r.ok) all_ok_ = false;
-    if (each_) each_(r);
-    run_next();
-  });
 }
 
 }  // namespace hil::client::wr8

@@ -13,19 +13,13 @@
 #include <variant>
 #include <vector>
 
+#include "client/wr8/action_runner.hpp"
 #include "client/wr8/session.hpp"
 #include "link/executor.hpp"
 
 namespace hil::client::wr8 {
 
 namespace op {
-/// Opens the connection and logs in.
-struct Connect {
-  friend bool operator==(const Connect&, const Connect&) = default;
-};
-struct Disconnect {
-  friend bool operator==(const Disconnect&, const Disconnect&) = default;
-};
 struct Drive {
   std::int32_t distance_cm = 0;
   friend bool operator==(const Drive&, const Drive&) = default;
@@ -46,14 +40,6 @@ struct GetSettings {
 struct SetSettings {
   std::vector<proto::Setting> settings;
   friend bool operator==(const SetSettings&, const SetSettings&) = default;
-};
-struct Wait {
-  Duration duration{0};
-  friend bool operator==(const Wait&, const Wait&) = default;
-};
-/// Waits for the next DATA packet.
-struct WaitData {
-  friend bool operator==(const WaitData&, const WaitData&) = default;
 };
 }  // namespace op
 
@@ -113,36 +99,22 @@ struct Script {
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile = proto::default_profile());
 
-/// How one action ended (of either dialect's vocabulary).
-template <class Action>
-struct BasicActionResult {
-  Action action;
-  Time started{0};
-  Time finished{0};
-  bool ok = false;
-  /// For a success what came back ("logged in: device 8, id 1, STOP",
-  /// "P=1.5 I=0.25 ..."), for a failure the reason.
-  std::string detail;
-};
 using ActionResult = BasicActionResult<OperatorAction>;
 
-struct RunnerOptions {
-  /// A `connect` that has not logged in this long after it was given fails.
-  Duration connect_timeout = link::seconds(10);
-  /// A `wait-data` without DATA this long fails.
-  Duration data_timeout = link::seconds(5);
+/// The request a document action waits for.
+struct RequestWait {
+  std::optional<std::uint8_t> coi;
+  bool started = false;
+  std::vector<proto::Setting> settings;  ///< what get-settings returned
 };
 
 /// Carries out actions one at a time on a session. The session's event
 /// sink must pass every event to `on_event`.
-class OperatorRunner {
+class OperatorRunner final
+    : public ActionRunner<OperatorRunner, Wr8Session, OperatorAction, RequestWait> {
  public:
-  using Done = std::function<void(const ActionResult&)>;
-
-  OperatorRunner(link::Executor& executor, Wr8Session& session, RunnerOptions options = {});
-  ~OperatorRunner();
-  OperatorRunner(const OperatorRunner&) = delete;
-  OperatorRunner& operator=(const OperatorRunner&) = delete;
+  OperatorRunner(link::Executor& executor, Wr8Session& session, RunnerOptions options = {})
+      : ActionRunner(executor, session, options) {}
 
   /// Feed every session event here (from the session's sink).
   void on_event(Time now, const Event& event);
@@ -151,50 +123,13 @@ class OperatorRunner {
   /// Programmer error (std::logic_error) while another action runs.
   void execute(OperatorAction action, Done done);
 
-  /// Runs `actions` in order, each result to `each`; stops after the first
-  /// failure unless `keep_going`. `finished(all_ok)` comes at the end.
-  void run(std::vector<OperatorAction> actions, bool keep_going, Done each,
-           std::function<void(bool all_ok)> finished);
-
-  bool busy() const { return current_.has_value(); }
-
  private:
-  struct Current {
-    OperatorAction action;
-    Time started{0};
-    Done done;
-    std::optional<std::uint8_t> coi;  // the request being waited for
-    bool request_started = false;
-    std::optional<link::Executor::TimerId> timer;
-    std::vector<proto::Setting> settings;  // what get-settings returned
-  };
-
   void start_request(SubmitResult submitted);
-  void finish(bool ok, std::string detail);
-  void arm_timer(Duration after, std::function<void()> fire);
   void on_request(const RequestEvent& r);
-  void run_next();
-
-  link::Executor& executor_;
-  Wr8Session& session_;
-  RunnerOptions options_;
-  std::optional<Current> current_;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
-
-  // The sequence `run` works through.
-  std::vector<OperatorAction> queue_;
-  std::size_t next_ = 0;
-  bool keep_going_ = false;
-  bool all_ok_ = true;
-  Done each_;
-  std::function<void(bool)> finished_;
 };
 
 /// "P=1.5 I=0.25 D=0.05 servo-zero=90" in the profile's presentation.
 std::string format_settings(const std::vector<proto::Setting>& settings,
                             const proto::Profile& profile = proto::default_profile());
-
-/// "250ms" / "1.5s" style text of a duration.
-std::string format_duration(Duration d);
 
 }  // namespace hil::client::wr8

@@ -13,7 +13,12 @@ namespace {
 
 using svgui::Version;
 
-// The words the dialects use for a request, as the operator types them.
+std::string seconds_text(Duration d) {
+  return duration_text(d);
+}
+
+}  // namespace
+
 std::string svgui_request_name(const RequestEvent& r) {
   if (r.kind == RequestKind::settings) return r.coi == 0 ? "set" : "settings";
   switch (r.task) {
@@ -30,12 +35,6 @@ std::string svgui_request_name(const RequestEvent& r) {
   }
   return "task " + std::to_string(static_cast<int>(r.task));
 }
-
-std::string seconds_text(Duration d) {
-  return duration_text(d);
-}
-
-}  // namespace
 
 protocol::Bytes svgui_auth_text(svgui::Version version) {
   protocol::Bytes text = {'k', 'o', 'n', 'n', 'i', 'c', 'h', 'i', 'w', 'a'};

@@ -107,6 +107,10 @@ using SvguiEvent = std::variant<ConnectionEvent, LoginEvent, LoginFailedEvent, S
                                 RequestEvent, ParseErrorEvent, DataEvent, HighFreqEvent,
                                 LowFreqEvent, MapEvent, SetReadEvent, PacketIgnoredEvent>;
 
+/// The operator's word for the request an event is about: "forward",
+/// "wheels", "signals", "settings" (v2019); "set", "set-request" (head).
+std::string svgui_request_name(const RequestEvent& r);
+
 /// One line for a person, e.g. "request COI 3 forward timed_out (...)".
 std::string describe(const SvguiEvent& event);
 

@@ -287,51 +287,11 @@ std::string to_text(const SvguiAction& action) {
 
 // ---- runner ----
 
-SvguiRunner::SvguiRunner(link::Executor& executor, SvguiSession& session, RunnerOptions options)
-    : executor_(executor), session_(session), options_(options) {}
-
-SvguiRunner::~SvguiRunner() {
-  *alive_ = false;
-  if (current_ && current_->timer) executor_.cancel(*current_->timer);
-}
-
 void SvguiRunner::execute(SvguiAction action, Done done) {
-  if (current_) throw std::logic_error("SvguiRunner::execute while an action runs");
-  current_ = Current{std::move(action), executor_.now(), std::move(done), {}, {}};
-  const auto& core = session_.core();
-  const auto refused = [this](Refusal r) {
-    std::string why(to_string(r));
-    for (char& c : why)
-      if (c == '_') c = ' ';
-    finish(false, "refused: " + why);
-  };
+  if (begin(std::move(action), std::move(done))) return;
+  const auto refused = [this](Refusal r) { refuse(r); };
   std::visit(
       Overloaded{
-          [&](const op::Connect&) {
-            if (core.state() == ConnectionState::connected) {
-              finish(true, "already logged in");
-              return;
-            }
-            session_.connect();
-            arm_timer(options_.connect_timeout, [this] {
-              session_.disconnect();
-              finish(false, "not logged in within " + format_duration(options_.connect_timeout));
-            });
-          },
-          [&](const op::Disconnect&) {
-            session_.disconnect();
-            finish(true, "disconnected");
-          },
-          [&](const op::Wait& a) { arm_timer(a.duration, [this] { finish(true, ""); }); },
-          [&](const op::WaitData&) {
-            if (core.state() == ConnectionState::disconnected) {
-              finish(false, "not connected");
-              return;
-            }
-            arm_timer(options_.data_timeout, [this] {
-              finish(false, "no DATA within " + format_duration(options_.data_timeout));
-            });
-          },
           [&](const op::Forward& a) {
             start_request(session_.forward(a.distance_cm), RequestKind::task,
                           proto::TaskCode::drive);
@@ -373,6 +333,7 @@ void SvguiRunner::execute(SvguiAction action, Done done) {
           [&](const op::SetRequest&) {
             start_request(session_.set_request(), RequestKind::task, proto::TaskCode::get_settings);
           },
+          [](const auto&) {},  // the shared words, which begin() carried out
       },
       current_->action);
 }
@@ -399,43 +360,15 @@ void SvguiRunner::start_set(const op::Set& set) {
 
 void SvguiRunner::start_request(SubmitResult submitted, RequestKind kind, proto::TaskCode task) {
   if (!submitted) {
-    std::string why(to_string(submitted.refusal));
-    for (char& c : why)
-      if (c == '_') c = ' ';
-    finish(false, "refused: " + why);
+    refuse(submitted.refusal);
     return;
   }
-  current_->request = RequestEvent{submitted.coi, kind, task, RequestState::sent, {}};
-}
-
-void SvguiRunner::arm_timer(Duration after, std::function<void()> fire) {
-  std::weak_ptr<bool> alive = alive_;
-  current_->timer = executor_.call_after(after, [this, alive, fire = std::move(fire)] {
-    if (const auto a = alive.lock(); !a || !*a) return;
-    if (!current_) return;
-    current_->timer.reset();
-    fire();
-  });
-}
-
-void SvguiRunner::finish(bool ok, std::string detail) {
-  if (!current_) return;
-  if (current_->timer) executor_.cancel(*current_->timer);
-  SvguiActionResult result{std::move(current_->action), current_->started, executor_.now(), ok,
-                           std::move(detail)};
-  Done done = std::move(current_->done);
-  current_.reset();
-  // Handed on from the executor, never from inside the session's event sink.
-  std::weak_ptr<bool> alive = alive_;
-  executor_.post([alive, done = std::move(done), result = std::move(result)] {
-    if (const auto a = alive.lock(); !a || !*a) return;
-    if (done) done(result);
-  });
+  current_->pending = RequestEvent{submitted.coi, kind, task, RequestState::sent, {}};
 }
 
 void SvguiRunner::on_request(const RequestEvent& r) {
-  if (!current_ || !current_->request) return;
-  const RequestEvent& want = *current_->request;
+  if (!current_ || !current_->pending) return;
+  const RequestEvent& want = *current_->pending;
   if (r.coi != want.coi || r.kind != want.kind || r.task != want.task) return;
   const auto with_note = [&r](std::string text) {
     return r.note.empty() ? text : text + " (" + r.note + ")";
@@ -470,39 +403,23 @@ void SvguiRunner::on_request(const RequestEvent& r) {
 
 void SvguiRunner::on_event(Time, const SvguiEvent& event) {
   if (!current_) return;
-  const bool waits_data = std::holds_alternative<op::WaitData>(current_->action);
   std::visit(Overloaded{
-                 [&](const LoginEvent& e) {
-                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
-                   finish(true, "logged in: device " + std::to_string(e.reply.device_code) +
-                                    ", id " + std::to_string(e.reply.device_id) + ", " +
-                                    std::string(proto::to_string(e.reply.state)));
-                 },
-                 [&](const LoginFailedEvent& e) {
-                   if (!std::holds_alternative<op::Connect>(current_->action)) return;
-                   session_.disconnect();
-                   finish(false, e.reason);
-                 },
+                 [&](const LoginEvent& e) { on_login(e); },
+                 [&](const LoginFailedEvent& e) { on_login_failed(e); },
                  [&](const DataEvent& e) {
-                   if (waits_data)
-                     finish(true, "DATA " + std::string(proto::to_string(e.data.state)) + " at " +
-                                      std::to_string(e.data.timestamp_ms) + " ms");
+                   on_data("DATA " + std::string(proto::to_string(e.data.state)) + " at " +
+                           std::to_string(e.data.timestamp_ms) + " ms");
                  },
                  [&](const HighFreqEvent& e) {
-                   if (waits_data)
-                     finish(true,
-                            "HIGH-FREQ DATA at " + std::to_string(e.data.timestamp_ms) + " ms");
+                   on_data("HIGH-FREQ DATA at " + std::to_string(e.data.timestamp_ms) + " ms");
                  },
                  [&](const LowFreqEvent& e) {
-                   if (waits_data)
-                     finish(true, "LOW-FREQ DATA " + std::string(proto::to_string(e.data.state)) +
-                                      " at " + std::to_string(e.data.timestamp_ms) + " ms");
+                   on_data("LOW-FREQ DATA " + std::string(proto::to_string(e.data.state)) + " at " +
+                           std::to_string(e.data.timestamp_ms) + " ms");
                  },
                  [&](const ConnectionEvent& e) {
-                   if (waits_data && e.state == ConnectionState::disconnected)
-                     finish(false, "disconnected");
-                   if (e.state == ConnectionState::connected &&
-                       std::holds_alternative<op::Connect>(current_->action) &&
+                   on_connection(e);
+                   if (e.state == ConnectionState::connected && waits_for<op::Connect>() &&
                        !session_.core().config().wait_for_login)
                      finish(true, "connected; AUTH sent, its answer not awaited");
                  },
@@ -510,30 +427,6 @@ void SvguiRunner::on_event(Time, const SvguiEvent& event) {
                  [](const auto&) {},
              },
              event);
-}
-
-void SvguiRunner::run(std::vector<SvguiAction> actions, bool keep_going, Done each,
-                      std::function<void(bool)> finished) {
-  queue_ = std::move(actions);
-  next_ = 0;
-  keep_going_ = keep_going;
-  all_ok_ = true;
-  each_ = std::move(each);
-  finished_ = std::move(finished);
-  run_next();
-}
-
-void SvguiRunner::run_next() {
-  if (next_ >= queue_.size() || (!all_ok_ && !keep_going_)) {
-    auto finished = std::move(finished_);
-    if (finished) finished(all_ok_);
-    return;
-  }
-  execute(queue_[next_++], [this](const SvguiActionResult& r) {
-    if (!r.ok) all_ok_ = false;
-    if (each_) each_(r);
-    run_next();
-  });
 }
 
 }  // namespace hil::client::wr8

@@ -104,58 +104,25 @@ using SvguiActionResult = BasicActionResult<SvguiAction>;
 std::string format_set(const svgui::Set& set);
 
 /// Carries out actions one at a time on an SvguiSession. The session's
-/// event sink must pass every event to `on_event`.
-class SvguiRunner {
+/// event sink must pass every event to `on_event`. The request an action
+/// waits for is kept with its kind and task, and its COI (0 in head).
+class SvguiRunner final
+    : public ActionRunner<SvguiRunner, SvguiSession, SvguiAction, std::optional<RequestEvent>> {
  public:
-  using Done = std::function<void(const SvguiActionResult&)>;
+  SvguiRunner(link::Executor& executor, SvguiSession& session, RunnerOptions options = {})
+      : ActionRunner(executor, session, options) {}
 
-  SvguiRunner(link::Executor& executor, SvguiSession& session, RunnerOptions options = {});
-  ~SvguiRunner();
-  SvguiRunner(const SvguiRunner&) = delete;
-  SvguiRunner& operator=(const SvguiRunner&) = delete;
-
+  /// Feed every session event here (from the session's sink).
   void on_event(Time now, const SvguiEvent& event);
 
   /// Starts `action`; `done` is called once when it ends (maybe at once).
   /// Programmer error (std::logic_error) while another action runs.
   void execute(SvguiAction action, Done done);
 
-  /// Runs `actions` in order, each result to `each`; stops after the first
-  /// failure unless `keep_going`. `finished(all_ok)` comes at the end.
-  void run(std::vector<SvguiAction> actions, bool keep_going, Done each,
-           std::function<void(bool all_ok)> finished);
-
-  bool busy() const { return current_.has_value(); }
-
  private:
-  struct Current {
-    SvguiAction action;
-    Time started{0};
-    Done done;
-    /// The request waited for: its kind and task, and its COI (0 in head).
-    std::optional<RequestEvent> request;
-    std::optional<link::Executor::TimerId> timer;
-  };
-
   void start_request(SubmitResult submitted, RequestKind kind, proto::TaskCode task);
   void start_set(const op::Set& set);
-  void finish(bool ok, std::string detail);
-  void arm_timer(Duration after, std::function<void()> fire);
   void on_request(const RequestEvent& r);
-  void run_next();
-
-  link::Executor& executor_;
-  SvguiSession& session_;
-  RunnerOptions options_;
-  std::optional<Current> current_;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
-
-  std::vector<SvguiAction> queue_;
-  std::size_t next_ = 0;
-  bool keep_going_ = false;
-  bool all_ok_ = true;
-  Done each_;
-  std::function<void(bool)> finished_;
 };
 
 }  // namespace hil::client::wr8
