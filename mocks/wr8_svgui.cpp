@@ -362,12 +362,7 @@ void SvguiFirmware::handle_task(Time now, ByteView packet) {
     return;
   }
   count_frame_in();
-  if (state_.current_coi != 0) {
-    ++state_.dropped_busy;
-    say("wr8 svgui-2019: TASK COI " + std::to_string(coi) + " dropped: busy with COI " +
-        std::to_string(state_.current_coi));
-    return;
-  }
+  if (dropped_busy("TASK", coi)) return;
   switch (dispose(now, "TASK")) {
     case Disposition::handle:
       // The program takes the COI before it looks at the type: a type it
@@ -382,6 +377,14 @@ void SvguiFirmware::handle_task(Time now, ByteView packet) {
       break;
   }
   frame_handled(now, "TASK");
+}
+
+bool SvguiFirmware::dropped_busy(std::string_view kind, std::uint8_t coi) {
+  if (state_.current_coi == 0) return false;
+  ++state_.dropped_busy;
+  say("wr8 svgui-2019: " + std::string(kind) + " COI " + std::to_string(coi) +
+      " dropped: busy with COI " + std::to_string(state_.current_coi));
+  return true;
 }
 
 void SvguiFirmware::start_task(Time now, std::uint8_t type,
@@ -421,12 +424,7 @@ void SvguiFirmware::handle_settings(Time now, ByteView packet) {
         " bytes: the program reads its values at bytes 2, 7, 12 and 17, the last past the "
         "packet (read here as 0)");
   }
-  if (state_.current_coi != 0) {
-    ++state_.dropped_busy;
-    say("wr8 svgui-2019: SETTINGS COI " + std::to_string(coi) + " dropped: busy with COI " +
-        std::to_string(state_.current_coi));
-    return;
-  }
+  if (dropped_busy("SETTINGS", coi)) return;
   switch (dispose(now, "SETTINGS")) {
     case Disposition::handle:
       // Busy from now on: nothing in the program ends a SETTINGS.

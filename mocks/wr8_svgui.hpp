@@ -174,6 +174,9 @@ class SvguiFirmware final : public Firmware {
   void handle_head(Time now, ByteView packet);
   void handle_task(Time now, ByteView packet);
   void handle_settings(Time now, ByteView packet);
+  /// v2019: a TASK or SETTINGS that comes while a COI is in progress is
+  /// dropped without a word (true); false while the car is idle.
+  bool dropped_busy(std::string_view kind, std::uint8_t coi);
   void start_task(Time now, std::uint8_t type, const std::vector<std::int32_t>& params);
   void finish_task(std::uint8_t code);
   void task_step(Time now);
