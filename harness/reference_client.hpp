@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/reference_settings.hpp"
 #include "harness/timeline_recorder.hpp"
 #include "link/endpoint.hpp"
 #include "link/transport.hpp"
@@ -52,25 +53,6 @@ class ReferenceSession {
   /// (`hard`: no more chances).
   virtual void terminate(bool hard) { (void)hard; }
 };
-
-/// One option of a car's reference client that a scenario may set
-/// (`client: {reference: {settings: {max_retries: 0}}}`).
-struct ReferenceSetting {
-  std::string name;   ///< "max_retries"
-  std::string takes;  ///< what a value looks like: "a duration (800ms)"
-  std::string what;   ///< what it changes, for people
-};
-
-/// The options the car's reference client takes in profile `profile`
-/// (empty: the default), in a fixed order.
-std::vector<ReferenceSetting> reference_settings(mocks::CarKind car, std::string_view profile = {});
-
-/// Why `value` (a text, or an array of texts for a list) cannot be the
-/// option `name` of the car's reference client in `profile`; nullopt when
-/// it can.
-std::optional<std::string> reference_setting_problem(mocks::CarKind car, const std::string& name,
-                                                     const nlohmann::json& value,
-                                                     std::string_view profile = {});
 
 /// The car's reference client on `endpoint`, writing client records to
 /// `timeline`, its library's defaults changed by `settings` (names to values
