@@ -1,5 +1,7 @@
 #include "harness/reference_settings.hpp"
 
+#include "base/duration.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <functional>
@@ -45,7 +47,7 @@ Option<Config> duration_option(std::string name, Duration Config::*member, std::
                                          : "a duration above 0 with a unit (800ms, 2s)";
   return {{std::move(name), takes, std::move(what)},
           [member, zero_allowed, takes](Config& c, const Json& v) -> std::optional<std::string> {
-            const auto d = v.is_string() ? link::parse_duration(v.get<std::string>())
+            const auto d = v.is_string() ? hil::parse_duration(v.get<std::string>())
                                          : std::optional<Duration>{};
             if (!d || (*d == Duration(0) && !zero_allowed)) return takes;
             c.*member = *d;
@@ -90,7 +92,7 @@ Option<Config> delays_option(std::vector<Duration> Config::*member, std::string 
             const Json list = v.is_array() ? v : Json::array({v});
             std::vector<Duration> delays;
             for (const auto& item : list) {
-              const auto d = item.is_string() ? link::parse_duration(item.get<std::string>())
+              const auto d = item.is_string() ? hil::parse_duration(item.get<std::string>())
                                               : std::optional<Duration>{};
               if (!d || *d == Duration(0)) return takes;
               delays.push_back(*d);

@@ -3,24 +3,23 @@
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
-#include <fstream>
 #include <set>
-#include <sstream>
 
-#include "link/faults/profile_yaml.hpp"
+#include "base/duration.hpp"
+#include "config/yaml.hpp"
 #include "protocol/common/bytes.hpp"
 
 namespace hil::mocks {
 namespace {
 
-[[noreturn]] void fail(const std::string& source, const YAML::Mark& mark,
-                       const std::string& message) {
-  const int line = mark.line >= 0 ? mark.line + 1 : 0;
-  const int column = mark.column >= 0 ? mark.column + 1 : 0;
-  throw BehaviourError(source, line, column, message);
-}
+using config::fail_at;
 
 using Keys = std::set<std::string, std::less<>>;
+
+/// "a, b, c", in sorted order.
+std::string join(const Keys& keys) {
+  return config::join(config::Keys(keys.begin(), keys.end()));
+}
 
 const Keys kWhenKeys = {"do", "name", "at", "after", "after_count"};
 
@@ -32,13 +31,6 @@ Keys keys_of(std::string_view action) {
   if (action == "send") keys.insert({"text", "hex"});
   if (action == "close") keys.insert("mode");
   return keys;
-}
-
-std::string join(const Keys& keys) {
-  std::string text;
-  for (const auto& k : keys)
-    text += (text.empty() ? "" : ", ") + k;
-  return text;
 }
 
 class BehaviourReader {
@@ -126,21 +118,12 @@ class BehaviourReader {
   }
 
   void check_keys(const Keys& allowed) {
-    Keys seen;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const YAML::Node key = it->first;
-      const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
-      if (!allowed.contains(name)) {
-        fail(source_, key.Mark(),
-             prefix_ + ": unknown key '" + name + "' (this action takes: " + join(allowed) + ")");
-      }
-      if (!seen.insert(name).second)
-        fail(source_, key.Mark(), prefix_ + ": key '" + name + "' given twice");
-    }
+    config::Reader(source_).check_keys(node_, config::Keys(allowed.begin(), allowed.end()), prefix_,
+                                       "this action takes");
   }
 
   [[noreturn]] void bad(const YAML::Node& n, const std::string& what) {
-    fail(source_, n.Mark(), prefix_ + ": " + what);
+    fail_at(source_, n.Mark(), prefix_ + ": " + what);
   }
 
   std::string scalar(const YAML::Node& n, const char* key) {
@@ -158,7 +141,7 @@ class BehaviourReader {
   }
 
   Duration duration(const YAML::Node& n, const char* key) {
-    const auto d = link::parse_duration(scalar(n, key));
+    const auto d = parse_duration(scalar(n, key));
     if (!d) {
       bad(n, "'" + std::string(key) +
                  "' must be a duration with a unit, like 250ms or 1.5s (units: ns, us, ms, s)");
@@ -173,34 +156,20 @@ class BehaviourReader {
 
 }  // namespace
 
-BehaviourError::BehaviourError(std::string source, int line, int column, const std::string& message)
-    : std::runtime_error(
-          (line > 0 ? source + ":" + std::to_string(line) + ":" + std::to_string(column) : source) +
-          ": " + message),
-      source_(std::move(source)),
-      line_(line),
-      column_(column) {}
-
 std::vector<Behaviour> parse_behaviours(const YAML::Node& node, const std::string& source_name) {
   YAML::Node list = node;
   if (node.IsMap()) {
-    for (auto it = node.begin(); it != node.end(); ++it) {
-      const YAML::Node key = it->first;
-      const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
-      if (name != "behaviours" && name != "description") {
-        fail(source_name, key.Mark(),
-             "unknown key '" + name + "' (a behaviours file takes: behaviours, description)");
-      }
-    }
+    config::Reader(source_name)
+        .check_keys(node, {"behaviours", "description"}, "", "a behaviours file takes");
     // A const lookup, and reset() rather than operator=: assigning to a
     // YAML::Node that shares `node` rewrites the caller's document (and a
     // missing key then leaves `node` invalid, so Mark() throws).
     const YAML::Node found = static_cast<const YAML::Node&>(node)["behaviours"];
-    if (!found) fail(source_name, node.Mark(), "'behaviours' is missing");
+    if (!found) fail_at(source_name, node.Mark(), "'behaviours' is missing");
     list.reset(found);
   }
   if (list.IsNull()) return {};
-  if (!list.IsSequence()) fail(source_name, list.Mark(), "'behaviours' must be a list");
+  if (!list.IsSequence()) fail_at(source_name, list.Mark(), "'behaviours' must be a list");
   std::vector<Behaviour> out;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node item = list[i];
@@ -211,21 +180,11 @@ std::vector<Behaviour> parse_behaviours(const YAML::Node& node, const std::strin
 
 std::vector<Behaviour> parse_behaviours_text(std::string_view yaml,
                                              const std::string& source_name) {
-  YAML::Node node;
-  try {
-    node = YAML::Load(std::string(yaml));
-  } catch (const YAML::ParserException& e) {
-    fail(source_name, e.mark, "not valid YAML: " + e.msg);
-  }
-  return parse_behaviours(node, source_name);
+  return parse_behaviours(config::Reader(source_name).parse(yaml), source_name);
 }
 
 std::vector<Behaviour> load_behaviours(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw BehaviourError(path, 0, 0, "cannot read the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_behaviours_text(text.str(), path);
+  return parse_behaviours_text(config::read_file(path, "file"), path);
 }
 
 }  // namespace hil::mocks

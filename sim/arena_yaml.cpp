@@ -1,8 +1,11 @@
 #include "sim/arena_yaml.hpp"
 
+#include "config/yaml.hpp"
+
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -17,60 +20,12 @@
 namespace hil::sim {
 namespace {
 
-using Keys = std::set<std::string, std::less<>>;
+using config::Keys;
 
-std::string position(const std::string& source, int line, int column) {
-  std::string text = source;
-  if (line > 0) text += ":" + std::to_string(line) + ":" + std::to_string(column);
-  return text;
-}
-
-[[noreturn]] void fail(const std::string& source, const YAML::Mark& mark,
-                       const std::string& message) {
-  // yaml-cpp counts from 0; a null mark (-1) means no position.
-  const int line = mark.line >= 0 ? mark.line + 1 : 0;
-  const int column = mark.column >= 0 ? mark.column + 1 : 0;
-  throw ArenaError(source, line, column, message);
-}
-
-std::string join(const Keys& keys) {
-  std::string text;
-  for (const auto& k : keys)
-    text += (text.empty() ? "" : ", ") + k;
-  return text;
-}
-
-/// How a node looks, for "got ..." in messages. Long scalars are cut so a
-/// hostile file cannot make a message of megabytes.
-std::string describe(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Scalar: {
-      constexpr std::size_t kMaxShown = 40;
-      const std::string& text = n.Scalar();
-      if (text.size() <= kMaxShown) return "'" + text + "'";
-      return "'" + text.substr(0, kMaxShown) + "...'";
-    }
-    case YAML::NodeType::Sequence:
-      return "a list of " + std::to_string(n.size());
-    case YAML::NodeType::Map:
-      return "a map";
-    default:
-      return "nothing";
-  }
-}
-
-std::optional<double> parse_number(std::string_view text) {
-  // YAML allows an explicit plus sign; from_chars does not.
-  if (text.starts_with('+')) {
-    text.remove_prefix(1);
-    if (text.starts_with('-')) return std::nullopt;
-  }
-  double value = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc{} || ptr != end || !std::isfinite(value)) return std::nullopt;
-  return value;
-}
+using config::describe;
+using config::fail_at;
+using config::join;
+using config::parse_number;
 
 /// Shortest text that reads back to exactly `value`.
 std::string format_number(double value) {
@@ -99,22 +54,23 @@ class MapReader {
             const Keys& allowed)
       : source_(source), node_(node), field_(std::move(field)) {
     if (!node_.IsMap()) {
-      fail(source_, node_.Mark(),
+      fail_at(source_, node_.Mark(),
            field_ + ": expected a map with keys " + join(allowed) + ", got " + describe(node_));
     }
-    Keys seen;
+    std::set<std::string, std::less<>> seen;
     for (auto it = node_.begin(); it != node_.end(); ++it) {
       // A copy: the iterator hands out a temporary pair, so a reference would dangle.
       const YAML::Node key = it->first;
       const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
-      if (!allowed.contains(name)) {
+      if (std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
         const std::string shown = describe(key);  // quoted and shortened
         const std::string short_name = key.IsScalar() ? shown.substr(1, shown.size() - 2) : "?";
-        fail(source_, key.Mark(),
-             path(short_name) + ": unknown key " + shown + " (allowed: " + join(allowed) + ")");
+        fail_at(source_, key.Mark(),
+                path(short_name) + ": unknown key " + shown + " (allowed: " + join(allowed) + ")" +
+                    config::did_you_mean(name, allowed));
       }
       if (!seen.insert(name).second)
-        fail(source_, key.Mark(), path(name) + ": key '" + name + "' given twice");
+        fail_at(source_, key.Mark(), path(name) + ": key '" + name + "' is given twice");
     }
   }
 
@@ -130,13 +86,13 @@ class MapReader {
 
   YAML::Node required(const char* key, const std::string& what) const {
     auto n = get(key);
-    if (!n) fail(source_, node_.Mark(), path(key) + ": missing; expected " + what);
+    if (!n) fail_at(source_, node_.Mark(), path(key) + ": missing; expected " + what);
     return *n;
   }
 
   double number(const YAML::Node& n, const std::string& field, const char* expected) const {
     const auto value = n.IsScalar() ? parse_number(n.Scalar()) : std::nullopt;
-    if (!value) fail(source_, n.Mark(), field + ": expected " + expected + ", got " + describe(n));
+    if (!value) fail_at(source_, n.Mark(), field + ": expected " + expected + ", got " + describe(n));
     return *value;
   }
 
@@ -147,7 +103,7 @@ class MapReader {
   double positive_metres(const YAML::Node& n, const std::string& field) const {
     const double value = number(n, field, "a positive number of metres");
     if (!(value > 0)) {
-      fail(source_, n.Mark(), field + ": expected a positive number of metres, got " + describe(n));
+      fail_at(source_, n.Mark(), field + ": expected a positive number of metres, got " + describe(n));
     }
     return value;
   }
@@ -170,13 +126,13 @@ class MapReader {
     const std::string text = n->IsScalar() ? n->Scalar() : std::string{};
     if (text == "true" || text == "True" || text == "TRUE") return true;
     if (text == "false" || text == "False" || text == "FALSE") return false;
-    fail(source_, n->Mark(), path(key) + ": expected true or false, got " + describe(*n));
+    fail_at(source_, n->Mark(), path(key) + ": expected true or false, got " + describe(*n));
   }
 
   std::string text(const YAML::Node& n, const std::string& field, const char* expected) const {
     // The scalar's own text: an unquoted 001 stays "001", not the number 1.
     if (!n.IsScalar())
-      fail(source_, n.Mark(), field + ": expected " + expected + ", got " + describe(n));
+      fail_at(source_, n.Mark(), field + ": expected " + expected + ", got " + describe(n));
     return n.Scalar();
   }
   std::string optional_text(const char* key) const {
@@ -190,14 +146,13 @@ class MapReader {
   std::string field_;
 };
 
-const Keys kTopKeys = {"name",  "size_m",    "walls", "wall_thickness_m",
-                       "start", "obstacles", "tapes", "tags"};
-const Keys kStartKeys = {"x_m", "y_m", "heading_deg"};
+const Keys kTopKeys = {"name", "obstacles", "size_m", "start", "tags", "tapes", "wall_thickness_m", "walls"};
+const Keys kStartKeys = {"heading_deg", "x_m", "y_m"};
 const Keys kObstacleKeys = {"box", "circle"};
-const Keys kBoxKeys = {"name", "x_m", "y_m", "width_m", "height_m", "angle_deg"};
-const Keys kCircleKeys = {"name", "x_m", "y_m", "radius_m"};
-const Keys kTapeKeys = {"name", "width_m", "closed", "points_m"};
-const Keys kTagKeys = {"id", "x_m", "y_m", "radius_m"};
+const Keys kBoxKeys = {"angle_deg", "height_m", "name", "width_m", "x_m", "y_m"};
+const Keys kCircleKeys = {"name", "radius_m", "x_m", "y_m"};
+const Keys kTapeKeys = {"closed", "name", "points_m", "width_m"};
+const Keys kTagKeys = {"id", "radius_m", "x_m", "y_m"};
 
 class ArenaReader {
  public:
@@ -205,7 +160,7 @@ class ArenaReader {
 
   Arena read() {
     if (!root_.IsMap()) {
-      fail(source_, root_.Mark(),
+      fail_at(source_, root_.Mark(),
            "arena: expected a map with keys " + join(kTopKeys) + ", got " + describe(root_));
     }
     marks_.document = root_.Mark();
@@ -220,7 +175,7 @@ class ArenaReader {
       // insists on a positive thickness when there are walls.
       const double t = top.number(*n, "wall_thickness_m", "a number of metres >= 0");
       if (!(t >= 0))
-        fail(source_, n->Mark(),
+        fail_at(source_, n->Mark(),
              "wall_thickness_m: expected a number of metres >= 0, got " + describe(*n));
       arena.wall_thickness_m = t;
       marks_.add("wall_thickness_m", "wall_thickness_m", n->Mark());
@@ -251,7 +206,7 @@ class ArenaReader {
     const char* expected = "[width, height] in metres";
     const YAML::Node n = top.required("size_m", expected);
     if (!n.IsSequence() || n.size() != 2)
-      fail(source_, n.Mark(), std::string("size_m: expected ") + expected + ", got " + describe(n));
+      fail_at(source_, n.Mark(), std::string("size_m: expected ") + expected + ", got " + describe(n));
     arena.width_m = top.positive_metres(n[0], "size_m[0]");
     arena.height_m = top.positive_metres(n[1], "size_m[1]");
     marks_.add("size", "size_m", n.Mark());
@@ -270,7 +225,7 @@ class ArenaReader {
   void each_item(const YAML::Node& list, const std::string& field, Fn&& fn) {
     if (list.IsNull()) return;  // "tags:" with nothing after it: no tags
     if (!list.IsSequence())
-      fail(source_, list.Mark(), field + ": expected a list, got " + describe(list));
+      fail_at(source_, list.Mark(), field + ": expected a list, got " + describe(list));
     for (std::size_t i = 0; i < list.size(); ++i) {
       const YAML::Node item = list[i];
       fn(item, field + "[" + std::to_string(i) + "]", i);
@@ -282,8 +237,7 @@ class ArenaReader {
     const auto box = outer.get("box");
     const auto circle = outer.get("circle");
     if (box.has_value() == circle.has_value()) {
-      fail(
-          source_, item.Mark(),
+      fail_at(source_, item.Mark(),
           field + ": expected exactly one of 'box' or 'circle', got " + (box ? "both" : "neither"));
     }
     const std::string validate_name = "obstacles[" + std::to_string(i) + "]";
@@ -317,14 +271,14 @@ class ArenaReader {
     const YAML::Node points = r.required("points_m", expected);
     const std::string points_field = r.path("points_m");
     if (!points.IsSequence())
-      fail(source_, points.Mark(),
+      fail_at(source_, points.Mark(),
            points_field + ": expected " + expected + ", got " + describe(points));
     const std::string validate_name = "tapes[" + std::to_string(i) + "]";
     for (std::size_t k = 0; k < points.size(); ++k) {
       const YAML::Node p = points[k];
       const std::string point_field = points_field + "[" + std::to_string(k) + "]";
       if (!p.IsSequence() || p.size() != 2) {
-        fail(source_, p.Mark(),
+        fail_at(source_, p.Mark(),
              point_field + ": expected an [x, y] pair of metres, got " + describe(p));
       }
       tape.points_m.push_back({r.number(p[0], point_field + "[0]", "a number of metres"),
@@ -355,7 +309,7 @@ class ArenaReader {
     if (problems.empty()) return;
     const std::string& problem = problems.front();
     const auto colon = problem.find(": ");
-    if (colon == std::string::npos) fail(source_, marks_.document, problem);
+    if (colon == std::string::npos) fail_at(source_, marks_.document, problem);
     const std::string part = problem.substr(0, colon);
     const std::string rest = problem.substr(colon);
     std::string key = part;
@@ -366,8 +320,8 @@ class ArenaReader {
       key += "/id";
     }
     const auto found = marks_.parts.find(key);
-    if (found == marks_.parts.end()) fail(source_, marks_.document, problem);
-    fail(source_, found->second.second, found->second.first + rest);
+    if (found == marks_.parts.end()) fail_at(source_, marks_.document, problem);
+    fail_at(source_, found->second.second, found->second.first + rest);
   }
 
   const YAML::Node& root_;
@@ -387,7 +341,7 @@ bool plain_safe(const std::string& text) {
   }
   static const Keys kSpecial = {"null",  "Null",  "NULL", "true", "True", "TRUE", "false",
                                 "False", "FALSE", "yes",  "no",   "on",   "off"};
-  return !kSpecial.contains(text);
+  return std::find(kSpecial.begin(), kSpecial.end(), text) == kSpecial.end();
 }
 
 void emit_text(YAML::Emitter& out, const std::string& text) {
@@ -404,53 +358,22 @@ void emit_number(YAML::Emitter& out, double value) {
 
 }  // namespace
 
-ArenaError::ArenaError(std::string source, int line, int column, const std::string& message)
-    : std::runtime_error(position(source, line, column) + ": " + message),
-      source_(std::move(source)),
-      line_(line),
-      column_(column) {}
-
 Arena parse_arena(const YAML::Node& node, const std::string& source_name) {
   try {
     return ArenaReader(node, source_name).read();
   } catch (const YAML::Exception& e) {
     // The reader checks every node's type before use; this is a last guard so
-    // no input can escape as anything but an ArenaError.
-    fail(source_name, e.mark, "arena: " + e.msg);
+    // no input can escape as anything but a ConfigError.
+    fail_at(source_name, e.mark, "arena: " + e.msg);
   }
 }
 
 Arena parse_arena_text(std::string_view yaml, const std::string& source_name) {
-  YAML::Node node;
-  try {
-    node = YAML::Load(std::string(yaml));
-  } catch (const YAML::DeepRecursion& e) {
-    // yaml-cpp's own text for this case reads "bad file".
-    fail(source_name, e.mark, "not valid YAML: nested too deeply");
-  } catch (const YAML::Exception& e) {
-    fail(source_name, e.mark, "not valid YAML: " + e.msg);
-  }
-  return parse_arena(node, source_name);
+  return parse_arena(config::Reader(source_name).parse(yaml), source_name);
 }
 
 Arena load_arena(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ArenaError(path, 0, 0, "cannot read the file: it is a directory");
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr)
-    throw ArenaError(path, 0, 0, std::string("cannot read the file: ") + std::strerror(errno));
-  std::string text;
-  char buffer[65536];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0)
-    text.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  const int error = errno;
-  std::fclose(file);
-  if (failed)
-    throw ArenaError(path, 0, 0, std::string("cannot read the file: ") + std::strerror(error));
-  return parse_arena_text(text, path);
+  return parse_arena_text(config::read_file(path, "file"), path);
 }
 
 std::string to_yaml(const Arena& arena) {

@@ -334,7 +334,7 @@ Reply LiveModel::set_faults(Car& car, const json& request) {
   if (!blank) {
     try {
       profile = link::parse_fault_profile_text(text, "profile");
-    } catch (const link::FaultProfileError& e) {
+    } catch (const config::ConfigError& e) {
       return bad(e.what());
     } catch (const YAML::Exception& e) {
       return bad(std::string("profile: ") + e.what());
@@ -353,7 +353,7 @@ Reply LiveModel::trigger(Car& car, const json& request) {
     std::vector<mocks::Behaviour> behaviours;
     try {
       behaviours = mocks::parse_behaviours_text(yaml, "behaviour");
-    } catch (const mocks::BehaviourError& e) {
+    } catch (const config::ConfigError& e) {
       return bad(e.what());
     } catch (const YAML::Exception& e) {
       return bad(std::string("behaviour: ") + e.what());

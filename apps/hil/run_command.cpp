@@ -190,7 +190,7 @@ int run_scenarios(const RunArgs& args) {
     try {
       p.scenario =
           harness::load_scenario(file, overrides, harness::LoadOptions{args.allow_outside_paths});
-    } catch (const harness::ScenarioError& e) {
+    } catch (const config::ConfigError& e) {
       p.error = e.what();
     } catch (const std::exception& e) {
       p.error = file + ": " + e.what();

@@ -52,7 +52,7 @@ void register_world(CLI::App& app, std::function<int()>& run) {
         try {
           const sim::Arena arena = sim::load_arena(file);
           std::cout << file << ": ok, " << describe(arena) << '\n';
-        } catch (const sim::ArenaError& e) {
+        } catch (const config::ConfigError& e) {
           std::cout << e.what() << '\n';
           status = 1;
         }
@@ -97,7 +97,7 @@ void register_world(CLI::App& app, std::function<int()>& run) {
         }
         std::cout << "wrote " << render_args->out << " (" << describe(arena) << ")\n";
         return 0;
-      } catch (const sim::ArenaError& e) {
+      } catch (const config::ConfigError& e) {
         std::cerr << e.what() << '\n';
         return 1;
       }

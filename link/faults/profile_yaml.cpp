@@ -1,48 +1,20 @@
 #include "link/faults/profile_yaml.hpp"
 
+#include "base/duration.hpp"
+#include "config/yaml.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cstdint>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 namespace hil::link {
 namespace {
 
 using protocol::Bytes;
 
-std::string position(const std::string& source, int line, int column) {
-  std::string text = source;
-  if (line > 0) text += ":" + std::to_string(line) + ":" + std::to_string(column);
-  return text;
-}
-
-[[noreturn]] void fail(const std::string& source, const YAML::Mark& mark,
-                       const std::string& message) {
-  // yaml-cpp counts from 0; a null mark (-1) means no position.
-  const int line = mark.line >= 0 ? mark.line + 1 : 0;
-  const int column = mark.column >= 0 ? mark.column + 1 : 0;
-  throw FaultProfileError(source, line, column, message);
-}
-
-std::optional<std::uint64_t> parse_uint(std::string_view text) {
-  std::uint64_t value = 0;
-  const auto* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc{} || ptr != end || text.empty()) return std::nullopt;
-  return value;
-}
-
-std::optional<double> parse_double(std::string_view text) {
-  double value = 0;
-  const auto* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (ec != std::errc{} || ptr != end || text.empty()) return std::nullopt;
-  return value;
-}
+using config::fail_at;
 
 const std::set<std::string, std::less<>> kCommonKeys = {"kind",  "name",       "direction", "from",
                                                         "to",    "match",      "at_frame",  "first",
@@ -94,13 +66,6 @@ std::set<std::string, std::less<>> keys_of(FaultKind kind) {
   return keys;
 }
 
-std::string join(const std::set<std::string, std::less<>>& keys) {
-  std::string text;
-  for (const auto& k : keys)
-    text += (text.empty() ? "" : ", ") + k;
-  return text;
-}
-
 /// Reads one rule map, reporting every problem at the node it is about.
 class RuleReader {
  public:
@@ -109,12 +74,12 @@ class RuleReader {
 
   FaultRule read() {
     if (!node_.IsMap())
-      fail(source_, node_.Mark(), prefix_ + ": must be a map with at least 'kind'");
+      fail_at(source_, node_.Mark(), prefix_ + ": must be a map with at least 'kind'");
     const YAML::Node kind_node = node_["kind"];
-    if (!kind_node) fail(source_, node_.Mark(), prefix_ + ": 'kind' is missing");
+    if (!kind_node) fail_at(source_, node_.Mark(), prefix_ + ": 'kind' is missing");
     const auto kind = parse_fault_kind(scalar(kind_node, "kind"));
     if (!kind) {
-      fail(source_, kind_node.Mark(),
+      fail_at(source_, kind_node.Mark(),
            prefix_ + ": unknown kind '" + kind_node.Scalar() +
                "' (known: fragment, coalesce, corrupt, drop, duplicate, garbage, delay, stall, "
                "bandwidth, disconnect, reset, refuse)");
@@ -130,11 +95,11 @@ class RuleReader {
     if (auto n = get("to")) {
       rule.window.to = duration(*n, "to");
       if (*rule.window.to <= rule.window.from)
-        fail(source_, n->Mark(), prefix_ + ": 'to' must be after 'from'");
+        fail_at(source_, n->Mark(), prefix_ + ": 'to' must be after 'from'");
     }
     read_trigger(rule.trigger);
     read_action(rule.action);
-    if (auto problem = rule_problem(rule)) fail(source_, node_.Mark(), prefix_ + ": " + *problem);
+    if (auto problem = rule_problem(rule)) fail_at(source_, node_.Mark(), prefix_ + ": " + *problem);
     return rule;
   }
 
@@ -146,22 +111,12 @@ class RuleReader {
   }
 
   void check_keys(const std::set<std::string, std::less<>>& allowed) {
-    std::set<std::string, std::less<>> seen;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      // A copy: the iterator hands out a temporary pair, so a reference would dangle.
-      const YAML::Node key = it->first;
-      const std::string name = key.IsScalar() ? key.Scalar() : std::string{};
-      if (!allowed.contains(name)) {
-        fail(source_, key.Mark(),
-             prefix_ + ": unknown key '" + name + "' (this kind takes: " + join(allowed) + ")");
-      }
-      if (!seen.insert(name).second)
-        fail(source_, key.Mark(), prefix_ + ": key '" + name + "' given twice");
-    }
+    config::Reader(source_).check_keys(node_, config::Keys(allowed.begin(), allowed.end()),
+                                       prefix_, "this kind takes");
   }
 
   [[noreturn]] void bad(const YAML::Node& n, const std::string& what) {
-    fail(source_, n.Mark(), prefix_ + ": " + what);
+    fail_at(source_, n.Mark(), prefix_ + ": " + what);
   }
 
   std::string scalar(const YAML::Node& n, const char* key) {
@@ -170,7 +125,7 @@ class RuleReader {
   }
 
   std::uint64_t count(const YAML::Node& n, const char* key, std::uint64_t min = 1) {
-    const auto v = parse_uint(scalar(n, key));
+    const auto v = config::parse_whole(scalar(n, key));
     if (!v || *v < min) {
       bad(n, "'" + std::string(key) + "' must be a whole number >= " + std::to_string(min));
     }
@@ -191,7 +146,7 @@ class RuleReader {
         "'" + std::string(key) + "' must be [min, max] with 1 <= min <= max, or one number";
     ByteCountRange r;
     if (n.IsScalar()) {
-      const auto v = parse_uint(n.Scalar());
+      const auto v = config::parse_whole(n.Scalar());
       if (!v || *v < 1) bad(n, expected);
       r.min = r.max = static_cast<std::size_t>(*v);
       return r;
@@ -199,7 +154,7 @@ class RuleReader {
     if (!n.IsSequence() || n.size() != 2) bad(n, expected);
     std::uint64_t bounds[2] = {0, 0};
     for (std::size_t k = 0; k < 2; ++k) {
-      const auto v = n[k].IsScalar() ? parse_uint(n[k].Scalar()) : std::nullopt;
+      const auto v = n[k].IsScalar() ? config::parse_whole(n[k].Scalar()) : std::nullopt;
       if (!v) bad(n, expected);
       bounds[k] = *v;
     }
@@ -237,7 +192,7 @@ class RuleReader {
     if (auto n = get("every")) t.every = count(*n, "every");
     if (auto n = get("at")) t.at = duration(*n, "at");
     if (auto n = get("probability")) {
-      const auto p = parse_double(scalar(*n, "probability"));
+      const auto p = config::parse_number(scalar(*n, "probability"));
       if (!p || !(*p >= 0.0 && *p <= 1.0)) bad(*n, "'probability' must be a number in [0, 1]");
       t.probability = *p;
     }
@@ -386,57 +341,6 @@ class RuleReader {
 
 }  // namespace
 
-FaultProfileError::FaultProfileError(std::string source, int line, int column,
-                                     const std::string& message)
-    : std::runtime_error(position(source, line, column) + ": " + message),
-      source_(std::move(source)),
-      line_(line),
-      column_(column) {}
-
-std::optional<Duration> parse_duration(std::string_view text) {
-  std::size_t digits_end = 0;
-  while (digits_end < text.size() &&
-         ((text[digits_end] >= '0' && text[digits_end] <= '9') || text[digits_end] == '.')) {
-    ++digits_end;
-  }
-  const std::string_view number = text.substr(0, digits_end);
-  const std::string_view unit = text.substr(digits_end);
-  std::int64_t unit_ns = 0;
-  if (unit == "ns") {
-    unit_ns = 1;
-  } else if (unit == "us") {
-    unit_ns = 1'000;
-  } else if (unit == "ms") {
-    unit_ns = 1'000'000;
-  } else if (unit == "s") {
-    unit_ns = 1'000'000'000;
-  } else {
-    return std::nullopt;
-  }
-  // Whole and fractional parts are read separately so "1.5s" is exactly
-  // 1 500 000 000 ns, with no floating-point rounding.
-  const auto dot = number.find('.');
-  const std::string_view whole = number.substr(0, dot);
-  const std::string_view fraction =
-      dot == std::string_view::npos ? std::string_view{} : number.substr(dot + 1);
-  if (whole.empty() || (dot != std::string_view::npos && fraction.empty())) return std::nullopt;
-  if (fraction.find('.') != std::string_view::npos || fraction.size() > 9) return std::nullopt;
-  const auto w = parse_uint(whole);
-  if (!w || *w > static_cast<std::uint64_t>(INT64_MAX / unit_ns / 2)) return std::nullopt;
-  std::int64_t ns = static_cast<std::int64_t>(*w) * unit_ns;
-  if (!fraction.empty()) {
-    const auto f = parse_uint(fraction);
-    if (!f) return std::nullopt;
-    std::int64_t scale = 1;
-    for (std::size_t i = 0; i < fraction.size(); ++i)
-      scale *= 10;
-    const auto scaled = static_cast<std::int64_t>(*f) * unit_ns;
-    if (scaled % scale != 0) return std::nullopt;  // finer than a nanosecond
-    ns += scaled / scale;
-  }
-  return Duration{ns};
-}
-
 FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& source_name) {
   YAML::Node rules = node;
   if (!node || node.IsNull()) return {};
@@ -445,7 +349,7 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
       const YAML::Node key_node = it->first;
       const std::string key = key_node.IsScalar() ? key_node.Scalar() : std::string{};
       if (key != "rules" && key != "description") {
-        fail(source_name, key_node.Mark(),
+        fail_at(source_name, key_node.Mark(),
              "unknown key '" + key +
                  "' (a fault profile has 'rules' and an optional 'description')");
       }
@@ -454,11 +358,11 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
     // YAML::Node that shares `node` rewrites the caller's document (and a
     // missing key then leaves `node` invalid, so Mark() throws).
     const YAML::Node found = static_cast<const YAML::Node&>(node)["rules"];
-    if (!found) fail(source_name, node.Mark(), "a fault profile needs 'rules: [...]'");
+    if (!found) fail_at(source_name, node.Mark(), "a fault profile needs 'rules: [...]'");
     if (found.IsNull()) return {};
     rules.reset(found);
   }
-  if (!rules.IsSequence()) fail(source_name, rules.Mark(), "'rules' must be a list of rules");
+  if (!rules.IsSequence()) fail_at(source_name, rules.Mark(), "'rules' must be a list of rules");
   FaultProfile profile;
   for (std::size_t i = 0; i < rules.size(); ++i) {
     const YAML::Node rule = static_cast<const YAML::Node&>(rules)[i];
@@ -468,21 +372,11 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
 }
 
 FaultProfile parse_fault_profile_text(std::string_view yaml, const std::string& source_name) {
-  YAML::Node node;
-  try {
-    node = YAML::Load(std::string(yaml));
-  } catch (const YAML::ParserException& e) {
-    fail(source_name, e.mark, "not valid YAML: " + e.msg);
-  }
-  return parse_fault_profile(node, source_name);
+  return parse_fault_profile(config::Reader(source_name).parse(yaml), source_name);
 }
 
 FaultProfile load_fault_profile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FaultProfileError(path, 0, 0, "cannot read the file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_fault_profile_text(text.str(), path);
+  return parse_fault_profile_text(config::read_file(path, "file"), path);
 }
 
 }  // namespace hil::link

@@ -1,5 +1,5 @@
 // libFuzzer target for the fault profile loader and its duration parser:
-// any bytes either load or are refused with FaultProfileError, and a loaded
+// any bytes either load or are refused with config::ConfigError, and a loaded
 // profile passes the checks a profile built in code must pass (the loader
 // and validate() must agree on what a sound profile is).
 
@@ -10,7 +10,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto text = hil::fuzz::as_text(data, size);
-  hil::fuzz::expect_only<hil::link::FaultProfileError>([&] {
+  hil::fuzz::expect_only<hil::config::ConfigError>([&] {
     const auto profile = hil::link::parse_fault_profile_text(text, "fuzz.yaml");
     try {
       hil::link::validate(profile);
@@ -20,6 +20,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   });
   // Durations come from the same files and from command lines.
-  if (size < 64) (void)hil::link::parse_duration(text);
+  if (size < 64) (void)hil::hil::parse_duration(text);
   return 0;
 }

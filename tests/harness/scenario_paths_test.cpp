@@ -49,7 +49,7 @@ class Library : public ::testing::Test {
     try {
       parse_scenario_text(yaml, scenario_file(), {}, LoadOptions{allow});
       return "";
-    } catch (const ScenarioError& e) {
+    } catch (const config::ConfigError& e) {
       return e.what();
     }
   }
@@ -111,7 +111,7 @@ TEST_F(Library, WorldFilesFollowTheSameRule) {
   try {
     parse_scenario_text(yaml, scenario_file());
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 3);
     EXPECT_EQ(e.column(), 8);
     EXPECT_NE(std::string(e.what()).find("world file '../../w.yaml' is outside"),
@@ -125,7 +125,7 @@ TEST_F(Library, FaultProfilesInStepsFollowTheSameRule) {
   try {
     parse_scenario_text(yaml, scenario_file());
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 5);
     EXPECT_NE(std::string(e.what()).find("--allow-outside-paths"), std::string::npos);
   }

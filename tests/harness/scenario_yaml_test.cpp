@@ -44,7 +44,7 @@ std::string error_of(const std::string& yaml,
                      const std::map<std::string, std::string>& overrides = {}) {
   try {
     parse_scenario_text(yaml, "t.yaml", overrides);
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     return e.what();
   }
   return "";
@@ -335,14 +335,14 @@ TEST(ScenarioYaml, AMissingFileIsReportedWhereItIsNamed) {
             "worlds/nowhere.yaml)");
   try {
     load_scenario(kData + "/nested/../relative.yaml");
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     FAIL() << e.what();
   }
   const std::string yaml = "name: t\ncar: logi\nsteps:\n  - faults: {file: gone.yaml}\n";
   try {
     parse_scenario_text(yaml, kData + "/x.yaml");
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 4);
     EXPECT_EQ(e.column(), 20);
     EXPECT_EQ(std::string(e.what()), kData +
@@ -356,7 +356,7 @@ TEST(ScenarioYaml, AFaultFileErrorKeepsItsOwnPosition) {
   try {
     load_scenario(kData + "/broken-faults.yaml");
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.file(), kData + "/faults/broken.yaml");
     EXPECT_EQ(e.line(), 3);
     EXPECT_EQ(e.column(), 5);
@@ -368,7 +368,7 @@ TEST(ScenarioYaml, InlineFaultErrorsPointIntoTheScenario) {
   try {
     parse("name: t\ncar: logi\nsteps: [connect]\nfaults:\n  - kind: drop\n    frist: 1\n");
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.file(), "t.yaml");
     EXPECT_EQ(e.line(), 6);
     EXPECT_EQ(e.column(), 5);
@@ -379,10 +379,10 @@ TEST(ScenarioYaml, AFileThatCannotBeReadIsAnErrorWithoutPosition) {
   try {
     load_scenario(kData + "/no-such-scenario.yaml");
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 0);
     EXPECT_EQ(std::string(e.what()),
-              kData + "/no-such-scenario.yaml: cannot read the scenario file");
+              kData + "/no-such-scenario.yaml: cannot read the scenario file: No such file or directory");
   }
 }
 
@@ -799,7 +799,7 @@ TEST(ScenarioYamlVariables, SubstitutedEverywhereAndOverridden) {
   try {
     load_scenario(kData + "/overrides.yaml", {{"speed", "fast"}});
     FAIL() << "loaded";
-  } catch (const ScenarioError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 9);
     EXPECT_NE(std::string(e.what()).find("step 3: LOGI action 'speed fast'"), std::string::npos)
         << e.what();
@@ -932,7 +932,7 @@ TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
 
 TEST(ScenarioYamlErrors, YamlSyntaxErrorsKeepTheParsersPosition) {
   EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect\n"),
-            "t.yaml:4:1: YAML syntax: end of sequence flow not found");
+            "t.yaml:4:1: not valid YAML: end of sequence flow not found");
   EXPECT_EQ(error_of("- just\n- a list\n"),
             "t.yaml:1:1: a scenario is a map with at least 'name', 'car' and 'steps' (see "
             "docs/scenarios.md)");
@@ -951,7 +951,7 @@ TEST(ScenarioYamlExamples, EveryExampleScenarioLoads) {
       EXPECT_FALSE(s.steps.empty());
       EXPECT_FALSE(s.expectations.empty());
       ++loaded;
-    } catch (const ScenarioError& e) {
+    } catch (const config::ConfigError& e) {
       ADD_FAILURE() << e.what();
     }
   }

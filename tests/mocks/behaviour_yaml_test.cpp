@@ -64,13 +64,13 @@ void expect_error(const std::string& yaml, const std::string& message) {
   try {
     parse_behaviours_text(yaml, "b.yaml");
     ADD_FAILURE() << "no error for:\n" << yaml;
-  } catch (const BehaviourError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), message);
   }
 }
 
 // Found by the behaviour fuzz target: a map without 'behaviours' escaped as
-// YAML::InvalidNode instead of a BehaviourError, and loading rewrote the node
+// YAML::InvalidNode instead of a config::ConfigError, and loading rewrote the node
 // it was given.
 TEST(BehaviourYaml, AMapWithoutBehavioursIsRefusedAndTheNodeIsLeftAlone) {
   expect_error("description: only words\n", "b.yaml:1:1: 'behaviours' is missing");
@@ -122,7 +122,7 @@ TEST(BehaviourYaml, EveryShippedBehavioursFileLoads) {
 }
 
 TEST(BehaviourYaml, AMissingFileIsAnError) {
-  EXPECT_THROW(load_behaviours("/nonexistent/b.yaml"), BehaviourError);
+  EXPECT_THROW(load_behaviours("/nonexistent/b.yaml"), config::ConfigError);
 }
 
 }  // namespace

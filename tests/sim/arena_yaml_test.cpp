@@ -99,12 +99,12 @@ struct Failure {
   int column = -1;
 };
 
-/// The ArenaError that reading `yaml` as "lab.yaml" raises.
+/// The config::ConfigError that reading `yaml` as "lab.yaml" raises.
 Failure failure_of(const std::string& yaml) {
   try {
     parse_arena_text(yaml, "lab.yaml");
-  } catch (const ArenaError& e) {
-    EXPECT_EQ(e.source(), "lab.yaml");
+  } catch (const config::ConfigError& e) {
+    EXPECT_EQ(e.file(), "lab.yaml");
     return {e.what(), e.line(), e.column()};
   }
   ADD_FAILURE() << "no error for:\n" << yaml;
@@ -308,7 +308,7 @@ TEST(ArenaYaml, EmbeddedNodeReadsLikeAFile) {
   try {
     parse_arena(scenario["world"], "scenario.yaml");
     FAIL() << "start outside the arena was accepted";
-  } catch (const ArenaError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 3);  // positions count in the whole scenario file
     EXPECT_EQ(e.column(), 10);
     EXPECT_THAT(e.what(), StartsWith("scenario.yaml:3:10: start: "));
@@ -322,8 +322,8 @@ TEST(ArenaYamlErrors, FileThatCannotBeRead) {
   try {
     load_arena(path);
     FAIL() << "a missing file loaded";
-  } catch (const ArenaError& e) {
-    EXPECT_EQ(e.source(), path);
+  } catch (const config::ConfigError& e) {
+    EXPECT_EQ(e.file(), path);
     EXPECT_EQ(e.line(), 0);
     EXPECT_EQ(e.column(), 0);
     EXPECT_EQ(std::string(e.what()), path + ": cannot read the file: No such file or directory");
@@ -331,7 +331,7 @@ TEST(ArenaYamlErrors, FileThatCannotBeRead) {
   try {
     load_arena(kWorlds.string());
     FAIL() << "a directory loaded";
-  } catch (const ArenaError& e) {
+  } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 0);
     EXPECT_THAT(e.what(), HasSubstr("directory"));
   }
@@ -402,7 +402,7 @@ TEST(ArenaYamlErrors, KeyGivenTwice) {
   const Failure f = failure_of(kBase + "walls: true\nwalls: false\n");
   EXPECT_EQ(f.line, 4);
   EXPECT_EQ(f.column, 1);
-  EXPECT_THAT(f.what, HasSubstr("walls: key 'walls' given twice"));
+  EXPECT_THAT(f.what, HasSubstr("walls: key 'walls' is given twice"));
 }
 
 TEST(ArenaYamlErrors, MissingRequiredKeysAreReportedAtTheirMap) {
@@ -659,7 +659,7 @@ TEST(ArenaYamlErrors, ZeroWallThicknessOnlyWithoutWalls) {
 
 TEST(ArenaYamlErrors, HostileInputsFailCleanly) {
   // Deep nesting, a self-referencing alias, and a huge number each end in
-  // an ArenaError, never a crash or a hang.
+  // an config::ConfigError, never a crash or a hang.
   EXPECT_THAT(failure_of(std::string(100'000, '[') + std::string(100'000, ']')).what,
               HasSubstr("not valid YAML"));
   EXPECT_THAT(failure_of("&a [*a]\n").what, HasSubstr("expected a map"));
