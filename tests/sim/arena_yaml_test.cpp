@@ -111,6 +111,14 @@ Failure failure_of(const std::string& yaml) {
   return {};
 }
 
+/// Reading `yaml` fails at `line`:`column` with a message that contains `text`.
+void expect_failure(const std::string& yaml, int line, int column, const std::string& text) {
+  const Failure f = failure_of(yaml);
+  EXPECT_EQ(f.line, line) << f.what;
+  EXPECT_EQ(f.column, column) << f.what;
+  EXPECT_THAT(f.what, HasSubstr(text));
+}
+
 // A valid arena for the error tests to add one mistake to. Lines 1-2.
 const std::string kBase =
     "size_m: [4, 3]\n"
@@ -351,10 +359,9 @@ TEST(ArenaYamlErrors, YamlSyntaxErrorHasTheParsersPosition) {
 }
 
 TEST(ArenaYamlErrors, TopLevelMustBeAMap) {
+  expect_failure("- size_m: [4, 3]\n", 1, 1,
+                 "arena: expected a map with keys name, obstacles, size_m");
   Failure f = failure_of("- size_m: [4, 3]\n");
-  EXPECT_EQ(f.line, 1);
-  EXPECT_EQ(f.column, 1);
-  EXPECT_THAT(f.what, HasSubstr("arena: expected a map with keys name, obstacles, size_m"));
   EXPECT_THAT(f.what, HasSubstr("got a list of 1"));
 
   f = failure_of("just text\n");
@@ -370,108 +377,75 @@ TEST(ArenaYamlErrors, TopLevelMustBeAMap) {
 }
 
 TEST(ArenaYamlErrors, UnknownKeysAreNamedWithTheAllowedOnes) {
-  Failure f = failure_of(kBase + "wall: false\n");
-  EXPECT_EQ(f.line, 3);
-  EXPECT_EQ(f.column, 1);
-  EXPECT_THAT(f.what, HasSubstr("wall: unknown key 'wall' (allowed: name, obstacles, size_m, "
-                                "start, tags, tapes, wall_thickness_m, walls)"));
+  expect_failure(kBase + "wall: false\n", 3, 1,
+                 "wall: unknown key 'wall' (allowed: name, obstacles, size_m, "
+                 "start, tags, tapes, wall_thickness_m, walls)");
 
-  f = failure_of(kBase +
-                 "obstacles:\n"
-                 "  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
-                 "  - circle: {x_m: 1, y_m: 1, raduis_m: 0.1}\n");
-  EXPECT_EQ(f.line, 5);
-  EXPECT_EQ(f.column, 30);
-  EXPECT_THAT(f.what, HasSubstr("obstacles[1].circle.raduis_m: unknown key 'raduis_m' (allowed: "
-                                "name, radius_m, x_m, y_m)"));
+  expect_failure(kBase +
+                     "obstacles:\n"
+                     "  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
+                     "  - circle: {x_m: 1, y_m: 1, raduis_m: 0.1}\n",
+                 5, 30,
+                 "obstacles[1].circle.raduis_m: unknown key 'raduis_m' (allowed: "
+                 "name, radius_m, x_m, y_m)");
 
-  f = failure_of(kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    colour: red\n");
-  EXPECT_EQ(f.line, 5);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].colour: unknown key 'colour' (allowed: closed, name, "
-                                "points_m, width_m)"));
+  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    colour: red\n", 5, 5,
+                 "tapes[0].colour: unknown key 'colour' (allowed: closed, name, "
+                 "points_m, width_m)");
 
-  f = failure_of("size_m: [4, 3]\nstart: {x_m: 1, y_m: 1, heading_rad: 1}\n");
-  EXPECT_EQ(f.line, 2);
-  EXPECT_EQ(f.column, 25);
-  EXPECT_THAT(f.what, HasSubstr("start.heading_rad: unknown key 'heading_rad' (allowed: "
-                                "heading_deg, x_m, y_m)"));
+  expect_failure("size_m: [4, 3]\nstart: {x_m: 1, y_m: 1, heading_rad: 1}\n", 2, 25,
+                 "start.heading_rad: unknown key 'heading_rad' (allowed: "
+                 "heading_deg, x_m, y_m)");
 }
 
 TEST(ArenaYamlErrors, KeyGivenTwice) {
-  const Failure f = failure_of(kBase + "walls: true\nwalls: false\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 1);
-  EXPECT_THAT(f.what, HasSubstr("walls: key 'walls' is given twice"));
+  expect_failure(kBase + "walls: true\nwalls: false\n", 4, 1, "walls: key 'walls' is given twice");
 }
 
 TEST(ArenaYamlErrors, MissingRequiredKeysAreReportedAtTheirMap) {
-  Failure f = failure_of("name: lab\nstart: {x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 1);
-  EXPECT_EQ(f.column, 1);
-  EXPECT_THAT(f.what, HasSubstr("size_m: missing; expected [width, height] in metres"));
+  expect_failure("name: lab\nstart: {x_m: 1, y_m: 1}\n", 1, 1,
+                 "size_m: missing; expected [width, height] in metres");
 
-  f = failure_of("size_m: [4, 3]\n");
+  Failure f = failure_of("size_m: [4, 3]\n");
   EXPECT_THAT(f.what, HasSubstr("start: missing"));
 
-  f = failure_of("size_m: [4, 3]\nstart: {y_m: 1}\n");
-  EXPECT_EQ(f.line, 2);
-  EXPECT_EQ(f.column, 8);
-  EXPECT_THAT(f.what, HasSubstr("start.x_m: missing; expected a number of metres"));
+  expect_failure("size_m: [4, 3]\nstart: {y_m: 1}\n", 2, 8,
+                 "start.x_m: missing; expected a number of metres");
 
-  f = failure_of(kBase + "tags:\n  - {x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what, HasSubstr("tags[0].id: missing"));
+  expect_failure(kBase + "tags:\n  - {x_m: 1, y_m: 1}\n", 4, 5, "tags[0].id: missing");
 
-  f = failure_of(kBase + "tapes:\n  - name: loop\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m: missing"));
+  expect_failure(kBase + "tapes:\n  - name: loop\n", 4, 5, "tapes[0].points_m: missing");
 }
 
 TEST(ArenaYamlErrors, WrongTypes) {
   // A list where a number belongs.
-  Failure f = failure_of("size_m: [4, 3]\nstart: {x_m: [1], y_m: 1}\n");
-  EXPECT_EQ(f.line, 2);
-  EXPECT_EQ(f.column, 14);
-  EXPECT_THAT(f.what, HasSubstr("start.x_m: expected a number of metres, got a list of 1"));
+  expect_failure("size_m: [4, 3]\nstart: {x_m: [1], y_m: 1}\n", 2, 14,
+                 "start.x_m: expected a number of metres, got a list of 1");
 
   // Text that is not a number, NaN and infinity.
   for (const char* value :
        {"one", ".nan", ".inf", "-.inf", "inf", "nan", "1e999", "1.5.2", "0x10"}) {
     SCOPED_TRACE(value);
-    f = failure_of("size_m: [4, 3]\nstart: {x_m: 1, y_m: " + std::string(value) + "}\n");
+    Failure f = failure_of("size_m: [4, 3]\nstart: {x_m: 1, y_m: " + std::string(value) + "}\n");
     EXPECT_EQ(f.line, 2);
     EXPECT_EQ(f.column, 22);
     EXPECT_THAT(f.what, HasSubstr("start.y_m: expected a number of metres, got '" +
                                   std::string(value) + "'"));
   }
 
-  f = failure_of(kBase + "walls: yes\n");
-  EXPECT_EQ(f.line, 3);
-  EXPECT_EQ(f.column, 8);
-  EXPECT_THAT(f.what, HasSubstr("walls: expected true or false, got 'yes'"));
+  expect_failure(kBase + "walls: yes\n", 3, 8, "walls: expected true or false, got 'yes'");
 
-  f = failure_of(kBase + "obstacles:\n  box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 3);
-  EXPECT_THAT(f.what, HasSubstr("obstacles: expected a list, got a map"));
+  expect_failure(kBase + "obstacles:\n  box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n", 4, 3,
+                 "obstacles: expected a list, got a map");
 
-  f = failure_of(kBase + "tags:\n  - {id: [1], x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 10);
-  EXPECT_THAT(f.what, HasSubstr("tags[0].id: expected the tag's id as text"));
+  expect_failure(kBase + "tags:\n  - {id: [1], x_m: 1, y_m: 1}\n", 4, 10,
+                 "tags[0].id: expected the tag's id as text");
 
-  f = failure_of("size_m: 4\nstart: {x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 1);
-  EXPECT_EQ(f.column, 9);
-  EXPECT_THAT(f.what, HasSubstr("size_m: expected [width, height] in metres, got '4'"));
+  expect_failure("size_m: 4\nstart: {x_m: 1, y_m: 1}\n", 1, 9,
+                 "size_m: expected [width, height] in metres, got '4'");
 
-  f = failure_of("size_m: [4, 3]\nstart: 1\n");
-  EXPECT_EQ(f.line, 2);
-  EXPECT_EQ(f.column, 8);
-  EXPECT_THAT(f.what, HasSubstr("start: expected a map with keys heading_deg, x_m, y_m, got '1'"));
+  expect_failure("size_m: [4, 3]\nstart: 1\n", 2, 8,
+                 "start: expected a map with keys heading_deg, x_m, y_m, got '1'");
 }
 
 TEST(ArenaYamlErrors, SizesMustBePositive) {
@@ -523,32 +497,21 @@ TEST(ArenaYamlErrors, SizesMustBePositive) {
 }
 
 TEST(ArenaYamlErrors, ObstacleIsExactlyOneOfBoxOrCircle) {
-  Failure f = failure_of(kBase +
-                         "obstacles:\n"
-                         "  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n"
-                         "    circle: {x_m: 1, y_m: 1, radius_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what,
-              HasSubstr("obstacles[0]: expected exactly one of 'box' or 'circle', got both"));
+  expect_failure(kBase +
+                     "obstacles:\n"
+                     "  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n"
+                     "    circle: {x_m: 1, y_m: 1, radius_m: 1}\n",
+                 4, 5, "obstacles[0]: expected exactly one of 'box' or 'circle', got both");
 
-  f = failure_of(kBase + "obstacles:\n  - {}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what,
-              HasSubstr("obstacles[0]: expected exactly one of 'box' or 'circle', got neither"));
+  expect_failure(kBase + "obstacles:\n  - {}\n", 4, 5,
+                 "obstacles[0]: expected exactly one of 'box' or 'circle', got neither");
 
-  f = failure_of(kBase + "obstacles:\n  - cylinder: {x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what, HasSubstr("obstacles[0].cylinder: unknown key 'cylinder' (allowed: box, "
-                                "circle)"));
+  expect_failure(kBase + "obstacles:\n  - cylinder: {x_m: 1, y_m: 1}\n", 4, 5,
+                 "obstacles[0].cylinder: unknown key 'cylinder' (allowed: box, "
+                 "circle)");
 
-  f = failure_of(kBase + "obstacles:\n  - circle\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what,
-              HasSubstr("obstacles[0]: expected a map with keys box, circle, got 'circle'"));
+  expect_failure(kBase + "obstacles:\n  - circle\n", 4, 5,
+                 "obstacles[0]: expected a map with keys box, circle, got 'circle'");
 }
 
 TEST(ArenaYamlErrors, TapePointsMustBePairs) {
@@ -559,80 +522,59 @@ TEST(ArenaYamlErrors, TapePointsMustBePairs) {
       f.what,
       HasSubstr("tapes[0].points_m[1]: expected an [x, y] pair of metres, got a list of 3"));
 
-  f = failure_of(kBase + "tapes:\n  - points_m: [[1, 1], 2]\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 24);
-  EXPECT_THAT(f.what,
-              HasSubstr("tapes[0].points_m[1]: expected an [x, y] pair of metres, got '2'"));
+  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], 2]\n", 4, 24,
+                 "tapes[0].points_m[1]: expected an [x, y] pair of metres, got '2'");
 
-  f = failure_of(kBase + "tapes:\n  - points_m: [[1, 1], [2, y]]\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 28);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m[1][1]: expected a number of metres, got 'y'"));
+  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], [2, y]]\n", 4, 28,
+                 "tapes[0].points_m[1][1]: expected a number of metres, got 'y'");
 
-  f = failure_of(kBase + "tapes:\n  - points_m: {x: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 15);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m: expected a list of [x, y] points"));
+  expect_failure(kBase + "tapes:\n  - points_m: {x: 1}\n", 4, 15,
+                 "tapes[0].points_m: expected a list of [x, y] points");
 }
 
 // The checks of validate() run after reading and point at the part they name.
 TEST(ArenaYamlErrors, PointOutsideTheArena) {
-  const Failure f = failure_of(kBase +
-                               "tapes:\n"
-                               "  - name: loop\n"
-                               "    points_m:\n"
-                               "      - [1, 1]\n"
-                               "      - [4.5, 1]\n");
-  EXPECT_EQ(f.line, 7);
-  EXPECT_EQ(f.column, 9);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m[1]: lies outside the arena"));
+  expect_failure(kBase +
+                     "tapes:\n"
+                     "  - name: loop\n"
+                     "    points_m:\n"
+                     "      - [1, 1]\n"
+                     "      - [4.5, 1]\n",
+                 7, 9, "tapes[0].points_m[1]: lies outside the arena");
 }
 
 TEST(ArenaYamlErrors, TooFewTapePoints) {
-  Failure f = failure_of(kBase + "tapes:\n  - points_m: [[1, 1]]\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 15);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m: needs at least 2 points"));
+  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1]]\n", 4, 15,
+                 "tapes[0].points_m: needs at least 2 points");
 
-  f = failure_of(kBase + "tapes:\n  - closed: true\n    points_m: [[1, 1], [2, 2]]\n");
-  EXPECT_EQ(f.line, 5);
-  EXPECT_EQ(f.column, 15);
-  EXPECT_THAT(f.what, HasSubstr("tapes[0].points_m: a closed tape needs 3 points"));
+  expect_failure(kBase + "tapes:\n  - closed: true\n    points_m: [[1, 1], [2, 2]]\n", 5, 15,
+                 "tapes[0].points_m: a closed tape needs 3 points");
 }
 
 TEST(ArenaYamlErrors, DuplicateTagIdAtTheSecondId) {
-  const Failure f = failure_of(kBase +
-                               "tags:\n"
-                               "  - {id: 001, x_m: 1, y_m: 1}\n"
-                               "  - {id: \"002\", x_m: 2, y_m: 1}\n"
-                               "  - {id: \"001\", x_m: 3, y_m: 1}\n");
-  EXPECT_EQ(f.line, 6);
-  EXPECT_EQ(f.column, 10);
-  EXPECT_THAT(f.what, HasSubstr("tags[2].id: id '001' is used twice"));
+  expect_failure(kBase +
+                     "tags:\n"
+                     "  - {id: 001, x_m: 1, y_m: 1}\n"
+                     "  - {id: \"002\", x_m: 2, y_m: 1}\n"
+                     "  - {id: \"001\", x_m: 3, y_m: 1}\n",
+                 6, 10, "tags[2].id: id '001' is used twice");
 }
 
 TEST(ArenaYamlErrors, EmptyTagId) {
-  const Failure f = failure_of(kBase + "tags:\n  - {id: '', x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 10);
-  EXPECT_THAT(f.what, HasSubstr("tags[0].id: id must not be empty"));
+  expect_failure(kBase + "tags:\n  - {id: '', x_m: 1, y_m: 1}\n", 4, 10,
+                 "tags[0].id: id must not be empty");
 }
 
 TEST(ArenaYamlErrors, TagOutsideTheArena) {
-  const Failure f = failure_of(kBase + "tags:\n  - {id: A, x_m: 1, y_m: -0.5}\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 5);
-  EXPECT_THAT(f.what, HasSubstr("tags[0]: lies outside the arena"));
+  expect_failure(kBase + "tags:\n  - {id: A, x_m: 1, y_m: -0.5}\n", 4, 5,
+                 "tags[0]: lies outside the arena");
 }
 
 TEST(ArenaYamlErrors, ObstacleCentreOutsideTheArena) {
-  const Failure f = failure_of(kBase +
-                               "obstacles:\n  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
-                               "  - box: {x_m: 5, y_m: 1, width_m: 1, height_m: 1}\n");
-  EXPECT_EQ(f.line, 5);
-  EXPECT_EQ(f.column, 10);
-  EXPECT_THAT(f.what, HasSubstr("obstacles[1].box: centre lies outside the arena"));
+  expect_failure(kBase +
+                     "obstacles:\n  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
+                     "  - box: {x_m: 5, y_m: 1, width_m: 1, height_m: 1}\n",
+                 5, 10, "obstacles[1].box: centre lies outside the arena");
 }
 
 TEST(ArenaYamlErrors, StartOutsideTheArena) {
@@ -643,18 +585,14 @@ TEST(ArenaYamlErrors, StartOutsideTheArena) {
 }
 
 TEST(ArenaYamlErrors, ArenaTooLarge) {
-  const Failure f = failure_of("size_m: [4, 1001]\nstart: {x_m: 1, y_m: 1}\n");
-  EXPECT_EQ(f.line, 1);
-  EXPECT_EQ(f.column, 9);
-  EXPECT_THAT(f.what, HasSubstr("size_m: at most 1000 m a side"));
+  expect_failure("size_m: [4, 1001]\nstart: {x_m: 1, y_m: 1}\n", 1, 9,
+                 "size_m: at most 1000 m a side");
 }
 
 TEST(ArenaYamlErrors, ZeroWallThicknessOnlyWithoutWalls) {
   EXPECT_NO_THROW(parse_arena_text(kBase + "walls: false\nwall_thickness_m: 0\n", "lab.yaml"));
-  const Failure f = failure_of(kBase + "walls: true\nwall_thickness_m: 0\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 19);
-  EXPECT_THAT(f.what, HasSubstr("wall_thickness_m: must be positive"));
+  expect_failure(kBase + "walls: true\nwall_thickness_m: 0\n", 4, 19,
+                 "wall_thickness_m: must be positive");
 }
 
 TEST(ArenaYamlErrors, HostileInputsFailCleanly) {
