@@ -1,6 +1,5 @@
 #include "harness/scenario_parts.hpp"
 
-
 namespace hil::harness::scenario_parts {
 namespace {
 // "degraded" and "down" are the Arduino link's own states.
@@ -10,35 +9,11 @@ const Keys kClientStates = {"connected",    "disconnected", "connecting", "authe
 /// Matchers of what the client, the simulation, the fault injector, the car and the steps report.
 class EventMatcherReader : public config::Reader {
  public:
-  explicit EventMatcherReader(const ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
+  explicit EventMatcherReader(const ScenarioFacts& facts)
+      : config::Reader(facts.file), facts_(facts) {}
 
   Matcher client_matcher(const YAML::Node& v, const std::string& where) const {
-    Matcher m;
-    m.source = Source::client;
-    if (v.IsScalar()) {
-      const std::string& word = v.Scalar();
-      if (word == "stale" || word == "fresh") {
-        m.kind = word;
-        m.text =
-            word == "stale" ? "client warned of stale telemetry" : "client telemetry fresh again";
-        return m;
-      }
-      if (word == "parse_error") {
-        m.kind = word;
-        m.text = "client reported a frame it could not parse";
-        return m;
-      }
-      if (!contains(kClientStates, word)) {
-        Keys known = kClientStates;
-        known.insert(known.end(), {"stale", "fresh", "parse_error"});
-        fail(v, where + ": unknown client state '" + word + "' (expected " + join(known) + ")" +
-                    config::did_you_mean(word, known));
-      }
-      m.kind = "connection";
-      m.tests.push_back(field_test("state", FieldTest::Op::equals, word));
-      m.text = "client " + word;
-      return m;
-    }
+    if (v.IsScalar()) return client_word_matcher(v, where);
     if (!v.IsMap()) {
       fail(v, where + " must be a state (connected, stale, ...) or a map like {notice: \"text\"}");
     }
@@ -54,88 +29,102 @@ class EventMatcherReader : public config::Reader {
       kind = k;
     }
     if (kind.empty()) fail(v, where + ": give one of " + join(kKinds));
-    const auto only = [&](const Keys& extra) {
-      for (const char* k : {"state", "ok", "reason"}) {
-        if (v[k] && !contains(extra, k)) {
-          fail(v[k], where + ": '" + std::string(k) + "' does not go with '" + kind + "'");
-        }
-      }
-    };
+    // Which of state, ok and reason go with each kind.
+    static const std::map<std::string, Keys, std::less<>> kExtras = {{"movement", {"reason"}},
+                                                                     {"login", {"reason"}},
+                                                                     {"command", {"state"}},
+                                                                     {"action", {"ok", "reason"}}};
+    const auto extras = kExtras.find(kind);
+    for (const char* k : {"state", "ok", "reason"}) {
+      if (v[k] && (extras == kExtras.end() || !contains(extras->second, k)))
+        fail(v[k], where + ": '" + std::string(k) + "' does not go with '" + kind + "'");
+    }
+    Matcher m;
+    m.source = Source::client;
+    m.kind = kind;
+    client_kind_tests(kind, v, where, m);
+    return m;
+  }
+
+  /// `client: connected`, `client: stale`, `client: parse_error`.
+  Matcher client_word_matcher(const YAML::Node& v, const std::string& where) const {
+    Matcher m;
+    m.source = Source::client;
+    const std::string& word = v.Scalar();
+    if (word == "stale" || word == "fresh") {
+      m.kind = word;
+      m.text =
+          word == "stale" ? "client warned of stale telemetry" : "client telemetry fresh again";
+      return m;
+    }
+    if (word == "parse_error") {
+      m.kind = word;
+      m.text = "client reported a frame it could not parse";
+      return m;
+    }
+    if (!contains(kClientStates, word)) {
+      Keys known = kClientStates;
+      known.insert(known.end(), {"stale", "fresh", "parse_error"});
+      fail(v, where + ": unknown client state '" + word + "' (expected " + join(known) + ")" +
+                  config::did_you_mean(word, known));
+    }
+    m.kind = "connection";
+    m.tests.push_back(field_test("state", FieldTest::Op::equals, word));
+    m.text = "client " + word;
+    return m;
+  }
+
+  /// The tests and the text of a client matcher map whose kind is `kind`.
+  void client_kind_tests(const std::string& kind, const YAML::Node& v, const std::string& where,
+                         Matcher& m) const {
     const YAML::Node x = v[kind];
+    const auto contains_test = [&](const char* field, const std::string& what) {
+      const std::string text = scalar(x, "'" + kind + "'");
+      m.tests.push_back(field_test(field, FieldTest::Op::contains, text));
+      m.text = what + " '" + text + "'";
+    };
+    const auto equals_flag = [&](const char* field, const char* yes, const char* no) {
+      const bool value = boolean(x, "'" + kind + "'");
+      m.tests.push_back(field_test(field, FieldTest::Op::equals, value));
+      m.text = value ? yes : no;
+    };
     if (kind == "notice") {
-      only({});
-      const std::string text = scalar(x, "'notice'");
-      m.kind = "notice";
-      m.tests.push_back(field_test("text", FieldTest::Op::contains, text));
-      m.text = "client notice containing '" + text + "'";
+      contains_test("text", "client notice containing");
     } else if (kind == "output") {
-      only({});
-      const std::string text = scalar(x, "'output'");
-      m.kind = "output";
-      m.tests.push_back(field_test("line", FieldTest::Op::contains, text));
-      m.text = "client printed a line containing '" + text + "'";
+      contains_test("line", "client printed a line containing");
+    } else if (kind == "parse_error") {
+      contains_test("text", "client could not parse a frame:");
     } else if (kind == "exit") {
-      only({});
-      m.kind = "exit";
       m.text = "client exited";
       if (!x.IsNull()) {
         const auto code = static_cast<std::int64_t>(whole(x, "'exit'", 0));
         m.tests.push_back(field_test("code", FieldTest::Op::equals, code));
         m.text += " with " + std::to_string(code);
       }
-    } else if (kind == "parse_error") {
-      only({});
-      const std::string text = scalar(x, "'parse_error'");
-      m.kind = "parse_error";
-      m.tests.push_back(field_test("text", FieldTest::Op::contains, text));
-      m.text = "client could not parse a frame: '" + text + "'";
     } else if (kind == "movement") {
-      only({"reason"});
-      const bool enabled = boolean(x, "'movement'");
-      m.kind = "movement";
-      m.tests.push_back(field_test("enabled", FieldTest::Op::equals, enabled));
-      m.text = enabled ? "client enabled movement" : "client disabled movement";
-      if (auto reason = v["reason"]) {
-        const std::string r = scalar(reason, "'reason'");
-        m.tests.push_back(field_test("reason", FieldTest::Op::contains, r));
-        m.text += " because of '" + r + "'";
-      }
+      equals_flag("enabled", "client enabled movement", "client disabled movement");
     } else if (kind == "login") {
-      only({"reason"});
-      const bool ok = boolean(x, "'login'");
-      m.kind = "login";
-      m.tests.push_back(field_test("ok", FieldTest::Op::equals, ok));
-      m.text = ok ? "client logged in" : "client login refused";
-      if (auto reason = v["reason"]) {
-        const std::string r = scalar(reason, "'reason'");
-        m.tests.push_back(field_test("reason", FieldTest::Op::contains, r));
-        m.text += " because of '" + r + "'";
-      }
+      equals_flag("ok", "client logged in", "client login refused");
     } else if (kind == "connection") {
-      only({});
       const std::string word = scalar(x, "'connection'");
       if (!contains(kClientStates, word)) {
         fail(x, where + ": unknown connection state '" + word + "' (expected " +
                     join(kClientStates) + ")" + config::did_you_mean(word, kClientStates));
       }
-      m.kind = "connection";
       m.tests.push_back(field_test("state", FieldTest::Op::equals, word));
       m.text = "client " + word;
     } else if (kind == "command") {
-      only({"state"});
       const std::string command = scalar(x, "'command'");
-      m.kind = "command";
       m.text = "client command " + command;
-      if (command != "*") m.tests.push_back(field_test("command", FieldTest::Op::kind_prefix, command));
+      if (command != "*")
+        m.tests.push_back(field_test("command", FieldTest::Op::kind_prefix, command));
       if (auto state = v["state"]) {
         const std::string s = scalar(state, "'state'");
         m.tests.push_back(field_test("state", FieldTest::Op::equals, s));
         m.text += " " + s;
       }
     } else {
-      only({"ok", "reason"});
       const std::string text = trim(scalar(x, "'action'"));
-      m.kind = "action";
       m.text = "action '" + text + "'";
       if (text != "*") m.tests.push_back(field_test("text", FieldTest::Op::equals, text));
       if (auto ok = v["ok"]) {
@@ -143,13 +132,12 @@ class EventMatcherReader : public config::Reader {
         m.tests.push_back(field_test("ok", FieldTest::Op::equals, b));
         m.text += b ? " succeeded" : " failed";
       }
-      if (auto reason = v["reason"]) {
-        const std::string r = scalar(reason, "'reason'");
-        m.tests.push_back(field_test("reason", FieldTest::Op::contains, r));
-        m.text += " because of '" + r + "'";
-      }
     }
-    return m;
+    if (auto reason = v["reason"]) {
+      const std::string r = scalar(reason, "'reason'");
+      m.tests.push_back(field_test("reason", FieldTest::Op::contains, r));
+      m.text += " because of '" + r + "'";
+    }
   }
 
   Matcher sim_matcher(const YAML::Node& v, const std::string& where) const {
@@ -352,8 +340,8 @@ Matcher read_car_matcher(const ScenarioFacts& facts, const YAML::Node& v,
   return EventMatcherReader(facts).car_matcher(v, where);
 }
 
-Matcher read_step_matcher(const ScenarioFacts& facts, const YAML::Node& v,
-                          const std::string& phase, const std::string& where) {
+Matcher read_step_matcher(const ScenarioFacts& facts, const YAML::Node& v, const std::string& phase,
+                          const std::string& where) {
   return EventMatcherReader(facts).step_matcher(v, phase, where);
 }
 

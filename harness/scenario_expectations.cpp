@@ -5,11 +5,12 @@
 namespace hil::harness::scenario_parts {
 namespace {
 
-/// `schedule:` (steps at a run time or on an event) and `expect:` (what must, or must not, happen and when).
+/// `schedule:` (steps at a run time or on an event) and `expect:` (what must, or must not, happen
+/// and when).
 class ExpectationReader : public config::Reader {
  public:
-  explicit ExpectationReader(const ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
-
+  explicit ExpectationReader(const ScenarioFacts& facts)
+      : config::Reader(facts.file), facts_(facts) {}
 
   std::vector<ScheduledStep> schedule(const YAML::Node& list) const {
     std::vector<ScheduledStep> out;
@@ -59,7 +60,6 @@ class ExpectationReader : public config::Reader {
     return out;
   }
 
-
   std::vector<Expectation> expectations(const YAML::Node& list) const {
     std::vector<Expectation> out;
     if (list.IsNull()) return out;
@@ -88,8 +88,33 @@ class ExpectationReader : public config::Reader {
 
     Expectation e;
     e.line = n.Mark().line + 1;
+    std::optional<YAML::Node> nested;
+    const std::string quantifier = read_quantifier(n, where, e, nested);
+    // The matcher.
+    if (nested) {
+      for (const auto& k : kMatcherSources) {
+        if (n[k]) fail(n[k], where + ": the matcher is inside '" + quantifier + "' already");
+      }
+      for (const auto& k : kWireDirections) {
+        if (n[k]) fail(n[k], where + ": the matcher is inside '" + quantifier + "' already");
+      }
+      e.what = read_matcher_node(facts_, *nested, where + ": '" + quantifier + "'");
+    } else {
+      e.what = read_matcher(facts_, n, where);
+    }
+    read_window(n, where, e);
+    if (auto label = n["label"]) {
+      e.label = scalar(label, "'label'");
+    } else {
+      e.label = make_label(e);
+    }
+    return e;
+  }
 
-    // The quantifier.
+  /// never, always, count, at_least, at_most or times; `nested` is the
+  /// matcher map of `never: {...}` or `always: {...}`. Returns the key.
+  std::string read_quantifier(const YAML::Node& n, const std::string& where, Expectation& e,
+                              std::optional<YAML::Node>& nested) const {
     std::string quantifier;
     for (const auto& k : kQuantifierKeys) {
       if (!n[k]) continue;
@@ -100,7 +125,6 @@ class ExpectationReader : public config::Reader {
     }
     // Assigning one YAML::Node to another rebinds the data both refer to,
     // so the nested matcher is kept apart instead.
-    std::optional<YAML::Node> nested;
     if (quantifier == "never") {
       const auto v = n["never"];
       if (v.IsMap()) {
@@ -141,21 +165,11 @@ class ExpectationReader : public config::Reader {
         if (n[k]) fail(n[k], where + ": '" + std::string(k) + "' goes with 'times'");
       }
     }
+    return quantifier;
+  }
 
-    // The matcher.
-    if (nested) {
-      for (const auto& k : kMatcherSources) {
-        if (n[k]) fail(n[k], where + ": the matcher is inside '" + quantifier + "' already");
-      }
-      for (const auto& k : kWireDirections) {
-        if (n[k]) fail(n[k], where + ": the matcher is inside '" + quantifier + "' already");
-      }
-      e.what = read_matcher_node(facts_, *nested, where + ": '" + quantifier + "'");
-    } else {
-      e.what = read_matcher(facts_, n, where);
-    }
-
-    // The window.
+  /// within, after, at or between.
+  void read_window(const YAML::Node& n, const std::string& where, Expectation& e) const {
     const auto within = n["within"];
     const auto after = n["after"];
     const auto at = n["at"];
@@ -188,13 +202,6 @@ class ExpectationReader : public config::Reader {
       if (after) e.window.from = read_anchor(facts_, after, where + ": 'after'", true);
       if (within) e.window.within = duration(within, where + ": 'within'");
     }
-
-    if (auto label = n["label"]) {
-      e.label = scalar(label, "'label'");
-    } else {
-      e.label = make_label(e);
-    }
-    return e;
   }
 
   static std::string key_name(const YAML::Node& map, const YAML::Node& value) {
