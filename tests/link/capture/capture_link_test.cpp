@@ -16,6 +16,21 @@ using protocol::to_bytes;
 
 using test::kWallUs;
 
+/// A pcap writer at `path` whose packets carry kWallUs.
+std::shared_ptr<PcapWriter> open_pcap(const std::string& path, std::error_code& ec) {
+  PcapOptions options;
+  options.wall_clock_us = [] { return kWallUs; };
+  return PcapWriter::open(path, options, ec);
+}
+
+/// A rule that cuts every write into `size`-byte pieces 1 ms apart.
+FaultRule split_into(std::size_t size) {
+  FaultRule fragment;
+  fragment.name = "split";
+  fragment.action = Fragment{{size, size}, {milliseconds(1), milliseconds(1)}};
+  return fragment;
+}
+
 struct Collected {
   std::string data;
   BytePipe::Handlers handlers() {
@@ -41,17 +56,12 @@ struct CaptureLinkTest : ::testing::Test {
     log_options.wall_clock_us = [] { return kWallUs; };
     auto log = WireLog::open(log_file.path(), log_options, ec);
     ASSERT_TRUE(log) << ec.message();
-    PcapOptions pcap_options;
-    pcap_options.wall_clock_us = [] { return kWallUs; };
-    auto pcap = PcapWriter::open(pcap_file.path(), pcap_options, ec);
+    auto pcap = open_pcap(pcap_file.path(), ec);
     ASSERT_TRUE(pcap) << ec.message();
 
-    FaultRule fragment;
-    fragment.name = "split";
-    fragment.action = Fragment{{5, 5}, {milliseconds(1), milliseconds(1)}};
     LinkOptions options;
     options.protocol = protocol_adapter("logi");
-    options.to_car.rules.push_back(fragment);
+    options.to_car.rules.push_back(split_into(5));
     options.observers = {log, pcap};
 
     auto [client_app, link_client] = make_mem_pipe(ex, "client");
@@ -132,18 +142,13 @@ TEST(CaptureLinkSvgui, APcapOfTheRealWr8ProgramsDecodesByTheLengthByteWhateverTh
   test::ScratchFile pcap_file{".pcap"};
   VirtualExecutor ex;
   std::error_code ec;
-  PcapOptions pcap_options;
-  pcap_options.wall_clock_us = [] { return kWallUs; };
-  auto pcap = PcapWriter::open(pcap_file.path(), pcap_options, ec);
+  auto pcap = open_pcap(pcap_file.path(), ec);
   ASSERT_TRUE(pcap) << ec.message();
   // The head vehicle's AUTH-REPLY and a HIGH-FREQ DATA, cut into 3-byte
   // segments on their way to the client.
-  FaultRule fragment;
-  fragment.name = "split";
-  fragment.action = Fragment{{3, 3}, {milliseconds(1), milliseconds(1)}};
   LinkOptions options;
   options.protocol = protocol_adapter("wr8", "svgui-head");
-  options.to_client.rules.push_back(fragment);
+  options.to_client.rules.push_back(split_into(3));
   options.observers = {pcap};
   auto [client_app, link_client] = make_mem_pipe(ex, "client");
   auto [link_car, car_app] = make_mem_pipe(ex, "car");

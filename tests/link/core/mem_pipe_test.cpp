@@ -17,9 +17,10 @@ struct PipeRecorder {
   }
 };
 
-// Two started ends of a mem:// line at `baud`, each with its recorder.
+// Two started ends of a mem:// line at `baud` (0: unpaced), each with its
+// recorder.
 struct PacedLine {
-  explicit PacedLine(unsigned baud) {
+  explicit PacedLine(unsigned baud = 0) {
     std::tie(a, b) = make_mem_pipe(ex, "t", baud);
     a->start(ra.handlers());
     b->start(rb.handlers());
@@ -30,11 +31,8 @@ struct PacedLine {
 };
 
 TEST(MemPipe, DeliversInOrderOnTheExecutor) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t");
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
+  PacedLine line;
+  auto& [ex, a, b, ra, rb] = line;
   a->write(protocol::to_bytes("hello "));
   a->write(protocol::to_bytes("world"));
   EXPECT_EQ(rb.data, "");  // nothing is delivered inside write()
@@ -57,11 +55,8 @@ TEST(MemPipe, BytesBeforeStartAreKept) {
 }
 
 TEST(MemPipe, GracefulCloseDeliversDataThenEndOfStream) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t");
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
+  PacedLine line;
+  auto& [ex, a, b, ra, rb] = line;
   a->write(protocol::to_bytes("last words"));
   a->close(CloseMode::graceful);
   a->write(protocol::to_bytes("ignored"));
@@ -74,11 +69,8 @@ TEST(MemPipe, GracefulCloseDeliversDataThenEndOfStream) {
 }
 
 TEST(MemPipe, ResetDropsDataInFlight) {
-  VirtualExecutor ex;
-  auto [a, b] = make_mem_pipe(ex, "t");
-  PipeRecorder ra, rb;
-  a->start(ra.handlers());
-  b->start(rb.handlers());
+  PacedLine line;
+  auto& [ex, a, b, ra, rb] = line;
   a->write(protocol::to_bytes("lost"));
   a->close(CloseMode::reset);
   ex.run_until_idle();
