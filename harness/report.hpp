@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "harness/outcome.hpp"
-#include "sim/svg.hpp"
 
 namespace hil::harness {
 
@@ -74,11 +73,6 @@ std::string format_seconds(Duration d);
 
 /// A JUnit XML document: one <testsuite name="hil">, one <testcase> per run.
 std::string junit_xml(const std::vector<ReportEntry>& entries);
-
-/// Text made safe for XML and HTML content and attributes (the SVG
-/// writer's escaping: & < > " ' escaped, control characters and invalid
-/// UTF-8 replaced).
-using sim::xml_escape;
 
 /// Fills each entry's empty `folder`: the scenario's name made safe for a
 /// file name, "-<repeat>" (from 1) when it ran more than once, and "-2",

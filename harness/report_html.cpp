@@ -13,6 +13,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "base/text.hpp"
 #include "harness/atomic_file.hpp"
 #include "harness/report.hpp"
 #include "sim/geometry.hpp"

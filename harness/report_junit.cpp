@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "base/text.hpp"
 #include "harness/report.hpp"
 
 namespace hil::harness {

@@ -3,7 +3,6 @@
 
 #include <span>
 #include <string>
-#include <string_view>
 
 #include "sim/arena.hpp"
 #include "sim/trajectory.hpp"
@@ -16,12 +15,6 @@ struct SvgOptions {
   bool legend = true;         ///< explain colours and marks below the arena
   bool grid = true;           ///< a light 0.5 m grid with metre labels
 };
-
-/// Text made safe for XML (and HTML) content and attribute values: & < > " '
-/// as references, bytes that are not UTF-8 as U+FFFD, and the characters
-/// XML 1.0 cannot carry at all (controls other than tab and line breaks,
-/// U+FFFE, U+FFFF) shown as \xNN so nothing is silently lost.
-std::string xml_escape(std::string_view text);
 
 /// The arena (walls, obstacles, tape, RFID stations with their ids, start
 /// pose) and each trajectory (path, footprint and heading at its last pose,

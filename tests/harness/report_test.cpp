@@ -252,14 +252,6 @@ TEST(ReportConsole, RecordsReadAsOneLineEach) {
             "    0.001 s  car     mystery {\"a\":1}");
 }
 
-TEST(ReportXml, EscapesEverythingXmlCannotCarryRaw) {
-  EXPECT_EQ(xml_escape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&#39;");
-  EXPECT_EQ(xml_escape("bell\x07"), "bell\\x07");
-  EXPECT_EQ(xml_escape("caf\xC3\xA9"), "caf\xC3\xA9");
-  EXPECT_EQ(xml_escape("bad\xFF"), "bad\xEF\xBF\xBD");
-  EXPECT_EQ(xml_escape("cut\xC3"), "cut\xEF\xBF\xBD");
-}
-
 // Markup outside tags must be only what the writer put there: after
 // removing every tag, no '<' may remain and every '&' starts an entity.
 void expect_well_escaped(const std::string& xml) {
