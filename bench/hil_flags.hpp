@@ -1,6 +1,7 @@
 #pragma once
 // The benchmark programs' own flags (--hil_NAME=VALUE), taken out of the
-// command line before Google Benchmark sees the rest.
+// command line before Google Benchmark sees the rest, and the run that
+// follows.
 
 #include <benchmark/benchmark.h>
 
@@ -49,6 +50,18 @@ bool run_benchmarks(HilFlags& flags, Reporter& reporter) {
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return true;
+}
+
+/// The end of a benchmark program's main(): runs the registered benchmarks
+/// through `reporter`, has it write its Markdown to --hil_markdown=FILE
+/// when asked, then asks `passes()`. The exit status: 2 when Google
+/// Benchmark did not understand an argument, 1 when passes() is false.
+template <class Reporter, class Passes>
+int run_and_check(HilFlags& flags, Reporter& reporter, Passes passes) {
+  if (!run_benchmarks(flags, reporter)) return 2;
+  if (const auto markdown = flags.text("markdown"); !markdown.empty())
+    reporter.write_markdown(markdown);
+  return passes() ? 0 : 1;
 }
 
 }  // namespace hil::bench

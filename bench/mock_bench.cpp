@@ -31,6 +31,7 @@
 #include <variant>
 #include <vector>
 
+#include "bench/best_runs.hpp"
 #include "bench/hil_flags.hpp"
 #include "link/faults/profile.hpp"
 #include "link/transport.hpp"
@@ -530,43 +531,17 @@ void register_all() {
 
 // ---- results ----
 
-struct Best {
-  double cpu_s = 0;  ///< CPU seconds per 60 s session, best repetition
-  double frames_in = 0;
-  double frames_out = 0;
-  double faults = 0;  ///< injected per session
-};
-
-class RecordingReporter : public benchmark::ConsoleReporter {
+class RecordingReporter : public hil::bench::BestRunReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const auto& run : runs) {
-      if (run.error_occurred) failed_ = true;
-      if (run.run_type != Run::RT_Iteration || run.iterations == 0) continue;
-      const double cpu_s = run.cpu_accumulated_time / static_cast<double>(run.iterations);
-      const auto counter = [&run](const char* name) {
-        const auto it = run.counters.find(name);
-        return it == run.counters.end() ? 0.0 : it->second.value;
-      };
-      auto [it, inserted] = best_.emplace(run.benchmark_name(), Best{});
-      if (inserted || cpu_s < it->second.cpu_s)
-        it->second = Best{cpu_s, counter("frames_in"), counter("frames_out"), counter("faults")};
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-
   bool check(double min_realtime) const {
-    bool ok = !failed_;
-    if (failed_) std::printf("a benchmark reported an error (see above)\n");
+    bool ok = no_errors();
     if (min_realtime <= 0) return ok;
     for (const auto& c : kCases) {
-      const auto it = best_.find(c.name);
-      if (it == best_.end() || it->second.cpu_s <= 0) continue;  // filtered out
-      const double realtime = kSessionSeconds / it->second.cpu_s;
-      const bool pass = realtime >= min_realtime;
-      std::printf("mock car %s runs %.0fx real time (floor %.0fx) %s\n", c.name, realtime,
-                  min_realtime, pass ? "ok" : "TOO SLOW");
-      ok = ok && pass;
+      const double cpu_s = seconds(c.name);
+      if (cpu_s <= 0) continue;  // filtered out
+      ok = hil::bench::check_realtime_floor(std::string("mock car ") + c.name,
+                                            kSessionSeconds / cpu_s, min_realtime) &&
+           ok;
     }
     return ok;
   }
@@ -577,44 +552,37 @@ class RecordingReporter : public benchmark::ConsoleReporter {
            "frames in / out per CPU second |\n"
            "|---|---:|---:|---:|---:|\n";
     char line[256];
-    for (const auto& c : kCases) {
-      const auto it = best_.find(c.name);
-      if (it == best_.end() || it->second.cpu_s <= 0) continue;
-      const Best& b = it->second;
-      std::snprintf(line, sizeof line, "| %s | %.0f | %.2f | %.0f / %.0f | %.0f / %.0f |\n", c.what,
-                    kSessionSeconds / b.cpu_s, b.cpu_s * 1e3, b.frames_in, b.frames_out,
-                    b.frames_in / b.cpu_s, b.frames_out / b.cpu_s);
-      out << line;
-    }
-    const Best* slowest = nullptr;
+    const hil::bench::BestRun* slowest = nullptr;
     const char* slowest_name = "";
     for (const auto& c : kCases) {
-      const auto it = best_.find(c.name);
-      if (it == best_.end() || it->second.cpu_s <= 0) continue;
-      if (slowest == nullptr || it->second.cpu_s > slowest->cpu_s) {
-        slowest = &it->second;
+      const hil::bench::BestRun* b = best(c.name);
+      if (b == nullptr || b->seconds <= 0) continue;
+      const double in = b->counter("frames_in");
+      const double out_frames = b->counter("frames_out");
+      std::snprintf(line, sizeof line, "| %s | %.0f | %.2f | %.0f / %.0f | %.0f / %.0f |\n", c.what,
+                    kSessionSeconds / b->seconds, b->seconds * 1e3, in, out_frames, in / b->seconds,
+                    out_frames / b->seconds);
+      out << line;
+      if (slowest == nullptr || b->seconds > slowest->seconds) {
+        slowest = b;
         slowest_name = c.what;
       }
     }
     if (slowest == nullptr) return;
     std::snprintf(line, sizeof line, "\nSlowest: %s at %.0fx real time (target >= 1000x).",
-                  slowest_name, kSessionSeconds / slowest->cpu_s);
+                  slowest_name, kSessionSeconds / slowest->seconds);
     out << line;
-    const auto clean = best_.find("logi");
-    const auto flaky = best_.find("logi_faults");
-    if (clean != best_.end() && flaky != best_.end() && clean->second.cpu_s > 0) {
+    const hil::bench::BestRun* clean = best("logi");
+    const hil::bench::BestRun* flaky = best("logi_faults");
+    if (clean != nullptr && flaky != nullptr && clean->seconds > 0) {
       std::snprintf(line, sizeof line,
                     " The flaky link (%.0f faults injected per session) costs the LOGI session "
                     "%.0f %% more CPU time.",
-                    flaky->second.faults, (flaky->second.cpu_s / clean->second.cpu_s - 1) * 100);
+                    flaky->counter("faults"), (flaky->seconds / clean->seconds - 1) * 100);
       out << line;
     }
     out << "\n";
   }
-
- private:
-  std::map<std::string, Best> best_;
-  bool failed_ = false;
 };
 
 }  // namespace
@@ -623,9 +591,6 @@ int main(int argc, char** argv) {
   auto flags = hil::bench::take_hil_flags(argc, argv);
   register_all();
   RecordingReporter reporter;
-  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
-  if (const auto markdown = flags.text("markdown"); !markdown.empty())
-    reporter.write_markdown(markdown);
-  if (!reporter.check(flags.number("min_realtime"))) return 1;
-  return 0;
+  return hil::bench::run_and_check(flags, reporter,
+                                   [&] { return reporter.check(flags.number("min_realtime")); });
 }

@@ -51,93 +51,70 @@ splice() {
   mv "$doc.new" "$doc"
 }
 
-run_decoder() {
-  cmake --build "$build" --target decoder_bench
-  "$build"/bench/decoder_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-    --hil_max_bytewise_ratio=5 --hil_markdown="$work/decoder.md"
+# Puts FILE in the page's NAME-bench section, under a line saying when, on
+# what and how it was measured ("with `COMMAND` (HOW):"), with paths into
+# this checkout made relative. A blank line closes the section unless the
+# fifth argument is "no" (FILE ends with one).
+write_section() {
+  local name=$1 command=$2 how=$3 file=$4 blank_end=${5:-yes}
   {
     echo
     echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh\` (best of 5 repetitions, 1 MiB stream per iteration):"
+    echo "with \`$command\` ($how):"
     echo
-    cat "$work/decoder.md"
-    echo
-  } >"$work/decoder.section"
-  splice decoder-bench "$work/decoder.section"
+    sed "s|$PWD/||" "$file"
+    [ "$blank_end" = no ] || echo
+  } >"$work/$name.section"
+  splice "$name-bench" "$work/$name.section"
+}
+
+# Builds the Google Benchmark program TARGET, runs it with ARGS and
+# --hil_markdown, and writes its table to the NAME-bench section.
+#   run_benchmark NAME TARGET COMMAND HOW ARGS...
+run_benchmark() {
+  local name=$1 target=$2 command=$3 how=$4
+  shift 4
+  cmake --build "$build" --target "$target"
+  "$build/bench/$target" "$@" --hil_markdown="$work/$name.md"
+  write_section "$name" "$command" "$how" "$work/$name.md"
+}
+
+run_decoder() {
+  run_benchmark decoder decoder_bench "bench/run.sh" \
+    "best of 5 repetitions, 1 MiB stream per iteration" \
+    --benchmark_min_time=0.5 --benchmark_repetitions=5 --hil_max_bytewise_ratio=5
 }
 
 run_proxy() {
   cmake --build "$build" --target proxy_bench
   "$build"/bench/proxy_bench --frames 20000 --mib 256 --protocol raw --markdown "$work/proxy.md"
   "$build"/bench/proxy_bench --frames 20000 --mib 128 --protocol logi --markdown "$work/proxy.md"
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh proxy\` (20,000 round trips, 256 MiB raw / 128 MiB LOGI one way, wall time):"
-    echo
-    cat "$work/proxy.md"
-  } >"$work/proxy.section"
-  splice proxy-bench "$work/proxy.section"
+  write_section proxy "bench/run.sh proxy" \
+    "20,000 round trips, 256 MiB raw / 128 MiB LOGI one way, wall time" "$work/proxy.md" no
 }
 
 run_sim() {
-  cmake --build "$build" --target sim_bench
-  "$build"/bench/sim_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-    --benchmark_enable_random_interleaving=true --hil_markdown="$work/sim.md"
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
-    echo
-    cat "$work/sim.md"
-    echo
-  } >"$work/sim.section"
-  splice sim-bench "$work/sim.section"
+  run_benchmark sim sim_bench "bench/run.sh" \
+    "best of 5 interleaved repetitions of at least 0.5 s, CPU time" \
+    --benchmark_min_time=0.5 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 }
 
 run_mock() {
-  cmake --build "$build" --target mock_bench
-  "$build"/bench/mock_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-    --benchmark_enable_random_interleaving=true --hil_markdown="$work/mock.md"
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh mock\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
-    echo
-    cat "$work/mock.md"
-    echo
-  } >"$work/mock.section"
-  splice mock-bench "$work/mock.section"
+  run_benchmark mock mock_bench "bench/run.sh mock" \
+    "best of 5 interleaved repetitions of at least 0.5 s, CPU time" \
+    --benchmark_min_time=0.5 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 }
 
 run_session() {
-  cmake --build "$build" --target session_bench
-  "$build"/bench/session_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-    --hil_min_sessions_per_s=20 --hil_markdown="$work/session.md"
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh session\` (best of 5 repetitions of at least 0.5 s, CPU time):"
-    echo
-    cat "$work/session.md"
-    echo
-  } >"$work/session.section"
-  splice session-bench "$work/session.section"
+  run_benchmark session session_bench "bench/run.sh session" \
+    "best of 5 repetitions of at least 0.5 s, CPU time" \
+    --benchmark_min_time=0.5 --benchmark_repetitions=5 --hil_min_sessions_per_s=20
 }
 
 run_stack() {
-  cmake --build "$build" --target scenario_bench
-  "$build"/bench/scenario_bench --benchmark_min_time=0.5 --benchmark_repetitions=5 \
-    --benchmark_enable_random_interleaving=true --hil_markdown="$work/stack.md"
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh stack\` (best of 5 interleaved repetitions of at least 0.5 s, CPU time):"
-    echo
-    sed "s|$PWD/||" "$work/stack.md"
-    echo
-  } >"$work/stack.section"
-  splice stack-bench "$work/stack.section"
+  run_benchmark stack scenario_bench "bench/run.sh stack" \
+    "best of 5 interleaved repetitions of at least 0.5 s, CPU time" \
+    --benchmark_min_time=0.5 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 }
 
 run_suite() {
@@ -147,15 +124,8 @@ run_suite() {
   bench/suite_time.sh --hil "$build"/apps/hil/hil --jobs 2 --markdown "$work/suite.md" ||
     echo "bench/run.sh: a scenario failed; the suite section says how many passed" >&2
   [ -s "$work/suite.md" ] || exit 1
-  {
-    echo
-    echo "Measured $(today) on $(machine),"
-    echo "with \`bench/run.sh suite\` (\`hil run -j 2\`, wall time of one run of the library):"
-    echo
-    cat "$work/suite.md"
-    echo
-  } >"$work/suite.section"
-  splice suite-bench "$work/suite.section"
+  write_section suite "bench/run.sh suite" \
+    '`hil run -j 2`, wall time of one run of the library' "$work/suite.md"
 }
 
 # Load average when the figures were taken: CPU times and in-run ratios are

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "bench/bare_box2d.hpp"
+#include "bench/best_runs.hpp"
 #include "bench/hil_flags.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
@@ -109,24 +110,10 @@ void bare_box2d(benchmark::State& state) {
   if (!(end_x > 0.3 && end_x < 1.1)) state.SkipWithError("the bare car left its circle");
 }
 
-class RecordingReporter : public benchmark::ConsoleReporter {
+class RecordingReporter : public hil::bench::BestRunReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const auto& run : runs) {
-      if (run.error_occurred) failed_ = true;
-      if (run.run_type != Run::RT_Iteration || run.iterations == 0) continue;
-      const double seconds_per_run = run.cpu_accumulated_time / static_cast<double>(run.iterations);
-      auto [it, inserted] = best_s_.emplace(run.benchmark_name(), seconds_per_run);
-      if (!inserted && seconds_per_run < it->second) it->second = seconds_per_run;
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-
   /// CPU seconds per run of the best repetition, 0 when it did not run.
-  double cpu_s(const std::string& name) const {
-    const auto it = best_s_.find(name);
-    return it == best_s_.end() ? 0.0 : it->second;
-  }
+  double cpu_s(const std::string& name) const { return seconds(name); }
   /// Simulated seconds per CPU second, 0 when it did not run.
   double realtime_x(const std::string& name) const {
     const double s = cpu_s(name);
@@ -134,32 +121,14 @@ class RecordingReporter : public benchmark::ConsoleReporter {
   }
 
   bool check(double min_ratio, double min_realtime) const {
-    bool ok = !failed_;
-    if (failed_) std::printf("a benchmark reported an error (see above)\n");
+    bool ok = no_errors();
     const double full = realtime_x(kStack);
-    const double bare = realtime_x(kBare);
     if (min_ratio > 0) {
-      if (full <= 0 || bare <= 0) {
-        std::printf("--hil_min_ratio needs both %s and %s in the run\n", kStack, kBare);
-        ok = false;
-      } else {
-        const bool pass = full / bare >= min_ratio;
-        std::printf("%s / %s simulated seconds per CPU second = %.2f (floor %.2f) %s\n", kStack,
-                    kBare, full / bare, min_ratio, pass ? "ok" : "TOO SLOW");
-        ok = ok && pass;
-      }
+      ok = hil::bench::check_ratio_floor(kStack, full, kBare, realtime_x(kBare),
+                                         "simulated seconds per CPU second", min_ratio) &&
+           ok;
     }
-    if (min_realtime > 0) {
-      if (full <= 0) {
-        std::printf("--hil_min_realtime needs %s in the run\n", kStack);
-        ok = false;
-      } else {
-        const bool pass = full >= min_realtime;
-        std::printf("%s runs %.0fx real time (floor %.0fx) %s\n", kStack, full, min_realtime,
-                    pass ? "ok" : "TOO SLOW");
-        ok = ok && pass;
-      }
-    }
+    if (min_realtime > 0) ok = hil::bench::check_realtime_floor(kStack, full, min_realtime) && ok;
     return ok;
   }
 
@@ -194,10 +163,6 @@ class RecordingReporter : public benchmark::ConsoleReporter {
       out << line;
     }
   }
-
- private:
-  std::map<std::string, double> best_s_;  // CPU seconds per run, best repetition
-  bool failed_ = false;
 };
 
 }  // namespace
@@ -231,9 +196,7 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark(kBare, bare_box2d)->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark(kStack, stack)->Unit(benchmark::kMillisecond);
   RecordingReporter reporter;
-  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
-  if (const auto markdown = flags.text("markdown"); !markdown.empty())
-    reporter.write_markdown(markdown);
-  if (!reporter.check(flags.number("min_ratio"), flags.number("min_realtime"))) return 1;
-  return 0;
+  return hil::bench::run_and_check(flags, reporter, [&] {
+    return reporter.check(flags.number("min_ratio"), flags.number("min_realtime"));
+  });
 }

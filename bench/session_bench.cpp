@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/best_runs.hpp"
 #include "bench/hil_flags.hpp"
 #include "client/logi/session.hpp"
 #include "link/faults/profile.hpp"
@@ -204,40 +205,18 @@ void random_sessions(benchmark::State& state) {
   state.counters["events"] = Counter(events, Counter::kAvgIterations);
 }
 
-struct Best {
-  double cpu_s = 0;  ///< CPU seconds per session, best repetition
-  double stat_frames = 0;
-  double actions = 0;
-  double faults = 0;
-  double events = 0;
-};
+constexpr const char* kSessionBenchmark = "logi_random_session";
 
-class RecordingReporter : public benchmark::ConsoleReporter {
+class RecordingReporter : public hil::bench::BestRunReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const auto& run : runs) {
-      if (run.error_occurred) failed_ = true;
-      if (run.run_type != Run::RT_Iteration || run.iterations == 0) continue;
-      const double cpu_s = run.cpu_accumulated_time / static_cast<double>(run.iterations);
-      const auto counter = [&run](const char* name) {
-        const auto it = run.counters.find(name);
-        return it == run.counters.end() ? 0.0 : it->second.value;
-      };
-      if (best_.cpu_s == 0 || cpu_s < best_.cpu_s) {
-        best_ = Best{cpu_s, counter("stat_frames"), counter("actions"), counter("faults"),
-                     counter("events")};
-      }
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-
   bool check(double min_rate) const {
-    if (failed_) {
+    if (failed()) {
       std::printf("the benchmark reported an error (see above)\n");
       return false;
     }
-    if (min_rate <= 0 || best_.cpu_s <= 0) return true;
-    const double rate = 1 / best_.cpu_s;
+    const double cpu_s = seconds(kSessionBenchmark);
+    if (min_rate <= 0 || cpu_s <= 0) return true;
+    const double rate = 1 / cpu_s;
     const bool pass = rate >= min_rate;
     std::printf("random LOGI sessions: %.1f per CPU second (floor %.1f) %s\n", rate, min_rate,
                 pass ? "ok" : "TOO SLOW");
@@ -245,38 +224,32 @@ class RecordingReporter : public benchmark::ConsoleReporter {
   }
 
   void write_markdown(const std::string& path) const {
-    if (best_.cpu_s <= 0) return;
+    const hil::bench::BestRun* b = best(kSessionBenchmark);
+    if (b == nullptr || b->seconds <= 0) return;
+    const double cpu_s = b->seconds;
     std::ofstream out(path);
     char line[512];
     out << "| sessions per CPU second | ms CPU per 60 s session | x real time | "
            "operator actions / faults injected / STATs decoded / client events per session |\n"
            "|---:|---:|---:|---:|\n";
     std::snprintf(line, sizeof line, "| %.1f | %.2f | %.0f | %.0f / %.0f / %.0f / %.0f |\n",
-                  1 / best_.cpu_s, best_.cpu_s * 1e3, 60 / best_.cpu_s, best_.actions, best_.faults,
-                  best_.stat_frames, best_.events);
+                  1 / cpu_s, cpu_s * 1e3, 60 / cpu_s, b->counter("actions"), b->counter("faults"),
+                  b->counter("stat_frames"), b->counter("events"));
     out << line;
     std::snprintf(line, sizeof line,
                   "\n%.1f random sessions of 60 simulated seconds per second "
                   "on one core (target >= 20).\n",
-                  1 / best_.cpu_s);
+                  1 / cpu_s);
     out << line;
   }
-
- private:
-  Best best_;
-  bool failed_ = false;
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
   auto flags = hil::bench::take_hil_flags(argc, argv);
-  benchmark::RegisterBenchmark("logi_random_session", random_sessions)
-      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark(kSessionBenchmark, random_sessions)->Unit(benchmark::kMillisecond);
   RecordingReporter reporter;
-  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
-  if (const auto markdown = flags.text("markdown"); !markdown.empty())
-    reporter.write_markdown(markdown);
-  if (!reporter.check(flags.number("min_sessions_per_s"))) return 1;
-  return 0;
+  return hil::bench::run_and_check(
+      flags, reporter, [&] { return reporter.check(flags.number("min_sessions_per_s")); });
 }

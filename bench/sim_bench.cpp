@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "bench/bare_box2d.hpp"
+#include "bench/best_runs.hpp"
 #include "bench/hil_flags.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
@@ -157,54 +158,24 @@ constexpr const char* kBare = "bare_box2d";
 constexpr const char* kNoSensors = "model_no_sensors";
 constexpr const char* kFull = "model_with_sensors";
 
-class RecordingReporter : public benchmark::ConsoleReporter {
+class RecordingReporter : public hil::bench::BestRunReporter {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const auto& run : runs) {
-      if (run.error_occurred) failed_ = true;
-      if (run.run_type != Run::RT_Iteration || run.iterations == 0) continue;
-      const double seconds_per_step =
-          run.cpu_accumulated_time / static_cast<double>(run.iterations);
-      auto [it, inserted] = best_s_.emplace(run.benchmark_name(), seconds_per_step);
-      if (!inserted && seconds_per_step < it->second) it->second = seconds_per_step;
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-
   /// Steps per second of the best repetition, 0 when it did not run.
   double steps_per_s(const std::string& name) const {
-    const auto it = best_s_.find(name);
-    return it == best_s_.end() || it->second <= 0 ? 0.0 : 1.0 / it->second;
+    const double s = seconds(name);
+    return s <= 0 ? 0.0 : 1.0 / s;
   }
 
   bool check(double min_ratio, double min_realtime) const {
-    bool ok = !failed_;
-    if (failed_) std::printf("a benchmark reported an error (see above)\n");
+    bool ok = no_errors();
     const double full = steps_per_s(kFull);
-    const double bare = steps_per_s(kBare);
     if (min_ratio > 0) {
-      if (full <= 0 || bare <= 0) {
-        std::printf("--hil_min_ratio needs both %s and %s in the run\n", kFull, kBare);
-        ok = false;
-      } else {
-        const bool pass = full / bare >= min_ratio;
-        std::printf("%s / %s steps per second = %.2f (floor %.2f) %s\n", kFull, kBare, full / bare,
-                    min_ratio, pass ? "ok" : "TOO SLOW");
-        ok = ok && pass;
-      }
+      ok = hil::bench::check_ratio_floor(kFull, full, kBare, steps_per_s(kBare), "steps per second",
+                                         min_ratio) &&
+           ok;
     }
-    if (min_realtime > 0) {
-      if (full <= 0) {
-        std::printf("--hil_min_realtime needs %s in the run\n", kFull);
-        ok = false;
-      } else {
-        const double realtime = full / kStepsPerSecond;
-        const bool pass = realtime >= min_realtime;
-        std::printf("%s runs %.0fx real time (floor %.0fx) %s\n", kFull, realtime, min_realtime,
-                    pass ? "ok" : "TOO SLOW");
-        ok = ok && pass;
-      }
-    }
+    if (min_realtime > 0)
+      ok = hil::bench::check_realtime_floor(kFull, full / kStepsPerSecond, min_realtime) && ok;
     return ok;
   }
 
@@ -235,18 +206,14 @@ class RecordingReporter : public benchmark::ConsoleReporter {
     if (no_sensors <= 0) return;
     out << "\n| read every step | steps/s | µs per step | added to model_no_sensors |\n"
            "|---|---:|---:|---:|\n";
-    for (const auto& [name, seconds] : best_s_) {
+    for (const auto& [name, b] : all()) {
       if (!name.starts_with("sensor_") && name != kFull) continue;
       std::snprintf(line, sizeof line, "| %s | %.0f | %.2f | %.2f µs |\n",
-                    name == kFull ? "all (model_with_sensors)" : name.c_str() + 7, 1 / seconds,
-                    seconds * 1e6, std::max(0.0, seconds - 1 / no_sensors) * 1e6);
+                    name == kFull ? "all (model_with_sensors)" : name.c_str() + 7, 1 / b.seconds,
+                    b.seconds * 1e6, std::max(0.0, b.seconds - 1 / no_sensors) * 1e6);
       out << line;
     }
   }
-
- private:
-  std::map<std::string, double> best_s_;  // seconds per step, best repetition
-  bool failed_ = false;
 };
 
 }  // namespace
@@ -255,9 +222,7 @@ int main(int argc, char** argv) {
   auto flags = hil::bench::take_hil_flags(argc, argv);
   register_all();
   RecordingReporter reporter;
-  if (!hil::bench::run_benchmarks(flags, reporter)) return 2;
-  if (const auto markdown = flags.text("markdown"); !markdown.empty())
-    reporter.write_markdown(markdown);
-  if (!reporter.check(flags.number("min_ratio"), flags.number("min_realtime"))) return 1;
-  return 0;
+  return hil::bench::run_and_check(flags, reporter, [&] {
+    return reporter.check(flags.number("min_ratio"), flags.number("min_realtime"));
+  });
 }
