@@ -5,6 +5,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "link/frame_splitters.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/sketch.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -20,96 +21,23 @@ namespace {
 
 using protocol::ByteView;
 using protocol::DecodeError;
+using splitters::AmendingSplitter;
+using splitters::KindAndText;
+using splitters::make_splitter;
+using splitters::RawSplitter;
 
 std::optional<ByteRange> non_empty(std::size_t first, std::size_t last) {
   if (first >= last) return std::nullopt;
   return ByteRange{first, last};
 }
 
-std::string error_text(const DecodeError& e) {
-  std::string text(protocol::to_string(e.kind));
-  if (!e.detail.empty()) text += ": " + e.detail;
-  return text;
-}
-
-/// Feeds a protocol's stream decoder and turns each item into a WireFrame;
-/// `describe` gives a valid frame's kind and text.
-template <class Decoder, class Message, class Describe>
-class DecoderSplitter final : public FrameSplitter {
- public:
-  DecoderSplitter(Decoder decoder, Describe describe, bool with_text)
-      : decoder_(std::move(decoder)), describe_(std::move(describe)), with_text_(with_text) {}
-
-  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
-    items_.clear();
-    decoder_.feed(bytes, items_);
-    convert(out);
-  }
-  void finish(std::vector<WireFrame>& out) override {
-    items_.clear();
-    decoder_.finish(items_);
-    convert(out);
-  }
-  std::size_t buffered() const override { return decoder_.buffered(); }
-
- private:
-  void convert(std::vector<WireFrame>& out) {
-    for (auto& item : items_) {
-      WireFrame frame;
-      if (auto* f = std::get_if<protocol::Frame<Message>>(&item)) {
-        frame.valid = true;
-        auto [kind, text] = describe_(f->message, with_text_);
-        frame.kind = std::move(kind);
-        frame.text = std::move(text);
-        frame.raw = std::move(f->raw);
-      } else {
-        auto& e = std::get<DecodeError>(item);
-        frame.kind = e.context;
-        frame.text = error_text(e);
-        frame.raw = std::move(e.raw);
-      }
-      out.push_back(std::move(frame));
-    }
-  }
-
-  Decoder decoder_;
-  Describe describe_;
-  bool with_text_;
-  std::vector<protocol::DecodeItem<Message>> items_;
-};
-
-template <class Message, class Decoder, class Describe>
-std::unique_ptr<FrameSplitter> make_splitter(Decoder decoder, Describe describe, bool with_text) {
-  return std::make_unique<DecoderSplitter<Decoder, Message, Describe>>(
-      std::move(decoder), std::move(describe), with_text);
-}
-
-using KindAndText = std::pair<std::string, std::string>;
-
 // ---------------------------------------------------------------- raw
-
-class RawSplitter final : public FrameSplitter {
- public:
-  explicit RawSplitter(bool with_text) : with_text_(with_text) {}
-  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
-    if (bytes.empty()) return;
-    WireFrame frame;
-    frame.raw.assign(bytes.begin(), bytes.end());
-    frame.valid = true;
-    if (with_text_) frame.text = protocol::escape(bytes);
-    out.push_back(std::move(frame));
-  }
-  void finish(std::vector<WireFrame>& /*out*/) override {}
-  std::size_t buffered() const override { return 0; }
-
- private:
-  bool with_text_;
-};
 
 class RawAdapter final : public ProtocolAdapter {
  public:
   std::string_view name() const override { return "raw"; }
   std::string_view profile() const override { return {}; }
+  bool text_frames() const override { return false; }
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     return std::make_unique<RawSplitter>(with_text);
   }
@@ -123,10 +51,29 @@ class RawAdapter final : public ProtocolAdapter {
   std::vector<std::string> field_names() const override { return {"payload", "body"}; }
 };
 
+// ---------------------------------------------------------------- text frames
+
+/// LOGI and Arduino: frames of text whose checksum is the two hex digits
+/// just before the frame's last byte.
+class TextFrameAdapter : public ProtocolAdapter {
+ public:
+  bool text_frames() const final { return true; }
+  std::optional<ByteRange> checksum_field(ByteView frame) const final {
+    if (!framed(frame)) return std::nullopt;
+    return ByteRange{frame.size() - 3, frame.size() - 1};
+  }
+
+ protected:
+  /// Whether `frame` has the places of a frame: its markers and the
+  /// separator before the checksum. A frame whose checksum is already wrong
+  /// still has them.
+  virtual bool framed(ByteView frame) const = 0;
+};
+
 // ---------------------------------------------------------------- LOGI
 // LOGI:<payload>:<CS>#
 
-class LogiAdapter final : public ProtocolAdapter {
+class LogiAdapter final : public TextFrameAdapter {
  public:
   explicit LogiAdapter(protocol::logi::Dialect dialect = protocol::logi::Dialect::guide)
       : dialect_(dialect) {}
@@ -143,11 +90,6 @@ class LogiAdapter final : public ProtocolAdapter {
           return KindAndText{protocol::logi::kind_of(m), text ? logi::describe(m) : std::string()};
         },
         with_text);
-  }
-
-  std::optional<ByteRange> checksum_field(ByteView frame) const override {
-    if (!framed(frame)) return std::nullopt;
-    return ByteRange{frame.size() - 3, frame.size() - 1};
   }
 
   std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
@@ -168,9 +110,8 @@ class LogiAdapter final : public ProtocolAdapter {
   }
 
  private:
-  // Shape only: header, ':' before two checksum characters, '#'. A frame
-  // whose checksum is already wrong still has these places.
-  static bool framed(ByteView f) {
+  // Header, ':' before two checksum characters, '#'.
+  bool framed(ByteView f) const override {
     const auto header = protocol::logi::kHeader;
     if (f.size() < header.size() + 5) return false;
     if (!std::equal(header.begin(), header.end(), f.begin())) return false;
@@ -188,25 +129,13 @@ class LogiAdapter final : public ProtocolAdapter {
 // judged as the real sketch judges them: a frame it acts on is valid (the
 // one-space payload of argument-less requests included), one it refuses
 // with a NACK or drops is not (docs/protocols/arduino.md, "Profiles").
-class SketchJudgedSplitter final : public FrameSplitter {
+class SketchJudgedSplitter final : public AmendingSplitter {
  public:
   SketchJudgedSplitter(std::unique_ptr<FrameSplitter> inner, bool with_text)
-      : inner_(std::move(inner)), with_text_(with_text) {}
-
-  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
-    const std::size_t first = out.size();
-    inner_->feed(bytes, out);
-    judge(out, first);
-  }
-  void finish(std::vector<WireFrame>& out) override {
-    const std::size_t first = out.size();
-    inner_->finish(out);
-    judge(out, first);
-  }
-  std::size_t buffered() const override { return inner_->buffered(); }
+      : AmendingSplitter(std::move(inner)), with_text_(with_text) {}
 
  private:
-  void judge(std::vector<WireFrame>& out, std::size_t first) const {
+  void amend(std::vector<WireFrame>& out, std::size_t first) const override {
     namespace arduino = protocol::arduino;
     for (std::size_t i = first; i < out.size(); ++i) {
       WireFrame& f = out[i];
@@ -259,11 +188,10 @@ class SketchJudgedSplitter final : public FrameSplitter {
     return protocol::to_string(ErrorKind::bad_format);
   }
 
-  std::unique_ptr<FrameSplitter> inner_;
   bool with_text_;
 };
 
-class ArduinoAdapter final : public ProtocolAdapter {
+class ArduinoAdapter final : public TextFrameAdapter {
  public:
   explicit ArduinoAdapter(protocol::arduino::Dialect dialect = protocol::arduino::kDefaultDialect)
       : dialect_(dialect) {}
@@ -286,11 +214,6 @@ class ArduinoAdapter final : public ProtocolAdapter {
                              text ? arduino::describe(m) : std::string()};
         },
         with_text);
-  }
-
-  std::optional<ByteRange> checksum_field(ByteView frame) const override {
-    if (!framed(frame)) return std::nullopt;
-    return ByteRange{frame.size() - 3, frame.size() - 1};
   }
 
   std::optional<ByteRange> field(ByteView frame, std::string_view name) const override {
@@ -316,14 +239,14 @@ class ArduinoAdapter final : public ProtocolAdapter {
   }
 
  private:
-  protocol::arduino::Dialect dialect_;
-
- private:
-  static bool framed(ByteView f) {
+  // '^', '*' before two checksum characters, '$'.
+  bool framed(ByteView f) const override {
     namespace arduino = protocol::arduino;
     return f.size() >= 5 && f.front() == arduino::kStart && f.back() == arduino::kEnd &&
            f[f.size() - 4] == static_cast<std::uint8_t>(arduino::kChecksumSeparator);
   }
+
+  protocol::arduino::Dialect dialect_;
 };
 
 // ---------------------------------------------------------------- WR8
@@ -336,6 +259,7 @@ class Wr8Adapter final : public ProtocolAdapter {
 
   std::string_view name() const override { return "wr8"; }
   std::string_view profile() const override { return protocol::default_car_profile("wr8").name; }
+  bool text_frames() const override { return false; }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace wr8 = protocol::wr8;
@@ -384,27 +308,15 @@ class Wr8Adapter final : public ProtocolAdapter {
 // The decoder names a packet it could not parse as the programs do
 // ("LOW-FREQ-DATA"); rules match the names of valid packets
 // ("LOW_FREQ_DATA"), so broken ones are spelled the same way.
-class UnderscoredKinds final : public FrameSplitter {
+class UnderscoredKinds final : public AmendingSplitter {
  public:
-  explicit UnderscoredKinds(std::unique_ptr<FrameSplitter> inner) : inner_(std::move(inner)) {}
-  void feed(ByteView bytes, std::vector<WireFrame>& out) override {
-    const std::size_t first = out.size();
-    inner_->feed(bytes, out);
-    respell(out, first);
-  }
-  void finish(std::vector<WireFrame>& out) override {
-    const std::size_t first = out.size();
-    inner_->finish(out);
-    respell(out, first);
-  }
-  std::size_t buffered() const override { return inner_->buffered(); }
+  using AmendingSplitter::AmendingSplitter;
 
  private:
-  static void respell(std::vector<WireFrame>& out, std::size_t first) {
+  void amend(std::vector<WireFrame>& out, std::size_t first) const override {
     for (std::size_t i = first; i < out.size(); ++i)
       std::replace(out[i].kind.begin(), out[i].kind.end(), '-', '_');
   }
-  std::unique_ptr<FrameSplitter> inner_;
 };
 
 class SvguiAdapter final : public ProtocolAdapter {
@@ -413,6 +325,7 @@ class SvguiAdapter final : public ProtocolAdapter {
 
   std::string_view name() const override { return "wr8"; }
   std::string_view profile() const override { return protocol::wr8::svgui::profile_of(version_); }
+  bool text_frames() const override { return false; }
 
   std::unique_ptr<FrameSplitter> splitter(bool with_text) const override {
     namespace svgui = protocol::wr8::svgui;
@@ -506,6 +419,8 @@ class LekaAdapter final : public ProtocolAdapter {
       : dialect_(dialect) {}
   std::string_view name() const override { return "leka"; }
   std::string_view profile() const override { return protocol::leka::to_string(dialect_); }
+  /// Command frames are binary; only the robot's replies are text.
+  bool text_frames() const override { return false; }
 
   std::unique_ptr<FrameSplitter> splitter_for(Direction direction, bool with_text) const override {
     if (direction == Direction::to_client) return std::make_unique<LineSplitter>(with_text);

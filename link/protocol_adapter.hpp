@@ -61,6 +61,10 @@ class ProtocolAdapter {
     (void)direction;
     return splitter(with_text);
   }
+  /// Whether frames are lines of text (LOGI, Arduino): a fault that changes
+  /// a checksum or field then keeps each character in its class (a digit
+  /// stays a digit, a letter a letter), so the frame still parses.
+  virtual bool text_frames() const = 0;
   /// Where the checksum is written in a frame; nullopt when the protocol has
   /// none (WR8, raw) or the frame is not one.
   virtual std::optional<ByteRange> checksum_field(protocol::ByteView frame) const = 0;

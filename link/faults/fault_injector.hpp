@@ -91,7 +91,7 @@ class FaultInjector {
   std::uint64_t faults_injected() const;
 
  private:
-  struct State;
+  class State;
   std::unique_ptr<State> state_;
 };
 

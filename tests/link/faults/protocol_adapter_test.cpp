@@ -121,6 +121,20 @@ TEST(ProtocolAdapter, LekaKindIsTheFirstCommandAndTheChecksumTheLastByte) {
   EXPECT_FALSE(l->checksum_field(*protocol::parse_hex("2A 2B 2C 2D 09 15 00 FF 00 00 41")));
 }
 
+// LOGI and Arduino frames are text, so a corrupt rule keeps their
+// characters in class; the others are bytes.
+TEST(ProtocolAdapter, TextProtocolsSayTheirFramesAreText) {
+  EXPECT_TRUE(protocol_adapter("logi")->text_frames());
+  EXPECT_TRUE(protocol_adapter("logi", "firmware")->text_frames());
+  EXPECT_TRUE(protocol_adapter("arduino")->text_frames());
+  EXPECT_TRUE(protocol_adapter("arduino", "readme")->text_frames());
+  EXPECT_FALSE(protocol_adapter("wr8")->text_frames());
+  EXPECT_FALSE(protocol_adapter("wr8", "svgui-2019")->text_frames());
+  EXPECT_FALSE(protocol_adapter("leka")->text_frames());
+  EXPECT_FALSE(protocol_adapter("leka", "comspecs-v3")->text_frames());
+  EXPECT_FALSE(protocol_adapter("raw")->text_frames());
+}
+
 // Profiles (protocol/common/car_profile.hpp): the adapter frames and judges
 // by the car's profile, and says which one it is.
 TEST(ProtocolAdapter, EachAdapterNamesItsProfile) {
