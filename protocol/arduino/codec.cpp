@@ -391,32 +391,11 @@ std::optional<Message> nack_response(const DecodeError& error) {
 }
 
 Decoder::Decoder(DecoderOptions options)
-    : options_(options),
-      framer_(std::string_view("^", 1), kEnd,
-              options.max_frame_bytes >= kMinFrameBytes
-                  ? options.max_frame_bytes
-                  : throw std::invalid_argument("Arduino decoder: max_frame_bytes below " +
-                                                std::to_string(kMinFrameBytes))) {}
-
-void Decoder::convert(std::vector<Item>& out) {
-  for (auto& event : events_) {
-    if (event.kind == DelimitedFramer::Kind::frame) {
-      out.push_back(decode_frame(event.bytes, options_));
-    } else {
-      out.emplace_back(framing_error(std::move(event), options_.max_frame_bytes));
-    }
-  }
-  events_.clear();
-}
-
-void Decoder::feed(ByteView bytes, std::vector<Item>& out) {
-  framer_.feed(bytes, events_);
-  if (!events_.empty()) convert(out);
-}
-
-void Decoder::finish(std::vector<Item>& out) {
-  framer_.finish(events_);
-  convert(out);
-}
+    : DelimitedDecoder(options, std::string_view("^", 1), kEnd,
+                       options.max_frame_bytes >= kMinFrameBytes
+                           ? options.max_frame_bytes
+                           : throw std::invalid_argument("Arduino decoder: max_frame_bytes below " +
+                                                         std::to_string(kMinFrameBytes)),
+                       decode_frame, framing_error) {}
 
 }  // namespace hil::protocol::arduino

@@ -12,7 +12,7 @@
 #include "protocol/arduino/message.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/common/decode.hpp"
-#include "protocol/common/delimited_framer.hpp"
+#include "protocol/common/delimited_decoder.hpp"
 
 namespace hil::protocol::arduino {
 
@@ -149,26 +149,14 @@ std::optional<std::uint8_t> sequence_of(ByteView raw);
 /// read (the protocol leaves that case open). nullopt when nack_for is.
 std::optional<Message> nack_response(const DecodeError& error);
 
-/// Incremental stream decoder for either direction: any chunking of the
-/// stream yields the same items in the same order. Never throws on input.
-/// Holds at most `max_frame_bytes` bytes: 256 by default (the PC's receive
-/// guard), 96 with DecoderOptions::firmware() (the firmware's buffer).
-class Decoder {
+/// Incremental stream decoder for either direction, '^' to '$'
+/// (protocol/common/delimited_decoder.hpp). Holds at most `max_frame_bytes`
+/// bytes: 256 by default (the PC's receive guard), 96 with
+/// DecoderOptions::firmware() (the firmware's buffer).
+class Decoder : public DelimitedDecoder<Message, DecoderOptions> {
  public:
   /// Throws std::invalid_argument when max_frame_bytes < kMinFrameBytes.
   explicit Decoder(DecoderOptions options = {});
-
-  void feed(ByteView bytes, std::vector<Item>& out);
-  /// End of stream: a partial frame comes out as ErrorKind::truncated.
-  void finish(std::vector<Item>& out);
-  std::size_t buffered() const { return framer_.buffered(); }
-
- private:
-  void convert(std::vector<Item>& out);
-
-  DecoderOptions options_;
-  DelimitedFramer framer_;
-  std::vector<DelimitedFramer::Event> events_;
 };
 
 }  // namespace hil::protocol::arduino

@@ -1,6 +1,13 @@
 #pragma once
 // What every stream decoder hands back: decoded frames and typed errors,
 // both carrying the exact bytes they were made from.
+//
+// Every protocol's stream Decoder keeps one contract: feed(bytes, out)
+// appends the items the bytes complete, and finish(out) hands out what is
+// still held at the end of the stream (a partial frame as
+// ErrorKind::truncated). Any chunking of a stream yields the same items in
+// the same order, every input byte lands in exactly one item's raw bytes,
+// input never makes it throw, and buffered() is the number of bytes held.
 
 #include <cstdint>
 #include <optional>

@@ -74,6 +74,14 @@ std::string ascii_upper(std::string_view text) {
   return out;
 }
 
+bool kind_matches(std::string_view pattern, std::string_view kind) {
+  if (pattern.empty()) return true;
+  if (kind.size() < pattern.size() || kind.substr(0, pattern.size()) != pattern) return false;
+  if (kind.size() == pattern.size()) return true;
+  const char next = kind[pattern.size()];
+  return next == ':' || next == '.';
+}
+
 std::string fixed_decimals(double value, int decimals) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, value);

@@ -26,6 +26,12 @@ bool is_printable_ascii(std::string_view text);
 /// The text with a..z made A..Z and every other byte kept (no locale).
 std::string ascii_upper(std::string_view text);
 
+/// Whether a frame's kind ("MV:FWD", "motor.all") starts with `pattern`
+/// by whole ':'- or '.'-separated parts: "MV" matches "MV" and "MV:FWD",
+/// not "MVX"; an empty pattern matches every kind. Fault rules and mock
+/// behaviours pick frames by it.
+bool kind_matches(std::string_view pattern, std::string_view kind);
+
 /// `value` with exactly `decimals` digits after the point ("0.50"), for
 /// status lines and logs.
 std::string fixed_decimals(double value, int decimals);

@@ -83,11 +83,9 @@ using Item = DecodeItem<Message>;
 /// Decodes exactly one complete frame (start sequence to checksum).
 Item decode_frame(ByteView raw, const DecoderOptions& options = {});
 
-/// Incremental stream decoder: any chunking of the stream yields the same
-/// items in the same order, and every input byte ends up in exactly one
-/// item's raw bytes. Never throws on input. Holds at most
-/// options.max_frame_bytes bytes (128 by default): a frame never needs more,
-/// and garbage is passed on in chunks of at most that size.
+/// The stream decoder (its contract: protocol/common/decode.hpp). Holds at
+/// most options.max_frame_bytes bytes (128 by default): a frame never needs
+/// more, and garbage is passed on in chunks of at most that size.
 ///
 /// A candidate that fails its checksum is reported only up to the next start
 /// sequence inside it, and decoding resumes there, so header-like garbage
@@ -98,7 +96,6 @@ class Decoder {
   explicit Decoder(DecoderOptions options = {});
 
   void feed(ByteView bytes, std::vector<Item>& out);
-  /// End of stream: a partial frame comes out as ErrorKind::truncated.
   void finish(std::vector<Item>& out);
   std::size_t buffered() const { return buf_.size(); }
 

@@ -360,27 +360,6 @@ Item decode_handover(ByteView raw, const DecoderOptions& options) {
 }
 
 Decoder::Decoder(DecoderOptions options)
-    : options_(options), framer_(kHeader, kTail, options.max_frame_bytes) {}
-
-void Decoder::convert(std::vector<Item>& out) {
-  for (auto& event : events_) {
-    if (event.kind == DelimitedFramer::Kind::frame) {
-      out.push_back(decode_frame(event.bytes, options_));
-    } else {
-      out.emplace_back(to_error(std::move(event), options_.max_frame_bytes));
-    }
-  }
-  events_.clear();
-}
-
-void Decoder::feed(ByteView bytes, std::vector<Item>& out) {
-  framer_.feed(bytes, events_);
-  if (!events_.empty()) convert(out);
-}
-
-void Decoder::finish(std::vector<Item>& out) {
-  framer_.finish(events_);
-  convert(out);
-}
+    : DelimitedDecoder(options, kHeader, kTail, options.max_frame_bytes, decode_frame) {}
 
 }  // namespace hil::protocol::logi

@@ -9,7 +9,7 @@
 
 #include "protocol/common/bytes.hpp"
 #include "protocol/common/decode.hpp"
-#include "protocol/common/delimited_framer.hpp"
+#include "protocol/common/delimited_decoder.hpp"
 #include "protocol/logi/message.hpp"
 
 namespace hil::protocol::logi {
@@ -85,24 +85,12 @@ inline constexpr std::size_t kFirmwareMinBytes = 10;
 /// header to first '#') takes them (docs/protocols/logi.md, "Profiles").
 Item decode_handover(ByteView handover, const DecoderOptions& options = {});
 
-/// Incremental stream decoder: any chunking of the stream yields the same
-/// items in the same order. Never throws on input; holds at most
-/// `max_frame_bytes` bytes.
-class Decoder {
+/// Incremental stream decoder, header to first '#'
+/// (protocol/common/delimited_decoder.hpp); holds at most `max_frame_bytes`
+/// bytes.
+class Decoder : public DelimitedDecoder<Message, DecoderOptions> {
  public:
   explicit Decoder(DecoderOptions options = {});
-
-  void feed(ByteView bytes, std::vector<Item>& out);
-  /// End of stream: a partial frame comes out as ErrorKind::truncated.
-  void finish(std::vector<Item>& out);
-  std::size_t buffered() const { return framer_.buffered(); }
-
- private:
-  void convert(std::vector<Item>& out);
-
-  DecoderOptions options_;
-  DelimitedFramer framer_;
-  std::vector<DelimitedFramer::Event> events_;
 };
 
 }  // namespace hil::protocol::logi

@@ -129,6 +129,190 @@ Bytes encode_impl(const Message& m, const Profile& profile, bool checked) {
   return out;
 }
 
+/// The length of a packet of `code` when it is fixed; 0 for the packets
+/// whose block size byte gives it.
+constexpr std::size_t fixed_length(PacketCode code) {
+  switch (code) {
+    case PacketCode::empty:
+      return 1;
+    case PacketCode::auth:
+      return 1 + kAuthTextBytes;
+    case PacketCode::auth_reply:
+      return 4;
+    case PacketCode::response:
+      return 3;
+    default:
+      return 0;
+  }
+}
+
+/// Where the block size byte of a packet of `code` is; 0 for fixed-length
+/// packets.
+constexpr std::size_t size_byte_at(PacketCode code) {
+  switch (code) {
+    case PacketCode::task:
+      return 3;
+    case PacketCode::settings:
+      return 2;
+    case PacketCode::data:
+      return kDataHeaderBytes - 1;
+    default:
+      return 0;
+  }
+}
+
+/// One complete packet being checked by decode_packet, and its items.
+struct Packet {
+  ByteView raw;
+  std::string context;  ///< the packet's name, once its code is known
+
+  Item error(ErrorKind kind, std::string detail) const {
+    return Item{DecodeError{kind, Bytes(raw.begin(), raw.end()), std::move(detail), context}};
+  }
+  Item frame(Message m, std::optional<ErrorKind> tolerated = std::nullopt) const {
+    return Item{Frame<Message>{std::move(m), Bytes(raw.begin(), raw.end()), tolerated}};
+  }
+  /// The error when the packet is not exactly `length` bytes long.
+  std::optional<Item> length_error(std::size_t length) const {
+    if (raw.size() < length) {
+      return error(ErrorKind::truncated, context + " packet needs " + plural(length, "byte") +
+                                             ", only " + std::to_string(raw.size()) + " present");
+    }
+    if (raw.size() > length) {
+      return error(ErrorKind::bad_format, context + " packet is " + plural(length, "byte") + ", " +
+                                              std::to_string(raw.size() - length) +
+                                              " more follow it");
+    }
+    return std::nullopt;
+  }
+};
+
+Item decode_task(const Packet& p, const Profile& profile) {
+  const ByteView raw = p.raw;
+  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
+  if (raw.size() < 4) return *p.length_error(4);
+  const std::size_t size = raw[3];
+  if (in_bytes && size % kWordBytes != 0) {
+    return p.error(ErrorKind::bad_format, "parameter block size " + std::to_string(size) +
+                                              " (byte 3) is not a multiple of 4 bytes");
+  }
+  const std::size_t count = in_bytes ? size / kWordBytes : size;
+  if (auto e = p.length_error(4 + count * kWordBytes)) return *e;
+  const std::uint8_t t = raw[2];
+  if (t >= kTaskCount) {
+    return p.error(ErrorKind::unknown_code,
+                   "task code " + std::to_string(t) + " (byte 2) is not 0..4; packet skipped");
+  }
+  const auto task = static_cast<TaskCode>(t);
+  if (count != profile.task_parameter_count[t]) {
+    return p.error(ErrorKind::bad_format, "task " + std::string(to_string(task)) + " takes " +
+                                              plural(profile.task_parameter_count[t], "parameter") +
+                                              ", the packet carries " + std::to_string(count));
+  }
+  Task m{raw[1], task, {}};
+  for (std::size_t i = 0; i < count; ++i) {
+    m.params.push_back(Word{get(raw, 4 + i * kWordBytes, kWordBytes, profile.byte_order)});
+  }
+  return p.frame(std::move(m));
+}
+
+Item decode_settings(const Packet& p, const Profile& profile) {
+  const ByteView raw = p.raw;
+  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
+  if (raw.size() < 3) return *p.length_error(3);
+  const std::size_t size = raw[2];
+  if (in_bytes && size % kSettingEntryBytes != 0) {
+    return p.error(ErrorKind::bad_format,
+                   "parameter block size " + std::to_string(size) +
+                       " (byte 2) is not a multiple of 5 bytes (type byte + 4-byte value)");
+  }
+  const std::size_t count = in_bytes ? size / kSettingEntryBytes : size;
+  if (auto e = p.length_error(3 + count * kSettingEntryBytes)) return *e;
+  Settings m{raw[1], {}};
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t at = 3 + i * kSettingEntryBytes;
+    if (raw[at] >= kSettingCount) {
+      return p.error(ErrorKind::unknown_code, "setting type " + std::to_string(raw[at]) +
+                                                  " (entry " + std::to_string(i + 1) + ", byte " +
+                                                  std::to_string(at) +
+                                                  ") is not 0..3; packet skipped");
+    }
+    m.params.push_back(Setting{static_cast<SettingCode>(raw[at]),
+                               Word{get(raw, at + 1, kWordBytes, profile.byte_order)}});
+  }
+  return p.frame(std::move(m));
+}
+
+/// DATA entries when the size byte counts bytes: the block is framed, so
+/// a code the profile cannot size ends the entries and the rest is kept.
+Item decode_data_values_in_bytes(const Packet& p, const Profile& profile, Data m) {
+  const ByteView raw = p.raw;
+  for (std::size_t at = kDataHeaderBytes; at < raw.size();) {
+    const DataParameter* d = profile.data_parameter(raw[at]);
+    if (d == nullptr) {
+      m.unparsed.assign(raw.begin() + static_cast<std::ptrdiff_t>(at), raw.end());
+      return p.frame(std::move(m), ErrorKind::unknown_code);
+    }
+    if (at + 1 + d->size_bytes > raw.size()) {
+      return p.error(ErrorKind::bad_format,
+                     "entry " + d->name + " (code " + std::to_string(d->code) + ") at byte " +
+                         std::to_string(at) + " needs " + plural(d->size_bytes, "value byte") +
+                         ", the block has " + std::to_string(raw.size() - at - 1) + " left");
+    }
+    m.values.push_back(
+        DataValue{d->code, Word{get(raw, at + 1, d->size_bytes, profile.byte_order)}});
+    at += 1 + d->size_bytes;
+  }
+  return p.frame(std::move(m));
+}
+
+/// DATA entries when the size byte counts entries: each code's size frames
+/// the next entry, so a code the profile cannot size ends the packet.
+Item decode_data_values_in_entries(const Packet& p, const Profile& profile, Data m) {
+  const ByteView raw = p.raw;
+  const std::size_t size = raw[kDataHeaderBytes - 1];
+  std::size_t at = kDataHeaderBytes;
+  for (std::size_t i = 0; i < size; ++i) {
+    if (at >= raw.size()) return *p.length_error(at + 1);
+    const DataParameter* d = profile.data_parameter(raw[at]);
+    if (d == nullptr) {
+      if (at + 1 == raw.size()) {
+        return p.error(ErrorKind::unknown_code,
+                       "entry " + std::to_string(i + 1) + " has code " + std::to_string(raw[at]) +
+                           ", which the profile cannot size; with sizes counting entries the "
+                           "packet cannot be framed past it, so decoding resumes after this byte");
+      }
+      return p.error(ErrorKind::unknown_code, "entry " + std::to_string(i + 1) + " has code " +
+                                                  std::to_string(raw[at]) +
+                                                  ", which the profile cannot size");
+    }
+    if (at + 1 + d->size_bytes > raw.size()) return *p.length_error(at + 1 + d->size_bytes);
+    m.values.push_back(
+        DataValue{d->code, Word{get(raw, at + 1, d->size_bytes, profile.byte_order)}});
+    at += 1 + d->size_bytes;
+  }
+  if (auto e = p.length_error(at)) return *e;
+  return p.frame(std::move(m));
+}
+
+Item decode_data(const Packet& p, const Profile& profile) {
+  const ByteView raw = p.raw;
+  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
+  if (raw.size() < kDataHeaderBytes) return *p.length_error(kDataHeaderBytes);
+  if (in_bytes) {
+    if (auto e = p.length_error(kDataHeaderBytes + raw[kDataHeaderBytes - 1])) return *e;
+  }
+  if (raw[1] >= kAllStates.size()) {
+    return p.error(ErrorKind::bad_value, "state code " + std::to_string(raw[1]) +
+                                             " (byte 1) is not 0..3 (FAULT, RUN, STOP, WAIT)");
+  }
+  Data m;
+  m.state = static_cast<State>(raw[1]);
+  m.timestamp_ms = get(raw, 2, kWordBytes, profile.byte_order);
+  if (in_bytes) return decode_data_values_in_bytes(p, profile, std::move(m));
+  return decode_data_values_in_entries(p, profile, std::move(m));
+}
+
 }  // namespace
 
 bool sends(Sender sender, std::uint8_t code) {
@@ -165,176 +349,51 @@ Bytes raw_packet(std::uint8_t code, ByteView body) {
 }
 
 Item decode_packet(ByteView raw, const DecoderOptions& options) {
-  const Profile& profile = options.profile;
-  const ByteOrder order = profile.byte_order;
-  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
-  std::string context;
-  const auto error = [&](ErrorKind kind, std::string detail) {
-    return Item{DecodeError{kind, Bytes(raw.begin(), raw.end()), std::move(detail), context}};
-  };
-  const auto frame = [&](Message m, std::optional<ErrorKind> tolerated = std::nullopt) {
-    return Item{Frame<Message>{std::move(m), Bytes(raw.begin(), raw.end()), tolerated}};
-  };
-  // The packet must be exactly `length` bytes long.
-  const auto length_error = [&](std::size_t length) -> std::optional<Item> {
-    if (raw.size() < length) {
-      return error(ErrorKind::truncated, context + " packet needs " + plural(length, "byte") +
-                                             ", only " + std::to_string(raw.size()) + " present");
-    }
-    if (raw.size() > length) {
-      return error(ErrorKind::bad_format, context + " packet is " + plural(length, "byte") + ", " +
-                                              std::to_string(raw.size() - length) +
-                                              " more follow it");
-    }
-    return std::nullopt;
-  };
-
-  if (raw.empty()) return error(ErrorKind::bad_format, "no bytes");
+  Packet p{raw, {}};
+  if (raw.empty()) return p.error(ErrorKind::bad_format, "no bytes");
   const std::uint8_t code = raw[0];
   if (code >= kPacketCodeCount) {
-    return error(ErrorKind::garbage,
-                 "first byte " + hex_byte(code) + " is not a packet code (0..6)");
+    return p.error(ErrorKind::garbage,
+                   "first byte " + hex_byte(code) + " is not a packet code (0..6)");
   }
-  context = to_string(static_cast<PacketCode>(code));
+  const auto packet = static_cast<PacketCode>(code);
+  p.context = to_string(packet);
   if (!sends(options.sender, code)) {
-    return error(ErrorKind::unknown_code, context + " is not a packet the " +
-                                              (options.sender == Sender::gui ? "GUI" : "vehicle") +
-                                              " sends");
+    return p.error(ErrorKind::unknown_code,
+                   p.context + " is not a packet the " +
+                       (options.sender == Sender::gui ? "GUI" : "vehicle") + " sends");
   }
-
-  switch (static_cast<PacketCode>(code)) {
+  if (const std::size_t length = fixed_length(packet)) {
+    if (auto e = p.length_error(length)) return *e;
+  }
+  switch (packet) {
     case PacketCode::empty:
-      if (auto e = length_error(1)) return *e;
-      return frame(Empty{});
+      return p.frame(Empty{});
     case PacketCode::auth: {
-      if (auto e = length_error(1 + kAuthTextBytes)) return *e;
       Auth a;
       std::copy(raw.begin() + 1, raw.end(), a.text.begin());
-      return frame(a);
+      return p.frame(a);
     }
-    case PacketCode::auth_reply: {
-      if (auto e = length_error(4)) return *e;
+    case PacketCode::auth_reply:
       if (raw[3] >= kAllStates.size()) {
-        return error(ErrorKind::bad_value, "state code " + std::to_string(raw[3]) +
-                                               " (byte 3) is not 0..3 (FAULT, RUN, STOP, WAIT)");
+        return p.error(ErrorKind::bad_value, "state code " + std::to_string(raw[3]) +
+                                                 " (byte 3) is not 0..3 (FAULT, RUN, STOP, WAIT)");
       }
-      return frame(AuthReply{raw[1], raw[2], static_cast<State>(raw[3])});
-    }
-    case PacketCode::task: {
-      if (raw.size() < 4) return *length_error(4);
-      const std::size_t size = raw[3];
-      if (in_bytes && size % kWordBytes != 0) {
-        return error(ErrorKind::bad_format, "parameter block size " + std::to_string(size) +
-                                                " (byte 3) is not a multiple of 4 bytes");
-      }
-      const std::size_t count = in_bytes ? size / kWordBytes : size;
-      if (auto e = length_error(4 + count * kWordBytes)) return *e;
-      const std::uint8_t t = raw[2];
-      if (t >= kTaskCount) {
-        return error(ErrorKind::unknown_code,
-                     "task code " + std::to_string(t) + " (byte 2) is not 0..4; packet skipped");
-      }
-      const auto task = static_cast<TaskCode>(t);
-      if (count != profile.task_parameter_count[t]) {
-        return error(ErrorKind::bad_format,
-                     "task " + std::string(to_string(task)) + " takes " +
-                         plural(profile.task_parameter_count[t], "parameter") +
-                         ", the packet carries " + std::to_string(count));
-      }
-      Task m{raw[1], task, {}};
-      for (std::size_t i = 0; i < count; ++i) {
-        m.params.push_back(Word{get(raw, 4 + i * kWordBytes, kWordBytes, order)});
-      }
-      return frame(std::move(m));
-    }
-    case PacketCode::settings: {
-      if (raw.size() < 3) return *length_error(3);
-      const std::size_t size = raw[2];
-      if (in_bytes && size % kSettingEntryBytes != 0) {
-        return error(ErrorKind::bad_format,
-                     "parameter block size " + std::to_string(size) +
-                         " (byte 2) is not a multiple of 5 bytes (type byte + 4-byte value)");
-      }
-      const std::size_t count = in_bytes ? size / kSettingEntryBytes : size;
-      if (auto e = length_error(3 + count * kSettingEntryBytes)) return *e;
-      Settings m{raw[1], {}};
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t at = 3 + i * kSettingEntryBytes;
-        if (raw[at] >= kSettingCount) {
-          return error(ErrorKind::unknown_code, "setting type " + std::to_string(raw[at]) +
-                                                    " (entry " + std::to_string(i + 1) + ", byte " +
-                                                    std::to_string(at) +
-                                                    ") is not 0..3; packet skipped");
-        }
-        m.params.push_back(
-            Setting{static_cast<SettingCode>(raw[at]), Word{get(raw, at + 1, kWordBytes, order)}});
-      }
-      return frame(std::move(m));
-    }
-    case PacketCode::response: {
-      if (auto e = length_error(3)) return *e;
+      return p.frame(AuthReply{raw[1], raw[2], static_cast<State>(raw[3])});
+    case PacketCode::response:
       if (raw[2] >= kAllResponseCodes.size()) {
-        return error(ErrorKind::unknown_code,
-                     "response code " + std::to_string(raw[2]) + " (byte 2) is not 0..2");
+        return p.error(ErrorKind::unknown_code,
+                       "response code " + std::to_string(raw[2]) + " (byte 2) is not 0..2");
       }
-      return frame(Response{raw[1], static_cast<ResponseCode>(raw[2])});
-    }
-    case PacketCode::data: {
-      if (raw.size() < kDataHeaderBytes) return *length_error(kDataHeaderBytes);
-      const std::size_t size = raw[6];
-      if (in_bytes) {
-        if (auto e = length_error(kDataHeaderBytes + size)) return *e;
-      }
-      if (raw[1] >= kAllStates.size()) {
-        return error(ErrorKind::bad_value, "state code " + std::to_string(raw[1]) +
-                                               " (byte 1) is not 0..3 (FAULT, RUN, STOP, WAIT)");
-      }
-      Data m;
-      m.state = static_cast<State>(raw[1]);
-      m.timestamp_ms = get(raw, 2, kWordBytes, order);
-      std::size_t at = kDataHeaderBytes;
-      if (in_bytes) {
-        while (at < raw.size()) {
-          const DataParameter* p = profile.data_parameter(raw[at]);
-          if (p == nullptr) {
-            m.unparsed.assign(raw.begin() + static_cast<std::ptrdiff_t>(at), raw.end());
-            return frame(std::move(m), ErrorKind::unknown_code);
-          }
-          if (at + 1 + p->size_bytes > raw.size()) {
-            return error(ErrorKind::bad_format,
-                         "entry " + p->name + " (code " + std::to_string(p->code) + ") at byte " +
-                             std::to_string(at) + " needs " + plural(p->size_bytes, "value byte") +
-                             ", the block has " + std::to_string(raw.size() - at - 1) + " left");
-          }
-          m.values.push_back(DataValue{p->code, Word{get(raw, at + 1, p->size_bytes, order)}});
-          at += 1 + p->size_bytes;
-        }
-        return frame(std::move(m));
-      }
-      for (std::size_t i = 0; i < size; ++i) {
-        if (at >= raw.size()) return *length_error(at + 1);
-        const DataParameter* p = profile.data_parameter(raw[at]);
-        if (p == nullptr) {
-          if (at + 1 == raw.size()) {
-            return error(
-                ErrorKind::unknown_code,
-                "entry " + std::to_string(i + 1) + " has code " + std::to_string(raw[at]) +
-                    ", which the profile cannot size; with sizes counting entries the "
-                    "packet cannot be framed past it, so decoding resumes after this byte");
-          }
-          return error(ErrorKind::unknown_code, "entry " + std::to_string(i + 1) + " has code " +
-                                                    std::to_string(raw[at]) +
-                                                    ", which the profile cannot size");
-        }
-        if (at + 1 + p->size_bytes > raw.size()) return *length_error(at + 1 + p->size_bytes);
-        m.values.push_back(DataValue{p->code, Word{get(raw, at + 1, p->size_bytes, order)}});
-        at += 1 + p->size_bytes;
-      }
-      if (auto e = length_error(at)) return *e;
-      return frame(std::move(m));
-    }
+      return p.frame(Response{raw[1], static_cast<ResponseCode>(raw[2])});
+    case PacketCode::task:
+      return decode_task(p, options.profile);
+    case PacketCode::settings:
+      return decode_settings(p, options.profile);
+    case PacketCode::data:
+      return decode_data(p, options.profile);
   }
-  return error(ErrorKind::bad_format, "unreachable");
+  return p.error(ErrorKind::bad_format, "unreachable");
 }
 
 Decoder::Decoder(DecoderOptions options) : options_(std::move(options)), limit_(0) {
@@ -388,29 +447,8 @@ void Decoder::start_packet(std::uint8_t code, std::vector<Item>& out) {
   code_ = code;
   buf_.push_back(code);
   pos_ = 1;
-  switch (static_cast<PacketCode>(code)) {
-    case PacketCode::empty:
-      total_ = 1;
-      break;
-    case PacketCode::auth:
-      total_ = 1 + kAuthTextBytes;
-      break;
-    case PacketCode::auth_reply:
-      total_ = 4;
-      break;
-    case PacketCode::response:
-      total_ = 3;
-      break;
-    case PacketCode::task:
-      size_at_ = 3;
-      break;
-    case PacketCode::settings:
-      size_at_ = 2;
-      break;
-    case PacketCode::data:
-      size_at_ = 6;
-      break;
-  }
+  total_ = fixed_length(static_cast<PacketCode>(code));
+  size_at_ = size_byte_at(static_cast<PacketCode>(code));
   if (pos_ == total_) complete_packet(out);
 }
 

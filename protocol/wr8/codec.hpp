@@ -62,11 +62,10 @@ using Item = DecodeItem<Message>;
 /// byte). Never throws.
 Item decode_packet(ByteView raw, const DecoderOptions& options = {});
 
-/// Incremental stream decoder: any chunking of the stream yields the same
-/// items in the same order, and every input byte is in exactly one item.
-/// Never throws on input. Holds at most max_buffered() bytes: one packet up
-/// to the limit, or one run of bytes that start no packet (such runs are
-/// reported in pieces of at most that size).
+/// The stream decoder (its contract: protocol/common/decode.hpp). Holds at
+/// most max_buffered() bytes: one packet up to the limit, or one run of
+/// bytes that start no packet (such runs are reported in pieces of at most
+/// that size).
 class Decoder {
  public:
   /// Throws std::invalid_argument for an invalid profile or a limit below
@@ -74,7 +73,6 @@ class Decoder {
   explicit Decoder(DecoderOptions options = {});
 
   void feed(ByteView bytes, std::vector<Item>& out);
-  /// End of stream: a partial packet comes out as ErrorKind::truncated.
   void finish(std::vector<Item>& out);
   std::size_t buffered() const { return buf_.size(); }
   std::size_t max_buffered() const { return limit_; }

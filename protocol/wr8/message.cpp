@@ -52,6 +52,14 @@ std::string name_or_number(std::uint8_t value, const std::array<std::string_view
   return std::string(prefix) + std::to_string(value);
 }
 
+/// The name of `value` in `names`, or `unknown` for a value past the table.
+template <class Enum, std::size_t N>
+std::string_view name_in(const std::array<std::string_view, N>& names, Enum value,
+                         std::string_view unknown) {
+  const auto i = static_cast<std::size_t>(value);
+  return i < N ? names[i] : unknown;
+}
+
 std::uint32_t mask_of(std::size_t size_bytes) {
   return size_bytes >= 4 ? 0xFFFFFFFFu : (1u << (8 * size_bytes)) - 1u;
 }
@@ -59,28 +67,23 @@ std::uint32_t mask_of(std::size_t size_bytes) {
 }  // namespace
 
 std::string_view to_string(PacketCode code) {
-  const auto i = static_cast<std::size_t>(code);
-  return i < kPacketNames.size() ? kPacketNames[i] : "UNKNOWN";
+  return name_in(kPacketNames, code, "UNKNOWN");
 }
 
 std::string_view to_string(State state) {
-  const auto i = static_cast<std::size_t>(state);
-  return i < kStateNames.size() ? kStateNames[i] : "UNKNOWN";
+  return name_in(kStateNames, state, "UNKNOWN");
 }
 
 std::string_view to_string(TaskCode task) {
-  const auto i = static_cast<std::size_t>(task);
-  return i < kTaskNames.size() ? kTaskNames[i] : "unknown";
+  return name_in(kTaskNames, task, "unknown");
 }
 
 std::string_view to_string(SettingCode code) {
-  const auto i = static_cast<std::size_t>(code);
-  return i < kSettingNames.size() ? kSettingNames[i] : "unknown";
+  return name_in(kSettingNames, code, "unknown");
 }
 
 std::string_view to_string(ResponseCode code) {
-  const auto i = static_cast<std::size_t>(code);
-  return i < kResponseNames.size() ? kResponseNames[i] : "unknown";
+  return name_in(kResponseNames, code, "unknown");
 }
 
 std::optional<State> parse_state(std::string_view text) {

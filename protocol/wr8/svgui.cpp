@@ -65,6 +65,11 @@ void require(bool ok, const std::string& what) {
 
 // ---- reading ----
 
+std::optional<State> state_of(std::uint8_t b) {
+  if (b > 3) return std::nullopt;
+  return static_cast<State>(b);
+}
+
 /// Reads a packet front to back; the first failure sticks, so a parse can
 /// read everything and check once.
 class Reader {
@@ -115,6 +120,15 @@ class Reader {
     return be32();
   }
   const std::optional<std::string>& wrong_code() const { return wrong_code_; }
+  /// A state byte; one that is no state reads as FAULT and is recorded.
+  State state() {
+    const std::uint8_t b = u8();
+    if (auto s = state_of(b)) return *s;
+    if (ok_ && !bad_state_) bad_state_ = b;
+    return State::fault;
+  }
+  /// The first state byte that was no state.
+  const std::optional<std::uint8_t>& bad_state() const { return bad_state_; }
 
  private:
   bool have(std::size_t n) {
@@ -128,12 +142,8 @@ class Reader {
   std::size_t at_;
   bool ok_ = true;
   std::optional<std::string> wrong_code_;
+  std::optional<std::uint8_t> bad_state_;
 };
-
-std::optional<State> state_of(std::uint8_t b) {
-  if (b > 3) return std::nullopt;
-  return static_cast<State>(b);
-}
 
 Item error(ErrorKind kind, ByteView packet, std::string detail, std::string_view context) {
   return DecodeError{kind, Bytes(packet.begin(), packet.end()), std::move(detail),
@@ -324,29 +334,34 @@ Bytes encode_prefixed(const Message& m, Version version) {
 
 namespace {
 
-Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view name) {
-  Reader r(packet);
-  std::optional<Message> m;
-  std::optional<std::uint8_t> bad_state;
-  auto read_state = [&]() {
-    const std::uint8_t b = r.u8();
-    if (auto s = state_of(b)) return *s;
-    if (r.ok() && !bad_state) bad_state = b;
-    return State::fault;
-  };
+Map read_map(Reader& r) {
+  Map map;
+  map.width = static_cast<std::int8_t>(r.u8());
+  map.height = static_cast<std::int8_t>(r.u8());
+  // Every row and cell read takes bytes or fails, so the loops end
+  // with the packet whatever the counts claim.
+  const std::size_t rows = r.be32();
+  for (std::size_t i = 0; i < rows && r.ok(); ++i) {
+    const std::size_t cells = r.be32();
+    std::vector<std::int8_t> row;
+    for (std::size_t j = 0; j < cells && r.ok(); ++j)
+      row.push_back(static_cast<std::int8_t>(r.u8()));
+    map.rows.push_back(std::move(row));
+  }
+  return map;
+}
+
+/// The message of a packet of `code` (not AUTH), read field by field;
+/// nullopt for a code that has no packet.
+std::optional<Message> read_message(Reader& r, Version version, std::uint8_t code) {
   const bool v2019 = version == Version::v2019;
   switch (code) {
-    case kAuth: {
-      return Frame<Message>{Auth{Bytes(packet.begin() + 1, packet.end())},
-                            Bytes(packet.begin(), packet.end()), std::nullopt};
-    }
     case kAuthReply: {
       AuthReply a;
       a.device_code = r.u8();
       a.device_id = r.u8();
-      a.state = read_state();
-      m = a;
-      break;
+      a.state = r.state();
+      return a;
     }
     case kTask: {
       Task t;
@@ -355,8 +370,7 @@ Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view
       const std::size_t n = r.u8();
       for (std::size_t i = 0; i < n && r.ok(); ++i)
         t.params.push_back(static_cast<std::int32_t>(r.le32()));
-      m = t;
-      break;
+      return t;
     }
     case kSet: {
       if (v2019) {
@@ -364,63 +378,40 @@ Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view
         s.coi = r.u8();
         for (auto& v : s.values)
           v = static_cast<std::int32_t>(r.le32());
-        m = s;
-      } else {
-        Set s;
-        for (auto& v : s.values)
-          v = r.real();
-        m = s;
+        return s;
       }
-      break;
+      Set s;
+      for (auto& v : s.values)
+        v = r.real();
+      return s;
     }
     case kAnswer: {
       Answer a;
       if (v2019) a.coi = r.u8();
       a.code = r.u8();
-      m = a;
-      break;
+      return a;
     }
     case kSix: {
-      if (!v2019) {
-        m = SetRequest{};
-        break;
-      }
+      if (!v2019) return SetRequest{};
       Data d;
-      d.state = read_state();
+      d.state = r.state();
       d.timestamp_ms = r.be32();
       d.encoder = static_cast<std::int32_t>(r.coded_u32(1));
       d.steering = r.coded_real(2);
       d.motor_battery = r.coded_u32(3);
       d.computer_battery = r.coded_u32(4);
-      m = d;
-      break;
+      return d;
     }
-    case kMap: {
-      Map map;
-      map.width = static_cast<std::int8_t>(r.u8());
-      map.height = static_cast<std::int8_t>(r.u8());
-      // Every row and cell read takes bytes or fails, so the loops end
-      // with the packet whatever the counts claim.
-      const std::size_t rows = r.be32();
-      for (std::size_t i = 0; i < rows && r.ok(); ++i) {
-        const std::size_t cells = r.be32();
-        std::vector<std::int8_t> row;
-        for (std::size_t j = 0; j < cells && r.ok(); ++j)
-          row.push_back(static_cast<std::int8_t>(r.u8()));
-        map.rows.push_back(std::move(row));
-      }
-      m = map;
-      break;
-    }
+    case kMap:
+      return read_map(r);
     case kLowFreq: {
       LowFreqData d;
-      d.state = read_state();
+      d.state = r.state();
       d.timestamp_ms = r.be32();
       d.motor_battery = r.coded_u32(1);
       d.computer_battery = r.coded_u32(2);
       d.temperature = r.coded_real(3);
-      m = d;
-      break;
+      return d;
     }
     case kHighFreq: {
       HighFreqData d;
@@ -430,18 +421,28 @@ Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view
       d.x = r.coded_real(3);
       d.y = r.coded_real(4);
       d.angle = r.coded_real(5);
-      m = d;
-      break;
+      return d;
     }
     case kControl: {
       Control c;
       c.x_axis = r.coded_real(1);
       c.y_axis = r.coded_real(2);
-      m = c;
-      break;
+      return c;
     }
-    default:  // decode_packet names only the codes above
-      return error(ErrorKind::unknown_code, packet, "packet code " + std::to_string(code), name);
+    default:
+      return std::nullopt;
+  }
+}
+
+Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view name) {
+  if (code == kAuth) {
+    return Frame<Message>{Auth{Bytes(packet.begin() + 1, packet.end())},
+                          Bytes(packet.begin(), packet.end()), std::nullopt};
+  }
+  Reader r(packet);
+  const std::optional<Message> m = read_message(r, version, code);
+  if (!m) {  // decode_packet names only the codes read_message reads
+    return error(ErrorKind::unknown_code, packet, "packet code " + std::to_string(code), name);
   }
   if (!r.ok()) {
     return error(ErrorKind::bad_format, packet,
@@ -458,9 +459,9 @@ Item parse(ByteView packet, Version version, std::uint8_t code, std::string_view
   if (r.wrong_code()) {
     return error(ErrorKind::bad_format, packet, std::string(name) + ": " + *r.wrong_code(), name);
   }
-  if (bad_state) {
+  if (r.bad_state()) {
     return error(ErrorKind::bad_value, packet,
-                 std::string(name) + ": state " + std::to_string(*bad_state) +
+                 std::string(name) + ": state " + std::to_string(*r.bad_state()) +
                      " is none of 0 FAULT, 1 RUN, 2 STOP, 3 WAIT",
                  name);
   }

@@ -168,11 +168,11 @@ using Item = DecodeItem<Message>;
 /// shorter or longer than its layout bad_format, a state above 3 bad_value.
 Item decode_packet(ByteView packet, Version version);
 
-/// Incremental decoder of one direction of a real program's stream: the
-/// length byte frames each packet (LengthPrefixSplitter) and the packet is
-/// then parsed as `version` lays it out. An item's raw bytes include its
-/// length byte. Any chunking gives the same items; every byte is in exactly
-/// one; holds at most 128 bytes; never throws. This is how hil reads such a
+/// The stream decoder (its contract: protocol/common/decode.hpp) of one
+/// direction of a real program's stream: the length byte frames each
+/// packet (LengthPrefixSplitter) and the packet is then parsed as `version`
+/// lays it out. An item's raw bytes include its length byte; it holds at
+/// most 128 bytes. This is how hil reads such a
 /// stream (wire logs, captures, faults, clients); the real programs read
 /// theirs differently (svgui_receiver.hpp).
 class Decoder {
