@@ -67,8 +67,8 @@ std::string_view motion_word(ArduinoMotion motion) {
 }  // namespace
 
 ArduinoFirmware::ArduinoFirmware(sim::World& world, sim::Vehicle& vehicle, ArduinoConfig config)
-    : Firmware(world, vehicle),
-      config_(validated(std::move(config))),
+    : FirmwareWith(world, vehicle, "arduino", arduino::to_string(config.dialect),
+                   validated(config)),
       chassis_(differential_chassis_of(vehicle, "ArduinoFirmware")),
       decoder_(decoder_options(config_)) {
   boot(world.time());

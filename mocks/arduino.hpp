@@ -87,21 +87,14 @@ struct ArduinoState {
   std::optional<std::uint8_t> last_seq;
 };
 
-class ArduinoFirmware final : public Firmware {
+class ArduinoFirmware final : public FirmwareWith<ArduinoConfig, ArduinoState> {
  public:
   /// Throws std::invalid_argument when the vehicle has no differential
   /// chassis or a config value is out of its range.
   ArduinoFirmware(sim::World& world, sim::Vehicle& vehicle, ArduinoConfig config = {});
 
-  std::string_view protocol() const override { return "arduino"; }
-  /// Frames the link by this robot's profile (its dialect).
-  std::string_view profile() const override {
-    return hil::protocol::arduino::to_string(config_.dialect);
-  }
   std::string summary() const override;
 
-  const ArduinoState& state() const { return state_; }
-  const ArduinoConfig& config() const { return config_; }
   bool moving() const { return state_.motion != ArduinoMotion::idle; }
 
   /// The STATUS answer at `now` in the configured dialect.
@@ -146,13 +139,11 @@ class ArduinoFirmware final : public Firmware {
   std::string sketch_status(Time now) const;
   std::string sketch_ir() const;
 
-  ArduinoConfig config_;
   sim::DifferentialChassis& chassis_;
   protocol::arduino::Decoder decoder_;
   std::vector<protocol::arduino::Item> items_;
   protocol::arduino::SketchReceiver sketch_;
   std::vector<protocol::arduino::SketchFrame> sketch_frames_;
-  ArduinoState state_;
   Time last_tick_{0};
   protocol::Bytes last_request_;
   std::string last_answer_;

@@ -19,14 +19,6 @@ std::string_view action_name(const Action& action) {
                     action);
 }
 
-bool kind_matches(std::string_view pattern, std::string_view kind) {
-  if (pattern.empty()) return true;
-  if (kind.size() < pattern.size() || kind.substr(0, pattern.size()) != pattern) return false;
-  if (kind.size() == pattern.size()) return true;
-  const char next = kind[pattern.size()];
-  return next == ':' || next == '.';
-}
-
 void Script::arm(Behaviour behaviour) {
   ++armed_;
   if (behaviour.name.empty()) behaviour.name = "#" + std::to_string(armed_);

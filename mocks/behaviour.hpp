@@ -13,6 +13,7 @@
 #include "link/byte_pipe.hpp"
 #include "link/time.hpp"
 #include "protocol/common/bytes.hpp"
+#include "protocol/common/text.hpp"
 
 namespace hil::mocks {
 
@@ -93,8 +94,8 @@ struct Behaviour {
 std::string_view action_name(const Action& action);
 
 /// Kind-prefix matching by whole ':'- or '.'-separated parts, as fault rules
-/// match: "MV" matches "MV" and "MV:FWD", not "MVX"; empty matches all.
-bool kind_matches(std::string_view pattern, std::string_view kind);
+/// match (protocol/common/text.hpp).
+using protocol::kind_matches;
 
 /// What a firmware does with one command, after the armed behaviours had
 /// their say.

@@ -40,7 +40,9 @@ Time next_grid_point(Time now, Duration period) {
   return (now / period + 1) * period;
 }
 
-Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle) : world_(world), vehicle_(vehicle) {}
+Firmware::Firmware(sim::World& world, sim::Vehicle& vehicle, std::string_view protocol,
+                   std::string_view profile)
+    : world_(world), vehicle_(vehicle), protocol_(protocol), profile_(profile) {}
 
 Firmware::~Firmware() = default;
 

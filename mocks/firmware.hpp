@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "link/byte_pipe.hpp"
 #include "link/protocol_adapter.hpp"
@@ -57,16 +58,19 @@ struct FirmwareStats {
 class Firmware {
  public:
   /// The vehicle must live in `world`; both must outlive the firmware.
-  Firmware(sim::World& world, sim::Vehicle& vehicle);
+  /// `protocol` and `profile` name what it plays (protocol(), profile());
+  /// both are static strings.
+  Firmware(sim::World& world, sim::Vehicle& vehicle, std::string_view protocol,
+           std::string_view profile = {});
   virtual ~Firmware();
   Firmware(const Firmware&) = delete;
   Firmware& operator=(const Firmware&) = delete;
 
   /// "logi", "wr8", "arduino" or "leka".
-  virtual std::string_view protocol() const = 0;
+  std::string_view protocol() const { return protocol_; }
   /// The car profile it plays (protocol/common/car_profile.hpp); empty: the
   /// car's default.
-  virtual std::string_view profile() const { return {}; }
+  std::string_view profile() const { return profile_; }
   /// How a link in front of this firmware frames its bytes (fault rules,
   /// captures): protocol_adapter(protocol(), profile()) unless the
   /// firmware's own settings change the framing (a WR8 byte layout).
@@ -169,6 +173,8 @@ class Firmware {
   };
   void release_delayed(Time now);
 
+  std::string_view protocol_;
+  std::string_view profile_;
   Script script_;
   std::function<void()> wakeup_changed_;
   FirmwareStats stats_;
@@ -180,6 +186,24 @@ class Firmware {
   std::optional<Time> muted_until_;
   bool connected_ = false;
   bool fault_ = false;
+};
+
+/// A firmware with its settings (`Config`, fixed when it is made) and the
+/// state it keeps (`State`), and their accessors.
+template <class Config, class State>
+class FirmwareWith : public Firmware {
+ public:
+  const Config& config() const { return config_; }
+  const State& state() const { return state_; }
+
+ protected:
+  /// `config` is already checked.
+  FirmwareWith(sim::World& world, sim::Vehicle& vehicle, std::string_view protocol,
+               std::string_view profile, Config config)
+      : Firmware(world, vehicle, protocol, profile), config_(std::move(config)) {}
+
+  Config config_;
+  State state_;
 };
 
 }  // namespace hil::mocks

@@ -84,8 +84,7 @@ std::string hex_rgb(const Rgb& c) {
 }  // namespace
 
 LekaFirmware::LekaFirmware(sim::World& world, sim::Vehicle& vehicle, LekaConfig config)
-    : Firmware(world, vehicle),
-      config_(checked(config)),
+    : FirmwareWith(world, vehicle, "leka", leka::to_string(config.dialect), checked(config)),
       chassis_(differential_chassis_of(vehicle, "LekaFirmware", "use sim::leka_robot()")),
       decoder_(decoder_options(config_)) {
   state_.belt.assign(std::size_t{config_.max_belt_led_id} + 1, kOff);

@@ -104,21 +104,13 @@ struct LekaState {
   LekaCounters counters;
 };
 
-class LekaFirmware final : public Firmware {
+class LekaFirmware final : public FirmwareWith<LekaConfig, LekaState> {
  public:
   /// Throws std::invalid_argument when the vehicle has no differential
   /// chassis or a config value is out of its range.
   LekaFirmware(sim::World& world, sim::Vehicle& vehicle, LekaConfig config = {});
 
-  std::string_view protocol() const override { return "leka"; }
-  /// Frames the link by this robot's profile (its dialect).
-  std::string_view profile() const override {
-    return hil::protocol::leka::to_string(config_.dialect);
-  }
   std::string summary() const override;
-
-  const LekaState& state() const { return state_; }
-  const LekaConfig& config() const { return config_; }
 
   /// The info line as the robot would send it now.
   std::string info_text() const;
@@ -152,13 +144,11 @@ class LekaFirmware final : public Firmware {
   void end_behaviour(bool interrupted);
   void play_behaviour(Time at);
 
-  LekaConfig config_;
   sim::DifferentialChassis& chassis_;
   protocol::leka::Decoder decoder_;
   std::vector<protocol::leka::Item> items_;
   Bytes serial_;  // received, not yet handed to the parser
   Bytes held_;    // the bytes the parser holds (a partial frame or garbage)
-  LekaState state_;
   // The LEDs as the commands set them; a behaviour shows its own pattern
   // over them and they come back when it ends.
   std::array<protocol::leka::Rgb, 2> base_ears_{};

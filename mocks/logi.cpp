@@ -108,8 +108,7 @@ std::string_view to_string(LogiRunEnd end) {
 }
 
 LogiFirmware::LogiFirmware(sim::World& world, sim::Vehicle& vehicle, LogiConfig config)
-    : Firmware(world, vehicle),
-      config_(checked(config)),
+    : FirmwareWith(world, vehicle, "logi", logi::to_string(config.dialect), checked(config)),
       chassis_(mecanum_of(vehicle)),
       decoder_(
           logi::DecoderOptions{logi::kDefaultMaxFrameBytes, config_.accept_lowercase_checksum}) {

@@ -97,21 +97,14 @@ struct LogiState {
   LogiRunEnd last_run_end = LogiRunEnd::none;
 };
 
-class LogiFirmware final : public Firmware {
+class LogiFirmware final : public FirmwareWith<LogiConfig, LogiState> {
  public:
   /// Throws std::invalid_argument when the vehicle has no mecanum chassis
   /// or a config value is out of its range.
   LogiFirmware(sim::World& world, sim::Vehicle& vehicle, LogiConfig config = {});
 
-  std::string_view protocol() const override { return "logi"; }
-  /// Frames the link by this car's profile.
-  std::string_view profile() const override {
-    return hil::protocol::logi::to_string(config_.dialect);
-  }
   std::string summary() const override;
 
-  const LogiState& state() const { return state_; }
-  const LogiConfig& config() const { return config_; }
   /// The STAT message the car would send now, from the last sensor reads.
   protocol::logi::Status status() const;
 
@@ -150,11 +143,9 @@ class LogiFirmware final : public Firmware {
   bool active() const;
   Time grid_after(Time now, Duration period) const;
 
-  LogiConfig config_;
   sim::MecanumChassis& chassis_;
   protocol::logi::Decoder decoder_;
   std::vector<protocol::logi::Item> items_;
-  LogiState state_;
   Time next_stat_{0};
   Time next_control_{0};
   bool control_scheduled_ = false;      // next_control_ was handed out by next_tick()

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "base/duration.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
@@ -55,10 +56,6 @@ wr8::Word word_of(double value, wr8::ValueType type, std::size_t size_bytes = 4)
   return wr8::Word{static_cast<std::uint32_t>(v) & mask};
 }
 
-std::string seconds_text(Duration d) {
-  return protocol::fixed_decimals(sim::to_seconds(d), 3) + " s";
-}
-
 }  // namespace
 
 Duration wrong_auth_delay(const Wr8Config& config, std::uint64_t failures_in_a_row) {
@@ -81,8 +78,7 @@ std::string_view to_string(Wr8Session session) {
 }
 
 Wr8Firmware::Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config config)
-    : Firmware(world, vehicle),
-      config_(std::move(config)),
+    : FirmwareWith(world, vehicle, "wr8", {}, std::move(config)),
       chassis_(ackermann_chassis_of(vehicle, "Wr8Firmware", "use sim::wr8_vehicle()")),
       decoder_(decoder_options(config_)) {
   require_config("Wr8Config", config_.data_period > Duration::zero(),
@@ -345,7 +341,7 @@ void Wr8Firmware::refuse(Time now) {
   say("wr8: login refused (AUTH **********): failed login " +
       std::to_string(state_.auth_failures_in_a_row) + " in a row, " +
       std::to_string(state_.auth_failures) + " in all; closing the connection in " +
-      seconds_text(delay) + ", nothing answered until then");
+      hil::seconds_text(delay, 3) + ", nothing answered until then");
 }
 
 void Wr8Firmware::say(const std::string& line) const {

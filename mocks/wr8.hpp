@@ -149,21 +149,18 @@ struct Wr8State {
 
 /// The WR8 vehicle: a TCP server that authenticates its GUI, streams DATA and
 /// runs tasks on an Ackermann chassis under a PID distance controller.
-class Wr8Firmware final : public Firmware {
+class Wr8Firmware final : public FirmwareWith<Wr8Config, Wr8State> {
  public:
   /// Throws std::invalid_argument when the vehicle has no Ackermann chassis
   /// or the config cannot work (a period not positive, an invalid profile).
   Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config config = {});
 
-  std::string_view protocol() const override { return "wr8"; }
   /// Frames the link by this vehicle's profile (byte order, block sizes, DATA table).
   std::shared_ptr<const link::ProtocolAdapter> adapter() const override {
     return link::wr8_adapter(config_.profile);
   }
   std::string summary() const override;
 
-  const Wr8State& state() const { return state_; }
-  const Wr8Config& config() const { return config_; }
   /// The state code DATA and AUTH-REPLY would carry now.
   protocol::wr8::State state_code() const;
   /// The DATA packet the vehicle would send at `now` (what on_tick sends).
@@ -204,11 +201,9 @@ class Wr8Firmware final : public Firmware {
   void task_failed(std::uint8_t coi);
   void task_completed(std::uint8_t coi);
 
-  Wr8Config config_;
   sim::AckermannChassis& chassis_;
   protocol::wr8::Decoder decoder_;
   std::vector<protocol::wr8::Item> items_;
-  Wr8State state_;
 };
 
 /// The close delay after the `failures_in_a_row`-th failed login in a row

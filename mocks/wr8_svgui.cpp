@@ -83,6 +83,12 @@ bool covers(const sim::Obstacle& obstacle, sim::Vec2 p) {
   return std::hypot(p.x_m - circle.center_m.x_m, p.y_m - circle.center_m.y_m) <= circle.radius_m;
 }
 
+/// The profile of the version `config` plays; empty without one (which
+/// SvguiConfig::checked() refuses).
+std::string_view profile_of_config(const SvguiConfig& config) {
+  return config.version ? svgui::profile_of(*config.version) : std::string_view{};
+}
+
 }  // namespace
 
 std::string_view to_string(SvguiState::Task task) {
@@ -128,8 +134,7 @@ SvguiConfig SvguiConfig::checked() const {
 }
 
 SvguiFirmware::SvguiFirmware(sim::World& world, sim::Vehicle& vehicle, SvguiConfig config)
-    : Firmware(world, vehicle),
-      config_(config.checked()),
+    : FirmwareWith(world, vehicle, "wr8", profile_of_config(config), config.checked()),
       version_(*config_.version),
       chassis_(ackermann_chassis_of(vehicle, "SvguiFirmware", "use sim::wr8_vehicle()")),
       receiver_(version_) {
@@ -362,13 +367,23 @@ void SvguiFirmware::handle_task(Time now, ByteView packet) {
     return;
   }
   count_frame_in();
-  if (dropped_busy("TASK", coi)) return;
-  switch (dispose(now, "TASK")) {
+  // The program takes the COI before it looks at the type: a type it has
+  // no action for leaves the car busy with no answer to come.
+  run_with_coi(now, "TASK", coi, [&] { start_task(now, type, params); });
+}
+
+template <class Run>
+void SvguiFirmware::run_with_coi(Time now, std::string_view kind, std::uint8_t coi, Run run) {
+  if (state_.current_coi != 0) {
+    ++state_.dropped_busy;
+    say("wr8 svgui-2019: " + std::string(kind) + " COI " + std::to_string(coi) +
+        " dropped: busy with COI " + std::to_string(state_.current_coi));
+    return;
+  }
+  switch (dispose(now, kind)) {
     case Disposition::handle:
-      // The program takes the COI before it looks at the type: a type it
-      // has no action for leaves the car busy with no answer to come.
       state_.current_coi = coi;
-      start_task(now, type, params);
+      run();
       break;
     case Disposition::reject:
       send_message(svgui::Answer{coi, 0});
@@ -376,15 +391,7 @@ void SvguiFirmware::handle_task(Time now, ByteView packet) {
     case Disposition::ignore:
       break;
   }
-  frame_handled(now, "TASK");
-}
-
-bool SvguiFirmware::dropped_busy(std::string_view kind, std::uint8_t coi) {
-  if (state_.current_coi == 0) return false;
-  ++state_.dropped_busy;
-  say("wr8 svgui-2019: " + std::string(kind) + " COI " + std::to_string(coi) +
-      " dropped: busy with COI " + std::to_string(state_.current_coi));
-  return true;
+  frame_handled(now, kind);
 }
 
 void SvguiFirmware::start_task(Time now, std::uint8_t type,
@@ -424,22 +431,12 @@ void SvguiFirmware::handle_settings(Time now, ByteView packet) {
         " bytes: the program reads its values at bytes 2, 7, 12 and 17, the last past the "
         "packet (read here as 0)");
   }
-  if (dropped_busy("SETTINGS", coi)) return;
-  switch (dispose(now, "SETTINGS")) {
-    case Disposition::handle:
-      // Busy from now on: nothing in the program ends a SETTINGS.
-      state_.current_coi = coi;
-      for (std::size_t k = 0; k < 4; ++k)
-        state_.v2019_settings[k] = le32_at(packet, 2 + 5 * k);
-      apply_steering(commanded_wheel_deg_);
-      break;
-    case Disposition::reject:
-      send_message(svgui::Answer{coi, 0});
-      break;
-    case Disposition::ignore:
-      break;
-  }
-  frame_handled(now, "SETTINGS");
+  // Busy from now on: nothing in the program ends a SETTINGS.
+  run_with_coi(now, "SETTINGS", coi, [&] {
+    for (std::size_t k = 0; k < 4; ++k)
+      state_.v2019_settings[k] = le32_at(packet, 2 + 5 * k);
+    apply_steering(commanded_wheel_deg_);
+  });
 }
 
 void SvguiFirmware::handle_head(Time now, ByteView packet) {

@@ -134,18 +134,14 @@ struct SvguiState {
 std::string_view to_string(SvguiState::Task task);
 
 /// The real vehicle program of one smart_vehicle_gui version.
-class SvguiFirmware final : public Firmware {
+class SvguiFirmware final : public FirmwareWith<SvguiConfig, SvguiState> {
  public:
   /// Throws std::invalid_argument when the vehicle has no Ackermann chassis
   /// or the config cannot work (SvguiConfig::checked()).
   SvguiFirmware(sim::World& world, sim::Vehicle& vehicle, SvguiConfig config);
 
-  std::string_view protocol() const override { return "wr8"; }
-  std::string_view profile() const override { return svgui::profile_of(version_); }
   std::string summary() const override;
 
-  const SvguiState& state() const { return state_; }
-  const SvguiConfig& config() const { return config_; }
   svgui::Version version() const { return version_; }
 
   /// What the DATA packets would carry at `now`.
@@ -174,9 +170,12 @@ class SvguiFirmware final : public Firmware {
   void handle_head(Time now, ByteView packet);
   void handle_task(Time now, ByteView packet);
   void handle_settings(Time now, ByteView packet);
-  /// v2019: a TASK or SETTINGS that comes while a COI is in progress is
-  /// dropped without a word (true); false while the car is idle.
-  bool dropped_busy(std::string_view kind, std::uint8_t coi);
+  /// v2019 TASK or SETTINGS `kind` with `coi`: dropped without a word while
+  /// another COI is in progress; else, unless a behaviour rejects it (an
+  /// ANSWER of code 0) or ignores it, the car is busy with `coi` from now on
+  /// and `run` acts on it.
+  template <class Run>
+  void run_with_coi(Time now, std::string_view kind, std::uint8_t coi, Run run);
   void start_task(Time now, std::uint8_t type, const std::vector<std::int32_t>& params);
   void finish_task(std::uint8_t code);
   void task_step(Time now);
@@ -188,11 +187,9 @@ class SvguiFirmware final : public Firmware {
   void send_message(const svgui::Message& message);
   void say(const std::string& line) const;
 
-  SvguiConfig config_;
   svgui::Version version_;
   sim::AckermannChassis& chassis_;
   svgui::ProgramReceiver receiver_;
-  SvguiState state_;
   double commanded_wheel_deg_ = 0;
 };
 

@@ -24,18 +24,7 @@ void AckermannChassis::set_steering_target(double angle_rad) {
 
 void AckermannChassis::drive_distance(double distance_m, double speed_mps) {
   goal_m_ = distance_m;
-  last_goal_remaining_m_ = distance_m;
   goal_speed_mps_ = std::clamp(std::abs(speed_mps), 0.0, def_.max_speed_mps);
-}
-
-double AckermannChassis::distance_remaining_m() const {
-  return goal_m_ ? *goal_m_ : last_goal_remaining_m_;
-}
-
-double AckermannChassis::turning_radius_m() const {
-  const double t = std::tan(steering_rad_);
-  if (t == 0) return std::numeric_limits<double>::infinity();
-  return def_.wheelbase_m / t;
 }
 
 Twist AckermannChassis::update(double dt_s) {
@@ -58,7 +47,6 @@ Twist AckermannChassis::update(double dt_s) {
   if (goal_m_) {
     const double before = *goal_m_;
     *goal_m_ -= step_m;
-    last_goal_remaining_m_ = *goal_m_;
     // Done once the wheels have covered the distance to a tenth of a
     // millimetre, or have just rolled past it.
     if (std::abs(*goal_m_) < 1e-4 || (before > 0) != (*goal_m_ > 0)) {

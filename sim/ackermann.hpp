@@ -38,16 +38,12 @@ class AckermannChassis final : public Chassis {
   void drive_distance(double distance_m, double speed_mps);
   /// True while a distance goal is being driven.
   bool driving_distance() const { return goal_m_.has_value(); }
-  /// Distance of the current (or last) goal still to go, metres.
-  double distance_remaining_m() const;
 
   double speed_mps() const { return speed_mps_; }
   double steering_rad() const { return steering_rad_; }
   double steering_target_rad() const { return steering_target_rad_; }
   /// Distance the wheels have rolled, forwards and backwards added up.
   double odometer_m() const { return odometer_m_; }
-  /// Turning radius of the rear axle's midpoint now (infinite when straight).
-  double turning_radius_m() const;
 
   const AckermannDef& def() const { return def_; }
 
@@ -67,7 +63,6 @@ class AckermannChassis final : public Chassis {
   double odometer_m_ = 0;
   std::optional<double> goal_m_;  ///< signed distance still to go
   double goal_speed_mps_ = 0;
-  double last_goal_remaining_m_ = 0;
 };
 
 }  // namespace hil::sim

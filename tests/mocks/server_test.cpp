@@ -15,8 +15,7 @@ using link::milliseconds;
 // Echoes every byte as "E<byte>" and sends "T" every 100 ms while connected.
 class EchoFirmware final : public Firmware {
  public:
-  using Firmware::Firmware;
-  std::string_view protocol() const override { return "raw"; }
+  EchoFirmware(sim::World& world, sim::Vehicle& vehicle) : Firmware(world, vehicle, "raw") {}
   std::string summary() const override { return "echo"; }
   int connects = 0;
   int disconnects = 0;
