@@ -1,6 +1,7 @@
 #pragma once
-// Writes a report file so that a reader (CI, a person, a crash) sees either
-// the old file or the whole new one, never a half-written one.
+// Writes a file (a report, JUnit XML, hil mock's list of ports) so that a
+// reader (CI, a person, a script, a crash) sees either the old file or the
+// whole new one, never a half-written one.
 
 #include <string>
 #include <string_view>

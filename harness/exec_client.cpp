@@ -94,29 +94,22 @@ std::optional<ClientLine> event_line(std::string_view rest) {
     line.record_data["state"] = std::string(state);
     return line;
   }
-  if (what == "notice" && !args.empty()) {
-    line.record_kind = "notice";
+  if ((what == "notice" || what == "parse_error") && !args.empty()) {
+    line.record_kind = std::string(what);
     line.record_data["text"] = std::string(args);
     return line;
   }
-  if (what == "parse_error" && !args.empty()) {
-    line.record_kind = "parse_error";
-    line.record_data["text"] = std::string(args);
-    return line;
-  }
-  if (what == "movement") {
-    const auto [state, reason] = first_word(args);
-    if (state != "enabled" && state != "disabled") return std::nullopt;
+  // `movement enabled|disabled REASON`, `login ok|failed [REASON]`.
+  const auto [word, reason] = first_word(args);
+  if (what == "movement" && one_of(word, {"enabled", "disabled"})) {
     line.record_kind = "movement";
-    line.record_data["enabled"] = state == "enabled";
+    line.record_data["enabled"] = word == "enabled";
     line.record_data["reason"] = std::string(reason);
     return line;
   }
-  if (what == "login") {
-    const auto [result, reason] = first_word(args);
-    if (result != "ok" && result != "failed") return std::nullopt;
+  if (what == "login" && one_of(word, {"ok", "failed"})) {
     line.record_kind = "login";
-    line.record_data["ok"] = result == "ok";
+    line.record_data["ok"] = word == "ok";
     if (!reason.empty()) line.record_data["reason"] = std::string(reason);
     return line;
   }
