@@ -52,33 +52,6 @@ Examples:
   hil decode arduino --profile readme --firmware -f capture.bin  the 96-byte frame bound
   hil decode arduino --hex '5E 30 37 7C 53 7C 20 2A 37 34 24')";
 
-// Decimal 0..255, or 0x00..0xFF.
-std::optional<std::uint8_t> parse_seq(const std::string& text) {
-  if (text.empty() || text.size() > 4) return std::nullopt;
-  int base = 10;
-  std::string digits = text;
-  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
-    base = 16;
-    digits = text.substr(2);
-  }
-  int value = 0;
-  for (const char c : digits) {
-    int d = 0;
-    if (c >= '0' && c <= '9') {
-      d = c - '0';
-    } else if (base == 16 && c >= 'a' && c <= 'f') {
-      d = c - 'a' + 10;
-    } else if (base == 16 && c >= 'A' && c <= 'F') {
-      d = c - 'A' + 10;
-    } else {
-      return std::nullopt;
-    }
-    value = value * base + d;
-  }
-  if (value > 255) return std::nullopt;
-  return static_cast<std::uint8_t>(value);
-}
-
 std::string upper(std::string text) {
   for (char& c : text)
     c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -131,7 +104,7 @@ int run_encode(const ArduinoEncodeArgs& args, bool body_given, bool seq_given) {
     if (args.words.empty()) {
       return fail("give a command, e.g. 'V 160', 'V:160', 'ACK OK' (see --help)");
     }
-    const auto seq = parse_seq(args.seq);
+    const auto seq = parse_byte_text(args.seq, 4);  // up to 0xFF
     if (!seq) {
       return fail("--seq '" + args.seq + "' is not 0..255 in decimal or 0x00..0xFF in hex");
     }

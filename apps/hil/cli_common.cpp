@@ -56,6 +56,32 @@ protocol::Bytes read_decode_input(const DecodeInput& input, bool binary) {
   return bytes;
 }
 
+std::optional<std::uint8_t> parse_byte_text(std::string_view text, std::size_t max_chars) {
+  if (text.empty() || text.size() > max_chars) return std::nullopt;
+  unsigned base = 10;
+  std::string_view digits = text;
+  if (digits.size() > 2 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
+    base = 16;
+    digits.remove_prefix(2);
+  }
+  unsigned value = 0;
+  for (const char c : digits) {
+    unsigned d = 0;
+    if (c >= '0' && c <= '9') {
+      d = static_cast<unsigned>(c - '0');
+    } else if (base == 16 && c >= 'a' && c <= 'f') {
+      d = static_cast<unsigned>(c - 'a' + 10);
+    } else if (base == 16 && c >= 'A' && c <= 'F') {
+      d = static_cast<unsigned>(c - 'A' + 10);
+    } else {
+      return std::nullopt;
+    }
+    value = value * base + d;
+  }
+  if (value > 255) return std::nullopt;
+  return static_cast<std::uint8_t>(value);
+}
+
 std::string render_bytes(protocol::ByteView bytes, bool binary) {
   return binary ? protocol::to_hex(bytes) : protocol::escape(bytes);
 }

@@ -6,7 +6,9 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -30,6 +32,11 @@ void add_decode_input(CLI::App& cmd, DecodeInput& input, bool binary);
 /// The bytes to decode. Throws CLI::ValidationError with a precise message
 /// when the input is unreadable or bad hex.
 protocol::Bytes read_decode_input(const DecodeInput& input, bool binary);
+
+/// A byte written in decimal (0..255) or as 0x and hex digits ("0x2A");
+/// nullopt for anything else, or for text of more than `max_chars`
+/// characters (leading zeros count).
+std::optional<std::uint8_t> parse_byte_text(std::string_view text, std::size_t max_chars);
 
 /// How a protocol renders bytes for a person: text protocols as escaped
 /// text, binary ones as spaced uppercase hex.

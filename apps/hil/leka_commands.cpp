@@ -70,33 +70,6 @@ bad_value (id or spin out of range), oversized (length over the frame bound),
 unknown_code (unknown command id), truncated (stream ended inside a frame).
 )";
 
-// A byte written in decimal or 0x hex.
-std::optional<std::uint8_t> parse_byte(const std::string& text) {
-  if (text.empty() || text.size() > 5) return std::nullopt;
-  int base = 10;
-  std::string_view digits = text;
-  if (digits.size() > 2 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
-    base = 16;
-    digits.remove_prefix(2);
-  }
-  unsigned value = 0;
-  for (const char c : digits) {
-    unsigned d = 0;
-    if (c >= '0' && c <= '9') {
-      d = static_cast<unsigned>(c - '0');
-    } else if (base == 16 && c >= 'a' && c <= 'f') {
-      d = static_cast<unsigned>(c - 'a' + 10);
-    } else if (base == 16 && c >= 'A' && c <= 'F') {
-      d = static_cast<unsigned>(c - 'A' + 10);
-    } else {
-      return std::nullopt;
-    }
-    value = value * static_cast<unsigned>(base) + d;
-  }
-  if (value > 255) return std::nullopt;
-  return static_cast<std::uint8_t>(value);
-}
-
 // The words of the command line as a command group; throws
 // std::invalid_argument with a message for the user.
 leka::CommandGroup parse_words(const std::vector<std::string>& words, leka::Dialect dialect) {
@@ -132,7 +105,7 @@ leka::CommandGroup parse_words(const std::vector<std::string>& words, leka::Dial
     }
     protocol::Bytes data;
     for (std::size_t k = i + 1; k < end; ++k) {
-      const auto b = parse_byte(words[k]);
+      const auto b = parse_byte_text(words[k], 5);  // "00255", "0x0FF" at the longest
       if (!b) {
         throw std::invalid_argument(std::string(spec->name) + " value " + std::to_string(k - i) +
                                     " '" + words[k] + "' is not a byte 0..255 (decimal or 0x hex)");

@@ -17,6 +17,8 @@
 #include <thread>
 
 #include "apps/hil/cli_common.hpp"
+#include "base/duration.hpp"
+#include "config/error.hpp"
 #include "harness/atomic_file.hpp"
 #include "harness/exec_client.hpp"
 #include "harness/report.hpp"
@@ -166,26 +168,25 @@ ScenarioOutcome load_failure(const Planned& p, const RunArgs& args) {
   return o;
 }
 
-int run_scenarios(const RunArgs& args) {
+// The --set values by name; nullopt (and a message) for one without '='.
+std::optional<std::map<std::string, std::string>> variable_overrides(const RunArgs& args) {
   std::map<std::string, std::string> overrides;
   for (const auto& s : args.sets) {
     const auto eq = s.find('=');
     if (eq == std::string::npos || eq == 0) {
       std::cerr << "hil run: --set " << s << ": expected name=value\n";
-      return 2;
+      return std::nullopt;
     }
     overrides[s.substr(0, eq)] = s.substr(eq + 1);
   }
-  const auto files = find_files(args);
-  if (!files) return 2;
-  if (files->empty()) {
-    std::cerr << "hil run: no scenario files (YAML with top-level car: and steps:) in "
-              << joined(args.paths, " ") << '\n';
-    return 2;
-  }
+  return overrides;
+}
 
+// Each file loaded, those without the wanted tags left out.
+std::vector<Planned> load_plan(const RunArgs& args, const std::vector<std::string>& files,
+                               const std::map<std::string, std::string>& overrides) {
   std::vector<Planned> plan;
-  for (const auto& file : *files) {
+  for (const auto& file : files) {
     Planned p{file, std::nullopt, {}};
     try {
       p.scenario =
@@ -203,45 +204,50 @@ int run_scenarios(const RunArgs& args) {
     // pass because a broken file was silently left out.
     plan.push_back(std::move(p));
   }
-  if (plan.empty()) {
-    std::cerr << "hil run: no scenario has the tags " << joined(args.tags)
-              << (args.exclude_tags.empty() ? "" : " without " + joined(args.exclude_tags)) << '\n';
-    return 2;
-  }
+  return plan;
+}
 
-  if (args.list) {
-    bool all_load = true;
-    for (const auto& p : plan) {
-      if (p.scenario) {
-        std::cout << p.file << "  " << p.scenario->name;
-        if (!p.scenario->tags.empty()) std::cout << "  [" << joined(p.scenario->tags) << ']';
-        std::cout << '\n';
-        // Every program a run would start, before anything is started.
-        if (const auto command = client_command(args, *p.scenario))
-          std::cout << "  client exec: " << *command << '\n';
-      } else {
-        all_load = false;
-        std::cout << p.file << "  does not load: " << p.error << '\n';
-      }
+// --list: each scenario with its tags and any program it would start.
+int list_plan(const RunArgs& args, const std::vector<Planned>& plan) {
+  bool all_load = true;
+  for (const auto& p : plan) {
+    if (p.scenario) {
+      std::cout << p.file << "  " << p.scenario->name;
+      if (!p.scenario->tags.empty()) std::cout << "  [" << joined(p.scenario->tags) << ']';
+      std::cout << '\n';
+      // Every program a run would start, before anything is started.
+      if (const auto command = client_command(args, *p.scenario))
+        std::cout << "  client exec: " << *command << '\n';
+    } else {
+      all_load = false;
+      std::cout << p.file << "  does not load: " << p.error << '\n';
     }
-    return all_load ? 0 : 1;
   }
+  return all_load ? 0 : 1;
+}
 
-  // One entry per run, in the table's order (file, then repeat); each knows
-  // its folder before it runs so the runner can put files there.
-  struct Task {
-    std::size_t plan_index;
-    std::optional<std::uint64_t> seed;
-  };
+// One run of a planned file: which, and with which seed.
+struct Task {
+  std::size_t plan_index;
+  std::optional<std::uint64_t> seed;
+};
+
+// The runs, one entry each in the table's order (file, then repeat); each
+// entry knows its folder before it runs so the runner can put files there.
+struct Batch {
   std::vector<ReportEntry> entries;
   std::vector<Task> tasks;
+};
+
+Batch make_batch(const RunArgs& args, const std::vector<Planned>& plan) {
+  Batch batch;
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const auto& p = plan[i];
     if (!p.scenario) {
       ReportEntry e;
       e.outcome = load_failure(p, args);
-      entries.push_back(std::move(e));
-      tasks.push_back(Task{i, std::nullopt});
+      batch.entries.push_back(std::move(e));
+      batch.tasks.push_back(Task{i, std::nullopt});
       continue;
     }
     const std::optional<std::uint64_t> base = args.seed ? args.seed : p.scenario->seed;
@@ -251,74 +257,104 @@ int run_scenarios(const RunArgs& args) {
       e.outcome.name = p.scenario->name;
       e.repeat = r;
       e.repeats = args.repeat;
-      entries.push_back(std::move(e));
-      tasks.push_back(
+      batch.entries.push_back(std::move(e));
+      batch.tasks.push_back(
           Task{i, base ? std::optional<std::uint64_t>(*base + static_cast<std::uint64_t>(r))
                        : std::nullopt});
     }
   }
-  if (!args.report_dir.empty()) harness::report_folders(entries);
+  if (!args.report_dir.empty()) harness::report_folders(batch.entries);
+  return batch;
+}
 
-  std::atomic<std::size_t> next{0};
-  std::atomic<std::size_t> done{0};
-  std::mutex progress;
-  std::set<std::string> shown_commands;  // files whose client command was printed
-  const auto worker = [&] {
-    for (std::size_t k = next++; k < tasks.size(); k = next++) {
-      const auto& p = plan[tasks[k].plan_index];
-      auto& entry = entries[k];
-      if (p.scenario) {
-        harness::RunOptions options;
-        options.seed = tasks[k].seed;
-        options.client_exec = args.client_exec;
-        // A scenario may start one program, its declared client: print the
-        // exact command line before it starts (once per scenario file).
-        options.on_client_command = [&, file = p.file](const std::string& command) {
-          const std::lock_guard lock(progress);
-          if (!shown_commands.insert(file).second) return;
-          std::cerr << "hil run: " << file << ": client exec: /bin/sh -c "
-                    << harness::shell_quote(command) << '\n';
-        };
-        if (!args.slack.empty()) options.time_slack = link::parse_duration(args.slack);
-        if (!args.report_dir.empty()) {
-          const fs::path folder = fs::path(args.report_dir) / entry.folder;
-          std::error_code ec;
-          fs::create_directories(folder, ec);
-          if (!ec) options.work_dir = folder.string();
-        }
-        ScenarioOutcome outcome;
-        try {
-          outcome = harness::run_scenario(*p.scenario, options);
-        } catch (const std::exception& e) {
-          outcome.error = std::string("the run stopped: ") + e.what();
-        }
-        if (outcome.file.empty()) outcome.file = p.file;
-        if (outcome.name.empty()) outcome.name = p.scenario->name;
-        if (outcome.tags.empty()) outcome.tags = p.scenario->tags;
-        outcome.repro_command = repro_command(args, p.file, outcome.seed);
-        entry.outcome = std::move(outcome);
-      }
-      const std::size_t finished = ++done;
-      if (args.verbose) {
-        const std::lock_guard lock(progress);
-        std::cerr << '[' << finished << '/' << tasks.size() << "] "
-                  << (entry.outcome.passed() ? "PASS " : "FAIL ") << entry.outcome.name;
-        if (entry.repeats > 1) std::cerr << " #" << entry.repeat + 1;
-        if (p.scenario) std::cerr << " (seed " << entry.outcome.seed << ')';
-        std::cerr << '\n';
-      }
+// Runs a batch on worker threads, printing what the runs start and, with
+// -v, each run as it finishes.
+class BatchRunner {
+ public:
+  BatchRunner(const RunArgs& args, const std::vector<Planned>& plan, Batch& batch)
+      : args_(args), plan_(plan), batch_(batch) {}
+
+  void run() {
+    const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
+    const std::size_t jobs = std::min<std::size_t>(
+        args_.jobs > 0 ? static_cast<std::size_t>(args_.jobs) : cores, batch_.tasks.size());
+    std::vector<std::thread> threads;
+    for (std::size_t t = 1; t < jobs; ++t)
+      threads.emplace_back([this] { work(); });
+    work();
+    for (auto& t : threads)
+      t.join();
+  }
+
+ private:
+  void work() {
+    for (std::size_t k = next_++; k < batch_.tasks.size(); k = next_++) {
+      const auto& p = plan_[batch_.tasks[k].plan_index];
+      auto& entry = batch_.entries[k];
+      if (p.scenario) entry.outcome = run_one(p, batch_.tasks[k], entry);
+      const std::size_t finished = ++done_;
+      if (args_.verbose) show_progress(finished, p, entry);
     }
-  };
-  const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
-  const std::size_t jobs = std::min<std::size_t>(
-      args.jobs > 0 ? static_cast<std::size_t>(args.jobs) : cores, tasks.size());
-  std::vector<std::thread> threads;
-  for (std::size_t t = 1; t < jobs; ++t)
-    threads.emplace_back(worker);
-  worker();
-  for (auto& t : threads)
-    t.join();
+  }
 
+  ScenarioOutcome run_one(const Planned& p, const Task& task, const ReportEntry& entry) {
+    ScenarioOutcome outcome;
+    try {
+      outcome = harness::run_scenario(*p.scenario, options(p, task, entry));
+    } catch (const std::exception& e) {
+      outcome.error = std::string("the run stopped: ") + e.what();
+    }
+    if (outcome.file.empty()) outcome.file = p.file;
+    if (outcome.name.empty()) outcome.name = p.scenario->name;
+    if (outcome.tags.empty()) outcome.tags = p.scenario->tags;
+    outcome.repro_command = repro_command(args_, p.file, outcome.seed);
+    return outcome;
+  }
+
+  harness::RunOptions options(const Planned& p, const Task& task, const ReportEntry& entry) {
+    harness::RunOptions options;
+    options.seed = task.seed;
+    options.client_exec = args_.client_exec;
+    // A scenario may start one program, its declared client: print the
+    // exact command line before it starts (once per scenario file).
+    options.on_client_command = [this, file = p.file](const std::string& command) {
+      const std::lock_guard lock(progress_);
+      if (!shown_commands_.insert(file).second) return;
+      std::cerr << "hil run: " << file << ": client exec: /bin/sh -c "
+                << harness::shell_quote(command) << '\n';
+    };
+    if (!args_.slack.empty()) options.time_slack = parse_duration(args_.slack);
+    if (!args_.report_dir.empty()) {
+      const fs::path folder = fs::path(args_.report_dir) / entry.folder;
+      std::error_code ec;
+      fs::create_directories(folder, ec);
+      if (!ec) options.work_dir = folder.string();
+    }
+    return options;
+  }
+
+  void show_progress(std::size_t finished, const Planned& p, const ReportEntry& entry) {
+    const std::lock_guard lock(progress_);
+    std::cerr << '[' << finished << '/' << batch_.tasks.size() << "] "
+              << (entry.outcome.passed() ? "PASS " : "FAIL ") << entry.outcome.name;
+    if (entry.repeats > 1) std::cerr << " #" << entry.repeat + 1;
+    if (p.scenario) std::cerr << " (seed " << entry.outcome.seed << ')';
+    std::cerr << '\n';
+  }
+
+  const RunArgs& args_;
+  const std::vector<Planned>& plan_;
+  Batch& batch_;
+  std::atomic<std::size_t> next_{0};
+  std::atomic<std::size_t> done_{0};
+  std::mutex progress_;
+  std::set<std::string> shown_commands_;  // files whose client command was printed
+};
+
+// The table on stdout, then JUnit XML and the report folder when asked
+// for. Returns the exit status: 1 when anything did not pass or a file
+// could not be written.
+int report_results(const RunArgs& args, const std::vector<ReportEntry>& entries) {
   harness::ConsoleOptions console;
   console.color = harness::want_color(STDOUT_FILENO);
   console.width = harness::terminal_width(STDOUT_FILENO, 100);
@@ -348,6 +384,28 @@ int run_scenarios(const RunArgs& args) {
     }
   }
   return status;
+}
+
+int run_scenarios(const RunArgs& args) {
+  const auto overrides = variable_overrides(args);
+  if (!overrides) return 2;
+  const auto files = find_files(args);
+  if (!files) return 2;
+  if (files->empty()) {
+    std::cerr << "hil run: no scenario files (YAML with top-level car: and steps:) in "
+              << joined(args.paths, " ") << '\n';
+    return 2;
+  }
+  const std::vector<Planned> plan = load_plan(args, *files, *overrides);
+  if (plan.empty()) {
+    std::cerr << "hil run: no scenario has the tags " << joined(args.tags)
+              << (args.exclude_tags.empty() ? "" : " without " + joined(args.exclude_tags)) << '\n';
+    return 2;
+  }
+  if (args.list) return list_plan(args, plan);
+  Batch batch = make_batch(args, plan);
+  BatchRunner(args, plan, batch).run();
+  return report_results(args, batch.entries);
 }
 
 }  // namespace
@@ -389,8 +447,8 @@ void register_run(CLI::App& app, std::function<int()>& run) {
                   "where it must not shrink by D (default 100ms in real time, 0 in virtual time)")
       ->type_name("D")
       ->check([](const std::string& text) {
-        return link::parse_duration(text) ? std::string()
-                                          : "'" + text + "' is not a duration (e.g. 100ms, 0.5s)";
+        return parse_duration(text) ? std::string()
+                                    : "'" + text + "' is not a duration (e.g. 100ms, 0.5s)";
       });
   cmd->add_option("--set", args->sets, "Set a scenario variable: name=value (repeatable)")
       ->type_name("NAME=VALUE")

@@ -1,7 +1,9 @@
 // hil encode wr8 / hil decode wr8.
 
+#include <array>
 #include <charconv>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -201,6 +203,128 @@ struct Wr8EncodeArgs {
   std::string unparsed;
 };
 
+// A code by its name, or with --unchecked any byte; else a UsageError
+// naming `what` and the `expected` names ("task 'UP': expected check, ...").
+template <class Code>
+Code named_code(std::string_view word, std::optional<Code> named, bool unchecked,
+                std::string_view byte_what, std::string_view what, std::string_view expected) {
+  if (named) return *named;
+  if (unchecked) return static_cast<Code>(parse_byte(word, byte_what));
+  throw UsageError(std::string(what) + " '" + std::string(word) + "': expected " +
+                   std::string(expected));
+}
+
+// The type of the values the profile gives code `index`; signed for a
+// code it does not know (sent with --unchecked).
+template <std::size_t N>
+wr8::ValueType value_type(const std::array<wr8::ValueType, N>& types, std::size_t index) {
+  return index < N ? types[index] : wr8::ValueType::signed_int;
+}
+
+// A message whose first word is its COI, once the words are counted.
+template <class Message>
+Message coi_message(const std::vector<std::string>& w, std::size_t min, std::size_t max,
+                    std::string_view usage) {
+  expect_count(w, min, max, usage);
+  Message m;
+  m.coi = parse_byte(w[1], "COI");
+  return m;
+}
+
+wr8::Auth auth_message(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
+  const auto& w = a.words;
+  expect_count(w, 0, 1, "[TEXT] (10 characters) or --text-hex HEX");
+  wr8::Auth m{profile.auth_text};
+  if (!a.text_hex.empty() && w.size() > 1)
+    throw UsageError("auth takes TEXT or --text-hex, not both");
+  protocol::Bytes text;
+  if (!a.text_hex.empty()) text = parse_hex_arg(a.text_hex, "--text-hex");
+  if (w.size() > 1) text = protocol::to_bytes(w[1]);
+  if (!a.text_hex.empty() || w.size() > 1) {
+    if (text.size() != wr8::kAuthTextBytes) {
+      throw UsageError("the authentication string must be exactly 10 bytes, got " +
+                       std::to_string(text.size()));
+    }
+    std::copy(text.begin(), text.end(), m.text.begin());
+  }
+  return m;
+}
+
+wr8::Task task_message(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
+  const auto& w = a.words;
+  auto m = coi_message<wr8::Task>(w, 2, 255, "COI TASK [VALUE...]");
+  m.task = named_code(w[2], wr8::parse_task(w[2]), a.unchecked, "task code", "task",
+                      "check, drive, turn, blink, get-settings or 0..4");
+  const auto index = static_cast<std::size_t>(m.task);
+  const auto type = value_type(profile.task_value_type, index);
+  for (std::size_t i = 3; i < w.size(); ++i)
+    m.params.push_back(parse_word(w[i], type, 4, "task"));
+  if (!a.unchecked && index < wr8::kTaskCount &&
+      m.params.size() != profile.task_parameter_count[index]) {
+    throw UsageError("task " + std::string(wr8::to_string(m.task)) + " takes " +
+                     std::to_string(profile.task_parameter_count[index]) + " value(s), got " +
+                     std::to_string(m.params.size()) + " (--unchecked sends it anyway)");
+  }
+  return m;
+}
+
+wr8::Settings settings_message(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
+  const auto& w = a.words;
+  auto m = coi_message<wr8::Settings>(w, 1, 255, "COI NAME=VALUE...");
+  for (std::size_t i = 2; i < w.size(); ++i) {
+    const auto [name, value] = split_assignment(w[i]);
+    const auto code = named_code(name, wr8::parse_setting(name), a.unchecked, "setting type",
+                                 "setting", "p, i, d, servo-zero or 0..3");
+    const auto type = value_type(profile.setting_value_type, static_cast<std::size_t>(code));
+    m.params.push_back(wr8::Setting{code, parse_word(value, type, 4, name)});
+  }
+  return m;
+}
+
+wr8::Response response_message(const Wr8EncodeArgs& a) {
+  const auto& w = a.words;
+  auto m = coi_message<wr8::Response>(w, 2, 2, "COI CODE");
+  m.code = named_code(w[2], wr8::parse_response(w[2]), a.unchecked, "response code",
+                      "response code", "error, started, completed or 0..2");
+  return m;
+}
+
+wr8::Data data_message(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
+  const auto& w = a.words;
+  expect_count(w, 2, 257, "STATE TIMESTAMP_MS [NAME=VALUE...]");
+  wr8::Data m;
+  m.state = parse_state_arg(w[1]);
+  m.timestamp_ms = parse_unsigned(w[2], 0xFFFFFFFFu, "timestamp");
+  for (std::size_t i = 3; i < w.size(); ++i) {
+    const auto [name, value] = split_assignment(w[i]);
+    std::string key = normalised(name);
+    if (key == "angle") key = "wheel_angle";
+    const wr8::DataParameter* p = profile.data_parameter(key);
+    if (p == nullptr && !key.empty() && key[0] >= '0' && key[0] <= '9') {
+      p = profile.data_parameter(parse_byte(key, "DATA code"));
+    }
+    if (p == nullptr) {
+      throw UsageError(
+          "DATA parameter '" + std::string(name) +
+          "': expected odometry, speed, wheel-angle, battery or a code the profile sizes");
+    }
+    m.values.push_back(wr8::DataValue{p->code, parse_word(value, p->type, p->size_bytes, p->name)});
+  }
+  if (!a.unparsed.empty()) m.unparsed = parse_hex_arg(a.unparsed, "--unparsed");
+  return m;
+}
+
+// `packet CODE [HEX...]`: any code and body, framed as they are.
+protocol::Bytes any_packet(const std::vector<std::string>& w) {
+  expect_count(w, 1, 100000, "CODE [HEX...]");
+  protocol::Bytes body;
+  for (std::size_t i = 2; i < w.size(); ++i) {
+    const auto b = parse_hex_arg(w[i], "packet byte(s)");
+    body.insert(body.end(), b.begin(), b.end());
+  }
+  return wr8::raw_packet(parse_byte(w[1], "packet code"), body);
+}
+
 // Builds the packet the words describe; throws UsageError for bad words.
 protocol::Bytes build_packet(const Wr8EncodeArgs& a, const wr8::Profile& profile) {
   const auto& w = a.words;
@@ -212,120 +336,17 @@ protocol::Bytes build_packet(const Wr8EncodeArgs& a, const wr8::Profile& profile
     expect_count(w, 0, 0, "no arguments");
     return encode(wr8::Empty{});
   }
-  if (form == "auth") {
-    expect_count(w, 0, 1, "[TEXT] (10 characters) or --text-hex HEX");
-    wr8::Auth m{profile.auth_text};
-    if (!a.text_hex.empty() && w.size() > 1)
-      throw UsageError("auth takes TEXT or --text-hex, not both");
-    protocol::Bytes text;
-    if (!a.text_hex.empty()) text = parse_hex_arg(a.text_hex, "--text-hex");
-    if (w.size() > 1) text = protocol::to_bytes(w[1]);
-    if (!a.text_hex.empty() || w.size() > 1) {
-      if (text.size() != wr8::kAuthTextBytes) {
-        throw UsageError("the authentication string must be exactly 10 bytes, got " +
-                         std::to_string(text.size()));
-      }
-      std::copy(text.begin(), text.end(), m.text.begin());
-    }
-    return encode(m);
-  }
+  if (form == "auth") return encode(auth_message(a, profile));
   if (form == "auth_reply") {
     expect_count(w, 3, 3, "DEVICE_CODE DEVICE_ID STATE");
     return encode(wr8::AuthReply{parse_byte(w[1], "device code"), parse_byte(w[2], "device id"),
                                  parse_state_arg(w[3])});
   }
-  if (form == "task") {
-    expect_count(w, 2, 255, "COI TASK [VALUE...]");
-    wr8::Task m;
-    m.coi = parse_byte(w[1], "COI");
-    const auto t = wr8::parse_task(w[2]);
-    if (t) {
-      m.task = *t;
-    } else if (a.unchecked) {
-      m.task = static_cast<wr8::TaskCode>(parse_byte(w[2], "task code"));
-    } else {
-      throw UsageError("task '" + w[2] +
-                       "': expected check, drive, turn, blink, get-settings or 0..4");
-    }
-    const auto index = static_cast<std::size_t>(m.task);
-    const auto type =
-        index < wr8::kTaskCount ? profile.task_value_type[index] : wr8::ValueType::signed_int;
-    for (std::size_t i = 3; i < w.size(); ++i)
-      m.params.push_back(parse_word(w[i], type, 4, "task"));
-    if (!a.unchecked && index < wr8::kTaskCount &&
-        m.params.size() != profile.task_parameter_count[index]) {
-      throw UsageError("task " + std::string(wr8::to_string(m.task)) + " takes " +
-                       std::to_string(profile.task_parameter_count[index]) + " value(s), got " +
-                       std::to_string(m.params.size()) + " (--unchecked sends it anyway)");
-    }
-    return encode(m);
-  }
-  if (form == "settings") {
-    expect_count(w, 1, 255, "COI NAME=VALUE...");
-    wr8::Settings m;
-    m.coi = parse_byte(w[1], "COI");
-    for (std::size_t i = 2; i < w.size(); ++i) {
-      const auto [name, value] = split_assignment(w[i]);
-      auto code = wr8::parse_setting(name);
-      if (!code && a.unchecked)
-        code = static_cast<wr8::SettingCode>(parse_byte(name, "setting type"));
-      if (!code)
-        throw UsageError("setting '" + std::string(name) +
-                         "': expected p, i, d, servo-zero or 0..3");
-      const auto index = static_cast<std::size_t>(*code);
-      const auto type = index < wr8::kSettingCount ? profile.setting_value_type[index]
-                                                   : wr8::ValueType::signed_int;
-      m.params.push_back(wr8::Setting{*code, parse_word(value, type, 4, name)});
-    }
-    return encode(m);
-  }
-  if (form == "response") {
-    expect_count(w, 2, 2, "COI CODE");
-    wr8::Response m;
-    m.coi = parse_byte(w[1], "COI");
-    const auto code = wr8::parse_response(w[2]);
-    if (code) {
-      m.code = *code;
-    } else if (a.unchecked) {
-      m.code = static_cast<wr8::ResponseCode>(parse_byte(w[2], "response code"));
-    } else {
-      throw UsageError("response code '" + w[2] + "': expected error, started, completed or 0..2");
-    }
-    return encode(m);
-  }
-  if (form == "data") {
-    expect_count(w, 2, 257, "STATE TIMESTAMP_MS [NAME=VALUE...]");
-    wr8::Data m;
-    m.state = parse_state_arg(w[1]);
-    m.timestamp_ms = parse_unsigned(w[2], 0xFFFFFFFFu, "timestamp");
-    for (std::size_t i = 3; i < w.size(); ++i) {
-      const auto [name, value] = split_assignment(w[i]);
-      std::string key = normalised(name);
-      if (key == "angle") key = "wheel_angle";
-      const wr8::DataParameter* p = profile.data_parameter(key);
-      if (p == nullptr && !key.empty() && key[0] >= '0' && key[0] <= '9') {
-        p = profile.data_parameter(parse_byte(key, "DATA code"));
-      }
-      if (p == nullptr) {
-        throw UsageError(
-            "DATA parameter '" + std::string(name) +
-            "': expected odometry, speed, wheel-angle, battery or a code the profile sizes");
-      }
-      m.values.push_back(
-          wr8::DataValue{p->code, parse_word(value, p->type, p->size_bytes, p->name)});
-    }
-    if (!a.unparsed.empty()) m.unparsed = parse_hex_arg(a.unparsed, "--unparsed");
-    return encode(m);
-  }
-  if (form == "packet") {
-    expect_count(w, 1, 100000, "CODE [HEX...]");
-    protocol::Bytes body;
-    for (std::size_t i = 2; i < w.size(); ++i) {
-      const auto b = parse_hex_arg(w[i], "packet byte(s)");
-      body.insert(body.end(), b.begin(), b.end());
-    }
-    return wr8::raw_packet(parse_byte(w[1], "packet code"), body);
-  }
+  if (form == "task") return encode(task_message(a, profile));
+  if (form == "settings") return encode(settings_message(a, profile));
+  if (form == "response") return encode(response_message(a));
+  if (form == "data") return encode(data_message(a, profile));
+  if (form == "packet") return any_packet(w);
   std::string message = "unknown form '" + w[0] +
                         "': expected empty, auth, auth-reply, task, settings, response, data or "
                         "packet (see --help)";

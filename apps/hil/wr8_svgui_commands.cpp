@@ -253,6 +253,18 @@ protocol::Bytes raw_prefixed(const std::vector<std::string>& w) {
   return protocol::wr8::prefix_length(packet);
 }
 
+// `STATE TIMESTAMP_MS [NAME=VALUE...]` of a DATA packet: the state and the
+// time stamp into `d`; the values by name, of `names`.
+template <class StateData>
+std::map<std::string, std::string_view> read_state_and_time(
+    const std::vector<std::string>& w, const std::vector<std::string_view>& names, StateData& d) {
+  expect_count(w, 2, 2 + names.size(), "STATE TIMESTAMP_MS [NAME=VALUE...]");
+  auto values = assignments(w, 3, names);
+  d.state = parse_state_arg(w[1]);
+  d.timestamp_ms = parse_u32(w[2], "timestamp");
+  return values;
+}
+
 svgui::Message v2019_message(const std::vector<std::string>& w, const std::string& form) {
   if (form == "task") return task_of(w);
   if (form == "settings") {
@@ -266,12 +278,9 @@ svgui::Message v2019_message(const std::vector<std::string>& w, const std::strin
     return svgui::Answer{parse_byte(w[1], "COI"), answer_code(w[2], Version::v2019)};
   }
   // data
-  expect_count(w, 2, 6, "STATE TIMESTAMP_MS [NAME=VALUE...]");
-  const auto values =
-      assignments(w, 3, {"encoder", "steering", "motor-battery", "computer-battery"});
   svgui::Data d;
-  d.state = parse_state_arg(w[1]);
-  d.timestamp_ms = parse_u32(w[2], "timestamp");
+  const auto values =
+      read_state_and_time(w, {"encoder", "steering", "motor-battery", "computer-battery"}, d);
   d.encoder = value_or(values, "encoder", parse_int32);
   d.steering = value_or(values, "steering", parse_double);
   d.motor_battery = value_or(values, "motor-battery", parse_u32);
@@ -298,11 +307,9 @@ svgui::Message head_message(const std::vector<std::string>& w, const std::string
   }
   if (form == "map") return map_of(w);
   if (form == "low_freq_data") {
-    expect_count(w, 2, 5, "STATE TIMESTAMP_MS [NAME=VALUE...]");
-    const auto values = assignments(w, 3, {"motor-battery", "computer-battery", "temperature"});
     svgui::LowFreqData d;
-    d.state = parse_state_arg(w[1]);
-    d.timestamp_ms = parse_u32(w[2], "timestamp");
+    const auto values =
+        read_state_and_time(w, {"motor-battery", "computer-battery", "temperature"}, d);
     d.motor_battery = value_or(values, "motor-battery", parse_u32);
     d.computer_battery = value_or(values, "computer-battery", parse_u32);
     d.temperature = value_or(values, "temperature", parse_double);
