@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "client/arduino/operator.hpp"
+#include "client/common/connection.hpp"
 #include "client/leka/operator.hpp"
+#include "client/logi/action_host.hpp"
 #include "client/logi/operator.hpp"
 #include "client/wr8/operator.hpp"
 #include "client/wr8/svgui_operator.hpp"
@@ -19,11 +21,15 @@
 namespace hil::harness {
 namespace {
 
-// Connection states under one vocabulary for every car, so one matcher
-// ({client: connected}) works whatever the car; "detail" keeps the
-// client's own name of the state.
-nlohmann::json connection(std::string state, std::string_view detail, int attempt) {
-  return {{"state", std::move(state)}, {"detail", std::string(detail)}, {"attempt", attempt}};
+// Connection states in the clients' shared vocabulary, so one matcher
+// ({client: connected}) works whatever the car; "detail" is the client's
+// own name of the state where it has one (Arduino's "OPEN"), else the same word.
+nlohmann::json connection(client::ConnectionState state, int attempt,
+                          std::string_view detail = {}) {
+  const std::string word(client::to_string(state));
+  return {{"state", word},
+          {"detail", detail.empty() ? word : std::string(detail)},
+          {"attempt", attempt}};
 }
 
 std::string decode_error_text(const protocol::DecodeError& e) {
@@ -34,6 +40,14 @@ std::string decode_error_text(const protocol::DecodeError& e) {
 
 std::string column_message(std::size_t column, const std::string& message) {
   return "column " + std::to_string(column) + ": " + message;
+}
+
+// Why an operator's parsed line is not one action, or nothing when it is.
+template <class Action>
+std::optional<std::string> line_problem(const client::ParseResult<Action>& parsed) {
+  if (parsed.error) return column_message(parsed.error->column, parsed.error->message);
+  if (!parsed.action) return "no action";
+  return std::nullopt;
 }
 
 // Runs the action's completion on a later turn, so a runner never sees its
@@ -66,40 +80,18 @@ class LogiReference final : public ReferenceSession {
       later(executor_, alive_, [done, why] { done(false, why); });
       return;
     }
-    retired_.clear();
     // Each action has a runner of its own, so a scheduled one (an
-    // emergency stop) goes out beside the action under way; an uncertain
-    // request one runner saw is confirmable by the next.
-    client::logi::OperatorRunnerOptions options;
-    options.confirmable = confirmable_;
-    if (std::holds_alternative<client::logi::op::Confirm>(*parsed.action)) confirmable_.reset();
-    const std::uint64_t id = ++next_id_;
-    std::vector<client::logi::OperatorStep> steps{{1, text, *parsed.action}};
-    auto result = std::make_shared<client::logi::ActionResult>();
-    auto runner = std::make_unique<client::logi::OperatorRunner>(
-        session_, executor_, std::move(steps), options,
-        [result](const client::logi::ActionResult& r) { *result = r; },
-        [this, id, result, done](const client::logi::RunSummary&) {
-          const auto it = running_.find(id);
-          if (it == running_.end()) return;           // cancelled
-          retired_.push_back(std::move(it->second));  // it is still on the stack
-          running_.erase(it);
-          later(executor_, alive_, [result, done] { done(result->ok, result->reason); });
+    // emergency stop) goes out beside the action under way.
+    actions_.run(
+        {{1, text, *parsed.action}}, {}, {},
+        [done](const client::logi::RunSummary&, const std::vector<client::logi::ActionResult>& r) {
+          done(!r.empty() && r.back().ok, r.empty() ? std::string() : r.back().reason);
         });
-    auto* started = runner.get();
-    running_.emplace(id, std::move(runner));
-    started->start();
   }
 
   bool concurrent() const override { return true; }
 
-  void cancel() override {
-    for (auto& [id, runner] : running_) {
-      runner->cancel();
-      retired_.push_back(std::move(runner));
-    }
-    running_.clear();
-  }
+  void cancel() override { actions_.cancel(); }
 
   void stop() override {
     cancel();
@@ -112,11 +104,7 @@ class LogiReference final : public ReferenceSession {
     std::visit(
         protocol::Overloaded{
             [&](const cl::ConnectionEvent& e) {
-              static constexpr const char* kStates[] = {"disconnected", "connecting", "connected",
-                                                        "reconnecting"};
-              timeline_.add(Source::client, "connection",
-                            connection(kStates[static_cast<int>(e.state)], cl::to_string(e.state),
-                                       e.attempt));
+              timeline_.add(Source::client, "connection", connection(e.state, e.attempt));
             },
             [&](const cl::CommandEvent& e) {
               timeline_.add(Source::client, "command",
@@ -143,28 +131,13 @@ class LogiReference final : public ReferenceSession {
             [](const cl::FeedbackEvent&) {},  // so are the FB frames
         },
         event);
-    namespace cl = client::logi;
-    if (const auto* c = std::get_if<cl::CommandEvent>(&event);
-        c != nullptr && c->state == cl::CommandState::uncertain && c->resend_on_confirm)
-      confirmable_ = c->request;
-    if (const auto* c = std::get_if<cl::ConnectionEvent>(&event);
-        c != nullptr && c->state != cl::ConnectionState::connected)
-      confirmable_.reset();
-    // A runner may end (and leave running_) while it hears the event.
-    std::vector<std::uint64_t> ids;
-    for (const auto& [id, runner] : running_)
-      ids.push_back(id);
-    for (const auto id : ids)
-      if (const auto it = running_.find(id); it != running_.end()) it->second->on_event(now, event);
+    actions_.on_event(now, event);
   }
 
   link::Executor& executor_;
   RunTimeline& timeline_;
   client::logi::LogiSession session_;
-  std::map<std::uint64_t, std::unique_ptr<client::logi::OperatorRunner>> running_;
-  std::vector<std::unique_ptr<client::logi::OperatorRunner>> retired_;
-  std::optional<client::logi::RequestId> confirmable_;
-  std::uint64_t next_id_ = 0;
+  client::logi::ActionHost actions_{session_, executor_};
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
@@ -223,10 +196,8 @@ class Wr8Reference final : public ReferenceSession {
 
   void execute(const std::string& text, Done done) override {
     auto parsed = dialect_.parse(text);
-    if (parsed.error || !parsed.action) {
-      const std::string why =
-          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
-      later(executor_, alive_, [done, why] { done(false, why); });
+    if (const auto why = line_problem(parsed)) {
+      later(executor_, alive_, [done, why = *why] { done(false, why); });
       return;
     }
     retired_.clear();
@@ -263,11 +234,7 @@ class Wr8Reference final : public ReferenceSession {
     std::visit(
         protocol::Overloaded{
             [&](const cw::ConnectionEvent& e) {
-              static constexpr const char* kStates[] = {
-                  "disconnected", "connecting", "authenticating", "connected", "reconnecting"};
-              timeline_.add(Source::client, "connection",
-                            connection(kStates[static_cast<int>(e.state)], cw::to_string(e.state),
-                                       e.attempt));
+              timeline_.add(Source::client, "connection", connection(e.state, e.attempt));
             },
             [&](const cw::LoginEvent&) {
               timeline_.add(Source::client, "login", {{"ok", true}});
@@ -324,19 +291,17 @@ class ArduinoReference final : public ReferenceSession {
 
   void execute(const std::string& text, Done done) override {
     auto parsed = client::arduino::parse_operator_line(text);
-    if (!parsed.ok() || !parsed.command) {
-      const std::string why =
-          parsed.error ? column_message(parsed.error->column, parsed.error->message) : "no action";
-      later(executor_, alive_, [done, why] { done(false, why); });
+    if (const auto why = line_problem(parsed)) {
+      later(executor_, alive_, [done, why = *why] { done(false, why); });
       return;
     }
     // Quitting means nothing in a scenario: the run decides when it ends.
-    if (std::holds_alternative<client::arduino::QuitCommand>(*parsed.command)) {
+    if (std::holds_alternative<client::arduino::QuitCommand>(*parsed.action)) {
       later(executor_, alive_, [done] { done(true, ""); });
       return;
     }
     pending_[next_index_++] = std::move(done);
-    runner_->add(std::move(*parsed.command));
+    runner_->add(std::move(*parsed.action));
   }
 
   void cancel() override {
@@ -369,24 +334,21 @@ class ArduinoReference final : public ReferenceSession {
 
   void on_event(const client::arduino::Event& event) {
     namespace ca = client::arduino;
-    std::visit(
-        protocol::Overloaded{
-            [&](const ca::LinkChanged& e) {
-              static constexpr const char* kStates[] = {"disconnected", "connecting",   "connected",
-                                                        "degraded",     "reconnecting", "down"};
-              auto data = connection(kStates[static_cast<int>(e.to)], ca::to_string(e.to), 0);
-              data["reason"] = e.reason;
-              timeline_.add(Source::client, "connection", std::move(data));
-            },
-            [&](const ca::RequestDone& e) {
-              timeline_.add(Source::client, "command",
-                            {{"request", e.id},
-                             {"state", std::string(ca::to_string(e.result.code))},
-                             {"detail", ca::describe_result(e.result)}});
-            },
-            [](const ca::FrameReceived&) {},  // on the wire already
-        },
-        event);
+    std::visit(protocol::Overloaded{
+                   [&](const ca::LinkChanged& e) {
+                     auto data = connection(e.to, 0, ca::link_name(e.to));
+                     data["reason"] = e.reason;
+                     timeline_.add(Source::client, "connection", std::move(data));
+                   },
+                   [&](const ca::RequestDone& e) {
+                     timeline_.add(Source::client, "command",
+                                   {{"request", e.id},
+                                    {"state", std::string(ca::to_string(e.result.code))},
+                                    {"detail", ca::describe_result(e.result)}});
+                   },
+                   [](const ca::FrameReceived&) {},  // on the wire already
+               },
+               event);
   }
 
   link::Executor& executor_;
@@ -462,11 +424,11 @@ class LekaReference final : public ReferenceSession {
   }
 
   void poll() override {
-    const bool open = session_.is_open();
-    if (open == open_) return;
-    open_ = open;
-    timeline_.add(Source::client, "connection",
-                  connection(open ? "connected" : "disconnected", open ? "open" : "closed", 0));
+    const auto state = session_.state();
+    if (state == state_) return;
+    state_ = state;
+    const bool open = state == client::ConnectionState::connected;
+    timeline_.add(Source::client, "connection", connection(state, 0, open ? "open" : "closed"));
   }
 
  private:
@@ -474,7 +436,7 @@ class LekaReference final : public ReferenceSession {
   RunTimeline& timeline_;
   client::leka::LekaSession session_;
   client::leka::ScriptRunner runner_;
-  bool open_ = false;
+  client::ConnectionState state_ = client::ConnectionState::disconnected;
   std::uint64_t generation_ = 0;
   RunTimeline::ListenerId listener_ = 0;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
@@ -516,26 +478,12 @@ std::unique_ptr<ReferenceSession> make_reference_session(
 
 std::optional<std::string> action_problem(mocks::CarKind car, std::string_view text) {
   switch (car) {
-    case mocks::CarKind::logi: {
-      const auto parsed = client::logi::parse_operator_action(text);
-      if (parsed.error)
-        return column_message(static_cast<std::size_t>(parsed.error->column),
-                              parsed.error->message);
-      if (!parsed.action) return "no action";
-      return std::nullopt;
-    }
-    case mocks::CarKind::wr8: {
-      const auto parsed = client::wr8::parse_operator_line(text);
-      if (parsed.error) return column_message(parsed.error->column, parsed.error->message);
-      if (!parsed.action) return "no action";
-      return std::nullopt;
-    }
-    case mocks::CarKind::arduino: {
-      const auto parsed = client::arduino::parse_operator_line(text);
-      if (parsed.error) return column_message(parsed.error->column, parsed.error->message);
-      if (!parsed.command) return "no action";
-      return std::nullopt;
-    }
+    case mocks::CarKind::logi:
+      return line_problem(client::logi::parse_operator_action(text));
+    case mocks::CarKind::wr8:
+      return line_problem(client::wr8::parse_operator_line(text));
+    case mocks::CarKind::arduino:
+      return line_problem(client::arduino::parse_operator_line(text));
     case mocks::CarKind::leka: {
       const auto parsed = client::leka::parse_operator_line(text);
       if (const auto* e = std::get_if<client::leka::OperatorError>(&parsed))

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "client/arduino/client_core.hpp"
+#include "client/arduino/core.hpp"
 #include "client/leka/core.hpp"
 #include "client/logi/core.hpp"
 #include "client/wr8/core.hpp"

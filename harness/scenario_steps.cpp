@@ -39,11 +39,11 @@ std::optional<std::pair<int, std::string>> check_action(mocks::CarKind car,
     case mocks::CarKind::arduino: {
       const auto r = client::arduino::parse_operator_line(text);
       if (r.error) return std::pair{static_cast<int>(r.error->column), r.error->message};
-      if (!r.command) return std::pair{1, std::string("an empty action")};
-      if (std::holds_alternative<client::arduino::HistoryCommand>(*r.command) ||
-          std::holds_alternative<client::arduino::SaveLogCommand>(*r.command) ||
-          std::holds_alternative<client::arduino::QuitCommand>(*r.command)) {
-        return std::pair{1, "'" + client::arduino::to_text(*r.command) +
+      if (!r.action) return std::pair{1, std::string("an empty action")};
+      if (std::holds_alternative<client::arduino::HistoryCommand>(*r.action) ||
+          std::holds_alternative<client::arduino::SaveLogCommand>(*r.action) ||
+          std::holds_alternative<client::arduino::QuitCommand>(*r.action)) {
+        return std::pair{1, "'" + client::arduino::to_text(*r.action) +
                                 "' is a command of the interactive prompt, not an operator "
                                 "action"};
       }

@@ -4,7 +4,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <asio/io_context.hpp>
 #include <cmath>
 #include <functional>
 #include <iostream>
@@ -14,8 +13,6 @@
 #include "apps/common/log_file.hpp"
 #include "apps/common/stdin_lines.hpp"
 #include "client/arduino/session.hpp"
-#include "link/asio_executor.hpp"
-#include "link/transport.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/common/car_profile.hpp"
 
@@ -28,10 +25,6 @@ namespace {
 void say(const std::string& text) {
   if (text.empty()) return;
   std::cout << text << '\n' << std::flush;
-}
-
-void warn(const std::string& text) {
-  std::cerr << text << '\n' << std::flush;
 }
 
 /// The interactive loop: lines from stdin, parsed and queued on the runner.
@@ -87,8 +80,8 @@ class Repl {
     const auto parsed = arduino::parse_operator_line(line);
     if (parsed.error) {
       warn("error: column " + std::to_string(parsed.error->column) + ": " + parsed.error->message);
-    } else if (parsed.command) {
-      runner_.add(*parsed.command);
+    } else if (parsed.action) {
+      runner_.add(*parsed.action);
       return;  // the runner says when it is idle again
     }
     if (runner_.idle() && !input_done_) prompt();
@@ -103,11 +96,12 @@ class Repl {
 };
 
 std::string link_change_text(const arduino::LinkChanged& change, const std::string& port) {
-  std::string text = "link " + std::string(arduino::to_string(change.to));
-  if (change.from == arduino::LinkState::opening && change.to == arduino::LinkState::down) {
+  std::string text = "link " + std::string(arduino::link_name(change.to));
+  if (change.from == arduino::ConnectionState::connecting &&
+      change.to == arduino::ConnectionState::down) {
     return text + ": cannot open " + port + " (" + change.reason + ")";
   }
-  if (!change.reason.empty() && change.to != arduino::LinkState::open) {
+  if (!change.reason.empty() && change.to != arduino::ConnectionState::connected) {
     text += ": " + change.reason;
   }
   return text;
@@ -165,8 +159,8 @@ TokenCommands commands_from_tokens(const std::vector<std::string>& tokens) {
     if (parsed.error) {
       out.errors.push_back("argument " + std::to_string(i + 1) + " '" + tokens[i] + "', column " +
                            std::to_string(parsed.error->column) + ": " + parsed.error->message);
-    } else if (parsed.command) {
-      out.commands.push_back(*parsed.command);
+    } else if (parsed.action) {
+      out.commands.push_back(*parsed.action);
     }
   }
   return out;
@@ -189,13 +183,8 @@ int run(const AppOptions& options) {
     if (!tokens.errors.empty()) return 2;
     batch = std::move(tokens.commands);
   }
-  link::Endpoint endpoint;
-  try {
-    endpoint = endpoint_for_port(options.port, options.baud);
-  } catch (const link::EndpointError& e) {
-    warn(std::string("arduino-client: --port: ") + e.what());
-    return 2;
-  }
+  const auto endpoint = port_endpoint("arduino-client", options.port, options.baud);
+  if (!endpoint) return kExitUsage;
 
   arduino::ClientConfig config;
   config.base_timeout =
@@ -203,25 +192,17 @@ int run(const AppOptions& options) {
   config.max_retries = options.retries;
   config.dialect = protocol::arduino::dialect_named(options.profile);
 
-  asio::io_context io;
-  link::AsioExecutor executor{io};
-  link::TransportContext context{executor, &io};
-  arduino::ArduinoSession session(context, endpoint, config);
-  arduino::OperatorRunner runner(session, executor,
+  ProgramLoop program;
+  arduino::ArduinoSession session(program.context(), *endpoint, config);
+  arduino::OperatorRunner runner(session, program.executor(),
                                  {.keep_going = options.keep_going || !is_batch});
-
-  std::optional<int> exit_code;
-  auto finish = [&](int code) {
-    if (exit_code) return;
-    exit_code = code;
-    io.stop();
-  };
+  auto finish = [&](int code) { program.finish(code, /*at_once=*/true); };
 
   runner.set_event_handler([&](const arduino::Event& event) {
     const auto* change = std::get_if<arduino::LinkChanged>(&event);
     // OPENING and CLOSED are the program's own doing; the rest is news.
-    if (change == nullptr || change->to == arduino::LinkState::opening ||
-        change->to == arduino::LinkState::closed) {
+    if (change == nullptr || change->to == arduino::ConnectionState::connecting ||
+        change->to == arduino::ConnectionState::disconnected) {
       return;
     }
     warn(link_change_text(*change, options.port));
@@ -229,8 +210,7 @@ int run(const AppOptions& options) {
   runner.set_outcome_handler(
       [](const arduino::CommandOutcome& outcome) { say(arduino::describe_outcome(outcome)); });
 
-  StopSignals signals(io);
-  signals.on_next([&](int) { finish(kExitInterrupted); });
+  program.on_stop_signal([&](int) { finish(kExitInterrupted); });
 
   std::unique_ptr<Repl> repl;
   session.open();
@@ -239,23 +219,19 @@ int run(const AppOptions& options) {
     runner.add(batch);
   } else {
     const bool interactive = ::isatty(STDIN_FILENO) != 0;
-    repl = std::make_unique<Repl>(io, runner, interactive, finish);
+    repl = std::make_unique<Repl>(program.io(), runner, interactive, finish);
     runner.set_idle_handler([&] { repl->on_idle(); });
     repl->start();
   }
-  if (!exit_code) io.run();
+  program.run();  // returns at once when the run already finished
 
   if (repl) repl->stop();
   runner.set_idle_handler({});
   runner.set_outcome_handler({});
   session.close();
-  if (!options.log_path.empty()) {
-    if (!save_log(session.log(), options.log_path)) {
-      warn("arduino-client: cannot write the log to " + options.log_path);
-      if (exit_code == 0) exit_code = 1;
-    }
-  }
-  return exit_code.value_or(0);
+  if (!options.log_path.empty() && !save_log(session.log(), options.log_path))
+    program.fail("arduino-client: cannot write the log to " + options.log_path);
+  return program.exit_code();
 }
 
 }  // namespace hil::apps::arduino_client

@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <asio/post.hpp>
+
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -51,6 +53,20 @@ link::Endpoint endpoint_for_port(const std::string& port, unsigned baud) {
   return link::PtyEndpoint{port, baud, link::Duration{0}};
 }
 
+std::optional<link::Endpoint> port_endpoint(const std::string& program, const std::string& port,
+                                            unsigned baud) {
+  try {
+    return endpoint_for_port(port, baud);
+  } catch (const link::EndpointError& e) {
+    warn(program + ": --port: " + e.what());
+    return std::nullopt;
+  }
+}
+
+void warn(const std::string& text) {
+  std::cerr << text << '\n' << std::flush;
+}
+
 std::optional<std::string> read_script_text(const std::string& path, std::istream& standard_input) {
   if (path == "-") {
     return std::string(std::istreambuf_iterator<char>(standard_input),
@@ -67,15 +83,64 @@ std::string seconds_stamp(link::Time at, int width) {
   return buf;
 }
 
-void StopSignals::on_next(std::function<void(int)> handler) {
-  signals_.async_wait([handler = std::move(handler)](const std::error_code& ec, int signal) {
-    if (!ec) handler(signal);
+std::string signal_name(int signal) {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "signal " + std::to_string(signal);
+  }
+}
+
+ProgramLoop::ProgramLoop(std::initializer_list<int> stop_signals) : signals_(io_) {
+  for (const int signal : stop_signals)
+    signals_.add(signal);
+}
+
+void ProgramLoop::on_stop_signal(std::function<void(int)> handler) {
+  on_signal_ = std::move(handler);
+  wait_for_signal();
+}
+
+void ProgramLoop::wait_for_signal() {
+  signals_.async_wait([this](const std::error_code& ec, int signal) {
+    if (ec || stopped_) return;
+    wait_for_signal();  // armed again first: the handler may stop()
+    if (on_signal_) on_signal_(signal);
   });
 }
 
-void StopSignals::cancel() {
+void ProgramLoop::fail(const std::string& message) {
+  warn(message);
+  if (exit_code_ == kExitOk) exit_code_ = kExitFailed;
+}
+
+int ProgramLoop::run() {
+  io_.run();
+  return exit_code_;
+}
+
+bool ProgramLoop::finish(int code, bool at_once) {
+  if (finished_) return false;
+  finished_ = true;
+  exit_code_ = code;
+  stop(at_once);
+  return true;
+}
+
+void ProgramLoop::stop(bool at_once) {
+  stopped_ = true;
   std::error_code ignored;
   signals_.cancel(ignored);
+  if (at_once) {
+    io_.stop();
+  } else {
+    asio::post(io_, [this] { io_.stop(); });
+  }
 }
 
 }  // namespace hil::apps

@@ -1,10 +1,12 @@
 #pragma once
 // What every client program does the same way around its own work: the
 // command line's exit codes, the --port endpoint, reading a script, time
-// stamps in its output, and ending on SIGINT or SIGTERM.
+// stamps in its output, and the run itself: its loop, ending on SIGINT or
+// SIGTERM, and its exit status.
 
 #include <csignal>
 #include <functional>
+#include <initializer_list>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -12,8 +14,10 @@
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
 
+#include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
 #include "link/time.hpp"
+#include "link/transport.hpp"
 
 namespace CLI {
 class App;
@@ -82,6 +86,13 @@ ParsedArguments<Options> parse_options(
 /// The endpoint for --port: a URI is taken as it is (a pty:// without a baud
 /// gets `baud`), anything else is a serial device path.
 link::Endpoint endpoint_for_port(const std::string& port, unsigned baud);
+/// endpoint_for_port(), or nullopt after telling stderr
+/// "<program>: --port: <what is wrong>".
+std::optional<link::Endpoint> port_endpoint(const std::string& program, const std::string& port,
+                                            unsigned baud);
+
+/// A line on stderr, flushed at once.
+void warn(const std::string& text);
 
 /// The whole text of a script file, or of `standard_input` for "-";
 /// nullopt (errno set) when the file cannot be read.
@@ -90,18 +101,52 @@ std::optional<std::string> read_script_text(const std::string& path, std::istrea
 /// "   1.234 s": seconds with three decimals, right-aligned in `width`.
 std::string seconds_stamp(link::Time at, int width);
 
-/// SIGINT and SIGTERM on the program's io_context.
-class StopSignals {
- public:
-  explicit StopSignals(asio::io_context& io) : signals_(io, SIGINT, SIGTERM) {}
+/// "SIGINT", "SIGTERM", "SIGHUP": a stop signal's name, for a message.
+std::string signal_name(int signal);
 
-  /// `handler(signal)` runs on the next of them (once; call again for the next).
-  void on_next(std::function<void(int signal)> handler);
-  /// No more signal handling; a pending wait ends without calling its handler.
-  void cancel();
+/// A client program's run in real time: the io_context with its executor
+/// and transport context, the stop signals (SIGINT and SIGTERM unless told
+/// otherwise), and the exit status run() returns.
+class ProgramLoop {
+ public:
+  explicit ProgramLoop(std::initializer_list<int> stop_signals = {SIGINT, SIGTERM});
+  ProgramLoop(const ProgramLoop&) = delete;
+  ProgramLoop& operator=(const ProgramLoop&) = delete;
+
+  asio::io_context& io() { return io_; }
+  link::AsioExecutor& executor() { return executor_; }
+  link::TransportContext& context() { return context_; }
+
+  /// `handler(signal)` on every stop signal until stop().
+  void on_stop_signal(std::function<void(int signal)> handler);
+  /// Runs the loop until stop(); returns exit_code().
+  int run();
+
+  /// The status run() returns: 0 until set.
+  int exit_code() const { return exit_code_; }
+  void set_exit_code(int code) { exit_code_ = code; }
+  /// Something at the end went wrong (a log that cannot be written): warn()
+  /// `message`, and a run that went well exits with kExitFailed.
+  void fail(const std::string& message);
+  /// Ends the run with `code`, unless it was ended before (then false and
+  /// the status stays): stop(), now or once the work already posted has run.
+  bool finish(int code, bool at_once = false);
+  bool finished() const { return finished_; }
+  /// No more stop signals; the loop ends now (`at_once`) or once the work
+  /// already posted has run (a close reaches its socket first).
+  void stop(bool at_once = false);
 
  private:
+  void wait_for_signal();
+
+  asio::io_context io_;
+  link::AsioExecutor executor_{io_};
+  link::TransportContext context_{executor_, &io_};
   asio::signal_set signals_;
+  std::function<void(int)> on_signal_;
+  bool finished_ = false;
+  bool stopped_ = false;
+  int exit_code_ = kExitOk;
 };
 
 }  // namespace hil::apps

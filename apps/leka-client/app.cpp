@@ -2,7 +2,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include <asio/io_context.hpp>
 #include <cerrno>
 #include <cstring>
 #include <iostream>
@@ -11,8 +10,6 @@
 
 #include "apps/common/log_file.hpp"
 #include "client/leka/session.hpp"
-#include "link/asio_executor.hpp"
-#include "link/transport.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/common/car_profile.hpp"
 #include "protocol/leka/message.hpp"
@@ -22,10 +19,6 @@ namespace hil::apps::leka_client {
 namespace leka = client::leka;
 
 namespace {
-
-void warn(const std::string& text) {
-  std::cerr << text << std::endl;
-}
 
 std::string hex_of(protocol::ByteView bytes) {
   static const char* digits = "0123456789ABCDEF";
@@ -125,15 +118,7 @@ leka::ClientConfig config_for(const AppOptions& options) {
 
 std::optional<leka::LogFormat> log_format_for(const std::string& path) {
   if (!has_log_extension(path)) return std::nullopt;
-  switch (log_format_of(path)) {
-    case LogFileFormat::csv:
-      return leka::LogFormat::csv;
-    case LogFileFormat::ndjson:
-      return leka::LogFormat::ndjson;
-    case LogFileFormat::text:
-      break;
-  }
-  return leka::LogFormat::txt;
+  return client::log_format_for(path);
 }
 
 std::variant<leka::Script, leka::ScriptError> load_script(const AppOptions& options,
@@ -184,17 +169,14 @@ class Run {
   Run(const AppOptions& options, leka::Script script, link::Endpoint endpoint)
       : options_(options),
         script_(std::move(script)),
-        executor_(io_),
-        context_{executor_, &io_},
-        session_(context_, std::move(endpoint), config_for(options)),
-        runner_(executor_, session_),
-        signals_(io_) {
+        session_(program_.context(), std::move(endpoint), config_for(options)),
+        runner_(program_.executor(), session_) {
     for (const auto& line : script_.lines)
       lines_[line.number] = &line.line;
   }
 
   int go() {
-    signals_.on_next([this](int) {
+    program_.on_stop_signal([this](int) {
       if (finishing_) return;
       runner_.cancel();
       if (session_.is_open()) {
@@ -207,8 +189,7 @@ class Run {
     });
     session_.open();
     wait_for_open(link::Time(0));
-    io_.run();
-    return exit_code_;
+    return program_.run();
   }
 
  private:
@@ -223,8 +204,8 @@ class Run {
       warn("leka-client: cannot open " + options_.port + " (not open after 5 s)");
       return finish(1);
     }
-    executor_.call_after(link::milliseconds(10),
-                         [this, waited] { wait_for_open(waited + link::milliseconds(10)); });
+    program_.executor().call_after(
+        link::milliseconds(10), [this, waited] { wait_for_open(waited + link::milliseconds(10)); });
   }
 
   void start() {
@@ -244,44 +225,35 @@ class Run {
   void finish(int code) {
     if (!finishing_) {
       finishing_ = true;
-      exit_code_ = code;
+      program_.set_exit_code(code);
     }
     drain(link::Duration{0});
   }
 
   void drain(link::Duration waited) {
     if (session_.is_open() && session_.core().queued_frames() > 0 && waited < link::seconds(1)) {
-      executor_.call_after(link::milliseconds(10),
-                           [this, waited] { drain(waited + link::milliseconds(10)); });
+      program_.executor().call_after(link::milliseconds(10),
+                                     [this, waited] { drain(waited + link::milliseconds(10)); });
       return;
     }
     // A short grace so the last write reaches the port before it closes.
-    executor_.call_after(link::milliseconds(50), [this] { close(); });
+    program_.executor().call_after(link::milliseconds(50), [this] { close(); });
   }
 
   void close() {
     session_.close();
-    signals_.cancel();
-    if (!options_.log_path.empty()) {
-      if (!save_log(session_.log(), options_.log_path)) {
-        warn("leka-client: cannot write the log " + options_.log_path);
-        if (exit_code_ == 0) exit_code_ = 1;
-      }
-    }
-    io_.stop();
+    if (!options_.log_path.empty() && !save_log(session_.log(), options_.log_path))
+      program_.fail("leka-client: cannot write the log to " + options_.log_path);
+    program_.stop(/*at_once=*/true);
   }
 
   const AppOptions& options_;
   leka::Script script_;
   std::map<std::size_t, const leka::OperatorLine*> lines_;
-  asio::io_context io_;
-  link::AsioExecutor executor_;
-  link::TransportContext context_;
+  ProgramLoop program_;
   leka::LekaSession session_;
   leka::ScriptRunner runner_;
-  StopSignals signals_;
   bool finishing_ = false;
-  int exit_code_ = 0;
 };
 
 }  // namespace
@@ -300,14 +272,9 @@ int run(const AppOptions& options) {
     std::cout << dry_run_text(script, config_for(options)) << std::flush;
     return 0;
   }
-  link::Endpoint endpoint;
-  try {
-    endpoint = endpoint_for_port(options.port, options.baud);
-  } catch (const link::EndpointError& e) {
-    warn(std::string("leka-client: --port: ") + e.what());
-    return 2;
-  }
-  Run run_state(options, std::move(script), std::move(endpoint));
+  auto endpoint = port_endpoint("leka-client", options.port, options.baud);
+  if (!endpoint) return kExitUsage;
+  Run run_state(options, std::move(script), std::move(*endpoint));
   return run_state.go();
 }
 

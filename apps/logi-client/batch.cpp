@@ -1,20 +1,13 @@
 #include "apps/logi-client/batch.hpp"
 
-#include <asio/io_context.hpp>
-
-#include <csignal>
 #include <cstdio>
-#include <functional>
 #include <iostream>
-#include <memory>
 #include <string_view>
 
 #include "apps/common/log_file.hpp"
+#include "apps/logi-client/actions_program.hpp"
 #include "client/common/operator_text.hpp"
 #include "client/logi/session.hpp"
-#include "link/asio_executor.hpp"
-#include "link/endpoint.hpp"
-#include "link/transport.hpp"
 
 namespace hil::apps::logi_client {
 
@@ -50,9 +43,10 @@ LoadedScript load_script_arguments(const std::vector<std::string>& actions) {
     }
     const auto parsed = logi::parse_operator_action(actions[i]);
     if (parsed.error) {
-      loaded.error = logi::OperatorScriptError{"<command line>", number, parsed.error->column,
-                                               parsed.error->message}
-                         .to_string();
+      loaded.error =
+          logi::OperatorScriptError{"<command line>", number,
+                                    static_cast<int>(parsed.error->column), parsed.error->message}
+              .to_string();
       return loaded;
     }
     if (!parsed.action) continue;  // an empty or comment-only argument
@@ -117,13 +111,15 @@ std::optional<std::string> BatchReporter::event_line(logi::Time now, const logi:
         return at + " link reconnect attempt " + std::to_string(c->attempt);
       case ConnectionState::connected:
         return at + " link connected";
-      case ConnectionState::waiting_to_reconnect:
+      case ConnectionState::reconnecting:
         shown_.reset();
         return at + " WARN not connected (lost or refused); reconnecting, attempt " +
                std::to_string(c->attempt) + " pending";
       case ConnectionState::disconnected:
         shown_.reset();
         return at + " link disconnected";
+      default:  // authenticating, degraded, down: LOGI never reaches them
+        break;
     }
     return std::nullopt;
   }
@@ -168,138 +164,29 @@ std::optional<std::string> BatchReporter::event_line(logi::Time now, const logi:
   return std::nullopt;
 }
 
-bool car_may_be_moving(const logi::LogiClientCore& core) {
-  if (core.held()) return true;
-  const auto& s = core.last_status();
-  return s && (s->running || s->manual != proto::Direction::stop);
-}
-
-void stop_car_then(logi::LogiSession& session, link::Executor& executor, bool stop_car,
-                   const std::function<void(const std::string&)>& print,
-                   std::function<void()> done) {
-  if (!stop_car) {
-    done();
-    return;
-  }
-  print(stamp(executor.now()) + " emergency stop: MV:STOP" +
-        (session.core().known_mode() == proto::Mode::manual ? "" : " and ST:STOP"));
-  session.emergency_stop();
-  // The answers (or their timeouts), within a bound that keeps a program
-  // driven by hil run inside the 5 s it has to exit.
-  const logi::Time deadline = executor.now() + link::seconds(3);
-  auto poll = std::make_shared<std::function<void()>>();
-  *poll = [&session, &executor, deadline, done = std::move(done),
-           self = std::weak_ptr<std::function<void()>>(poll)] {
-    const auto& core = session.core();
-    const bool settled = core.in_flight() == 0 && core.queued() == 0;
-    if (settled || core.state() != ConnectionState::connected || executor.now() >= deadline) {
-      done();
-      return;
-    }
-    if (auto again = self.lock())
-      executor.call_after(link::milliseconds(10), [again] { (*again)(); });
-  };
-  (*poll)();
-}
-
 // ---- the run ----
 
 namespace {
 
-/// The program's run: session, runner, signals, and the way out.
-class BatchRun {
+/// The run of a list of steps: the run ends with them; on a failure the
+/// car is stopped if it may be moving.
+class BatchRun final : public ActionsProgram {
  public:
   BatchRun(const BatchOptions& options, std::vector<logi::OperatorStep> steps, std::ostream& out,
            std::ostream& err)
-      : options_(options), out_(out), err_(err), signals_(io_) {
-    logi::ClientConfig config;
-    config.keepalive = options.keepalive;
-    session_ = std::make_unique<logi::LogiSession>(
-        context_, link::TcpEndpoint{options.host, options.port}, config,
-        [this](logi::Time now, const logi::Event& e) { on_event(now, e); });
-    runner_ = std::make_unique<logi::OperatorRunner>(
-        *session_, executor_, std::move(steps), options.runner,
+      : ActionsProgram(options, out, err), steps_(std::move(steps)) {}
+
+ private:
+  void begin() override {
+    actions_->run(
+        std::move(steps_), options_.runner,
         [this](const logi::ActionResult& r) { print(BatchReporter::result_line(r)); },
-        [this](const logi::RunSummary& s) {
-          // Leave the runner's callback before tearing anything down.
-          executor_.post([this, s] {
-            if (s.ok) {
-              shut_down(kExitOk, false);
-            } else {
-              shut_down(kExitActionFailed, true);
-            }
-          });
+        [this](const logi::RunSummary& s, const auto&) {
+          shut_down(s.ok ? kExitOk : kExitActionFailed, !s.ok);
         });
   }
 
-  int run() {
-    signals_.on_next([this](int signal) { on_signal(signal); });
-    runner_->start();
-    io_.run();
-    if (!options_.log_path.empty()) {
-      std::string error;
-      if (!write_log(*session_->log(), options_.log_path, error)) {
-        err_ << "logi-client: " << error << '\n';
-      }
-    }
-    out_.flush();
-    return exit_code_;
-  }
-
- private:
-  void print(const std::string& line) { out_ << line << std::endl; }
-
-  void on_event(logi::Time now, const logi::Event& e) {
-    if (auto line = reporter_.event_line(now, e)) print(*line);
-    if (runner_) runner_->on_event(now, e);
-  }
-
-  void on_signal(int signal) {
-    if (stopping_) {
-      // A second Ctrl-C: out now, without waiting for the car.
-      print(stamp(executor_.now()) + " interrupted again: leaving at once");
-      exit_code_ = kExitInterrupted;
-      io_.stop();
-      return;
-    }
-    print(stamp(executor_.now()) + " interrupted (" + (signal == SIGTERM ? "SIGTERM" : "SIGINT") +
-          "): stopping");
-    signals_.on_next([this](int s) { on_signal(s); });
-    runner_->cancel();
-    shut_down(kExitInterrupted, true);
-  }
-
-  /// Ends the run: an emergency stop first if asked and the car may be
-  /// moving, then disconnect and leave the io_context.
-  void shut_down(int code, bool stop_car) {
-    if (stopping_) return;
-    stopping_ = true;
-    exit_code_ = code;
-    runner_->cancel();  // no-op when the run already ended
-    const bool connected = session_->core().state() == ConnectionState::connected;
-    stop_car_then(
-        *session_, executor_, stop_car && connected && car_may_be_moving(session_->core()),
-        [this](const std::string& line) { print(line); }, [this] { finish(); });
-  }
-
-  void finish() {
-    session_->disconnect();
-    signals_.cancel();
-    executor_.post([this] { io_.stop(); });
-  }
-
-  const BatchOptions& options_;
-  std::ostream& out_;
-  std::ostream& err_;
-  asio::io_context io_;
-  link::AsioExecutor executor_{io_};
-  link::TransportContext context_{executor_, &io_};
-  StopSignals signals_;
-  std::unique_ptr<logi::LogiSession> session_;
-  std::unique_ptr<logi::OperatorRunner> runner_;
-  BatchReporter reporter_;
-  bool stopping_ = false;
-  int exit_code_ = kExitOk;
+  std::vector<logi::OperatorStep> steps_;
 };
 
 }  // namespace

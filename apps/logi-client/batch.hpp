@@ -65,17 +65,6 @@ class BatchReporter {
   std::optional<logi::proto::Status> shown_;
 };
 
-/// Whether the car may be moving as far as the client knows: a direction
-/// held, or the last STAT showing RUN 1 or a manual direction.
-bool car_may_be_moving(const logi::LogiClientCore& core);
-
-/// The way out of a run: with `stop_car`, an emergency stop (MV:STOP, and
-/// ST:STOP unless the car is in MAN) and a line saying so, then up to 3 s
-/// for the car's answers; then `done`. Timing from the executor only.
-void stop_car_then(logi::LogiSession& session, link::Executor& executor, bool stop_car,
-                   const std::function<void(const std::string&)>& print,
-                   std::function<void()> done);
-
 /// "[  1.234 s]": the time stamp every line starts with.
 std::string stamp(logi::Time at);
 

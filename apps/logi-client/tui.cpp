@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <asio/io_context.hpp>
 #include <asio/posix/stream_descriptor.hpp>
 #include <asio/post.hpp>
 #include <asio/signal_set.hpp>
@@ -20,6 +19,7 @@
 #include <string>
 
 #include "apps/common/log_file.hpp"
+#include "apps/common/program.hpp"
 #include "apps/logi-client/tui_model.hpp"
 #include "apps/logi-client/tui_view.hpp"
 #include "client/logi/session.hpp"
@@ -91,12 +91,11 @@ class LiveSession final : public SessionControl {
     std::tm local{};
     localtime_r(&t, &local);
     std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
-    const char* ext = format == LogFormat::text  ? "txt"
+    const char* ext = format == LogFormat::txt   ? "txt"
                       : format == LogFormat::csv ? "csv"
                                                  : "ndjson";
     const std::string path = log_dir_ + "/logi-client-log-" + stamp + "." + ext;
-    if (!write_text_file(path, export_log(*log_, log_format_of(path))))
-      return "could not write " + path + ": " + std::strerror(errno);
+    if (!log_->save(path, format)) return "could not write " + path + ": " + std::strerror(errno);
     return "log saved to " + path + " (" + std::to_string(log_->total()) + " entries)";
   }
 
@@ -116,34 +115,30 @@ class LiveSession final : public SessionControl {
 class TuiApp {
  public:
   explicit TuiApp(const TuiOptions& options)
-      : executor_(io_),
-        context_{executor_, &io_},
-        session_(context_, client_config(options), options.log_dir,
+      : session_(program_.context(), client_config(options), options.log_dir,
                  [this](Time now, const logi::Event& event) {
                    // Handled on a later turn: the model may be inside a call on the session.
-                   asio::post(io_, [this, now, event] {
+                   asio::post(program_.io(), [this, now, event] {
                      model_.on_event(now, event);
                      changed();
                    });
                  }),
         model_(session_, model_config(options)),
-        input_(io_, ::dup(STDIN_FILENO)),
-        signals_(io_, SIGINT, SIGTERM, SIGHUP) {}
+        input_(program_.io(), ::dup(STDIN_FILENO)) {}
 
   int run() {
     TuiScreen screen;
     screen_ = &screen;
-    signals_.async_wait([this](const std::error_code& ec, int) {
-      if (ec) return;
-      model_.quit(executor_.now());
+    program_.on_stop_signal([this](int) {
+      model_.quit(now());
       changed();
     });
     resize_signal_.async_wait([this](const std::error_code& ec, int) { on_resize(ec); });
-    model_.start(executor_.now());
+    model_.start(now());
     wait_for_input();
     tick();
     changed();
-    io_.run();
+    program_.run();
     screen_ = nullptr;
     return 0;
   }
@@ -168,11 +163,11 @@ class TuiApp {
       bool any = false;
       while (const auto k = screen_->read_key()) {
         any = true;
-        model_.on_key(executor_.now(), *k);
+        model_.on_key(now(), *k);
       }
       // Readable with nothing to read, again and again: the terminal is gone.
       idle_wakeups_ = any ? 0 : idle_wakeups_ + 1;
-      if (idle_wakeups_ > 100) model_.quit(executor_.now());
+      if (idle_wakeups_ > 100) model_.quit(now());
       changed();
       if (!model_.done()) wait_for_input();
     });
@@ -187,7 +182,7 @@ class TuiApp {
 
   // Redraws now and then even without news: the STAT age, the banner.
   void tick() {
-    executor_.call_after(link::milliseconds(250), [this] {
+    executor().call_after(link::milliseconds(250), [this] {
       if (model_.done()) return;
       changed();
       tick();
@@ -199,32 +194,31 @@ class TuiApp {
     const auto fresh = session_.log()->since(log_seen_);
     log_seen_ += fresh.size();
     if (!fresh.empty()) model_.on_log(fresh);
-    model_.on_time(executor_.now());
-    if (wakeup_timer_ != 0) executor_.cancel(wakeup_timer_);
+    model_.on_time(now());
+    if (wakeup_timer_ != 0) executor().cancel(wakeup_timer_);
     wakeup_timer_ = 0;
     if (const auto at = model_.next_wakeup()) {
-      wakeup_timer_ = executor_.call_at(*at, [this] {
+      wakeup_timer_ = executor().call_at(*at, [this] {
         wakeup_timer_ = 0;
         changed();
       });
     }
-    if (screen_ != nullptr) screen_->draw(model_, executor_.now());
+    if (screen_ != nullptr) screen_->draw(model_, now());
     if (model_.done()) {
       input_.cancel();
-      signals_.cancel();
       resize_signal_.cancel();
-      io_.stop();
+      program_.stop(/*at_once=*/true);
     }
   }
 
-  asio::io_context io_;
-  link::AsioExecutor executor_;
-  link::TransportContext context_;
+  Time now() { return program_.executor().now(); }
+  link::AsioExecutor& executor() { return program_.executor(); }
+
+  ProgramLoop program_{SIGINT, SIGTERM, SIGHUP};
   LiveSession session_;
   TuiModel model_;
   asio::posix::stream_descriptor input_;
-  asio::signal_set signals_;
-  asio::signal_set resize_signal_{io_, SIGWINCH};
+  asio::signal_set resize_signal_{program_.io(), SIGWINCH};
   TuiScreen* screen_ = nullptr;
   std::uint64_t log_seen_ = 0;
   link::Executor::TimerId wakeup_timer_ = 0;

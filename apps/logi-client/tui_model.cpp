@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <iterator>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <variant>
 
+#include "base/duration.hpp"
 #include "protocol/logi/codec.hpp"
 
 namespace hil::apps::logi_client {
@@ -37,8 +40,10 @@ std::string connection_text(ConnectionState s, int attempt) {
       return attempt > 0 ? "Connecting (attempt " + std::to_string(attempt) + ")" : "Connecting";
     case ConnectionState::connected:
       return "Connected";
-    case ConnectionState::waiting_to_reconnect:
+    case ConnectionState::reconnecting:
       return "Connection lost, reconnecting";
+    default:  // authenticating, degraded, down: LOGI never reaches them
+      break;
   }
   return "?";
 }
@@ -68,56 +73,23 @@ std::string track_text(std::uint8_t mask) {
   return s;
 }
 
-std::string seconds_text(Duration d) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f s", link::to_ms(d) / 1000.0);
-  return buf;
-}
-
 }  // namespace
 
 std::optional<Direction> direction_for_key(int code) {
-  switch (code) {
-    case 'w':
-    case 'W':
-    case key::kUp:
-      return Direction::fwd;
-    case 'x':
-    case 'X':
-    case key::kDown:
-      return Direction::bwd;
-    case 'a':
-    case 'A':
-    case key::kLeft:
-      return Direction::left;
-    case 'd':
-    case 'D':
-    case key::kRight:
-      return Direction::right;
-    case 'q':
-    case 'Q':
-      return Direction::lf;
-    case 'e':
-    case 'E':
-      return Direction::rf;
-    case 'z':
-    case 'Z':
-      return Direction::lb;
-    case 'c':
-    case 'C':
-      return Direction::rb;
-    case '[':
-    case '{':
-      return Direction::ccw;
-    case ']':
-    case '}':
-      return Direction::cw;
-    case 's':
-    case 'S':
-      return Direction::stop;
-    default:
-      return std::nullopt;
+  // Direction i has the keys kPlain[i] and kShifted[i] (a letter in either
+  // case, a bracket with or without shift), and the first four an arrow.
+  static constexpr Direction kDirections[] = {Direction::fwd,   Direction::bwd, Direction::left,
+                                              Direction::right, Direction::lf,  Direction::rf,
+                                              Direction::lb,    Direction::rb,  Direction::ccw,
+                                              Direction::cw,    Direction::stop};
+  static constexpr std::string_view kPlain = "wxadqezc[]s";
+  static constexpr std::string_view kShifted = "WXADQEZC{}S";
+  static constexpr int kArrows[] = {key::kUp, key::kDown, key::kLeft, key::kRight};
+  for (std::size_t i = 0; i < std::size(kDirections); ++i) {
+    if (code == kPlain[i] || code == kShifted[i] || (i < std::size(kArrows) && code == kArrows[i]))
+      return kDirections[i];
   }
+  return std::nullopt;
 }
 
 std::string format_log_line(const logi::LogEntry& entry) {
@@ -334,7 +306,7 @@ void TuiModel::edit_key(Time now, int code) {
     switch (code) {
       case 't':
       case 'T':
-        say(control_.save_log(LogFormat::text));
+        say(control_.save_log(LogFormat::txt));
         break;
       case 'c':
       case 'C':
@@ -582,7 +554,7 @@ Render TuiModel::render(Time now, std::size_t log_rows) const {
   r.header.style = connection_ == ConnectionState::connected ? Style::good : Style::warning;
   if (stale_) {
     r.stale = "STALE: no status from the car for over 2 s";
-    if (status_) r.stale->append(" (last " + seconds_text(now - status_at_) + " ago)");
+    if (status_) r.stale->append(" (last " + hil::seconds_text(now - status_at_, 1) + " ago)");
   }
 
   r.status.title = "Status";
@@ -610,7 +582,8 @@ Render TuiModel::render(Time now, std::size_t log_rows) const {
     r.status.lines.push_back({buf, age});
     for (const auto& [k, v] : s.extra)
       r.status.lines.push_back({pad(k, 5) + v, age});
-    r.status.lines.push_back({"updated " + seconds_text(now - status_at_) + " ago", Style::dim});
+    r.status.lines.push_back(
+        {"updated " + hil::seconds_text(now - status_at_, 1) + " ago", Style::dim});
   }
 
   r.controls.title = "Controls";

@@ -10,7 +10,6 @@
 #include <string_view>
 #include <vector>
 
-#include "client/logi/comm_log.hpp"
 #include "client/logi/core.hpp"
 #include "link/time.hpp"
 
@@ -21,7 +20,7 @@ namespace proto = protocol::logi;
 using link::Duration;
 using link::Time;
 
-enum class LogFormat : std::uint8_t { text, csv, ndjson };
+using client::LogFormat;
 
 /// What the screen asks of the LOGI session (LogiSession in the program, a
 /// mock in tests).
@@ -45,20 +44,10 @@ class SessionControl {
 /// Key codes the model understands: printable ASCII and control characters
 /// as themselves, the special keys below (the view maps its library's codes).
 namespace key {
-inline constexpr int kEnter = '\n';
-inline constexpr int kEscape = 27;
-inline constexpr int kBackspace = 127;
-inline constexpr int kCtrlC = 3;
-inline constexpr int kCtrlQ = 17;
-inline constexpr int kUp = 0x1001;
-inline constexpr int kDown = 0x1002;
-inline constexpr int kLeft = 0x1003;
-inline constexpr int kRight = 0x1004;
-inline constexpr int kPageUp = 0x1005;
-inline constexpr int kPageDown = 0x1006;
-inline constexpr int kHome = 0x1007;
-inline constexpr int kEnd = 0x1008;
-inline constexpr int kF10 = 0x1010;
+/// Control characters.
+enum : int { kCtrlC = 3, kEnter = '\n', kCtrlQ = 17, kEscape = 27, kBackspace = 127 };
+/// Keys without a character: codes above every character's.
+enum : int { kUp = 0x1001, kDown, kLeft, kRight, kPageUp, kPageDown, kHome, kEnd, kF10 = 0x1010 };
 }  // namespace key
 
 struct TuiModelConfig {

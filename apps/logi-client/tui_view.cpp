@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <clocale>
+#include <iterator>
 #include <string>
 
 namespace hil::apps::logi_client {
@@ -33,36 +34,18 @@ int attributes(Style style, bool colors) {
 }
 
 int to_model_key(int ch) {
-  switch (ch) {
-    case KEY_UP:
-      return key::kUp;
-    case KEY_DOWN:
-      return key::kDown;
-    case KEY_LEFT:
-      return key::kLeft;
-    case KEY_RIGHT:
-      return key::kRight;
-    case KEY_PPAGE:
-      return key::kPageUp;
-    case KEY_NPAGE:
-      return key::kPageDown;
-    case KEY_HOME:
-      return key::kHome;
-    case KEY_END:
-      return key::kEnd;
-    case KEY_BACKSPACE:
-    case KEY_DC:
-    case 8:
-    case 127:
-      return key::kBackspace;
-    case KEY_ENTER:
-    case '\r':
-    case '\n':
-      return key::kEnter;
-    default:
-      break;
+  // kCurses[i], curses' code, is the model's kModel[i].
+  static constexpr int kCurses[] = {
+      KEY_UP,    KEY_DOWN,      KEY_LEFT, KEY_RIGHT, KEY_PPAGE, KEY_NPAGE, KEY_HOME, KEY_END,
+      KEY_F(10), KEY_BACKSPACE, KEY_DC,   8,         127,       KEY_ENTER, '\r',     '\n'};
+  static constexpr int kModel[] = {
+      key::kUp,        key::kDown,  key::kLeft,  key::kRight,     key::kPageUp,    key::kPageDown,
+      key::kHome,      key::kEnd,   key::kF10,   key::kBackspace, key::kBackspace, key::kBackspace,
+      key::kBackspace, key::kEnter, key::kEnter, key::kEnter};
+  static_assert(std::size(kCurses) == std::size(kModel));
+  for (std::size_t i = 0; i < std::size(kModel); ++i) {
+    if (ch == kCurses[i]) return kModel[i];
   }
-  if (ch == KEY_F(10)) return key::kF10;
   return ch;
 }
 

@@ -3,15 +3,11 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
 #include <iostream>
 
 #include "apps/common/stdin_lines.hpp"
 #include "apps/wr8-client/console.hpp"
-#include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
-#include "link/transport.hpp"
 #include "protocol/common/car_profile.hpp"
 #include "protocol/wr8/svgui.hpp"
 
@@ -76,13 +72,10 @@ int run_with(const AppOptions& options, Config config, std::vector<typename Kit:
     return kExitUsage;
   }
 
-  asio::io_context io;
-  link::AsioExecutor executor(io);
-  link::TransportContext context{executor, &io};
-
+  ProgramLoop program;
   typename Kit::Runner* runner_ptr = nullptr;
   BasicConsole<Kit>* console_ptr = nullptr;
-  typename Kit::Session session(context, endpoint, std::move(config),
+  typename Kit::Session session(program.context(), endpoint, std::move(config),
                                 [&](link::Time now, const typename Kit::Event& e) {
                                   if (runner_ptr != nullptr) runner_ptr->on_event(now, e);
                                   if (console_ptr != nullptr) console_ptr->on_event(now, e);
@@ -90,33 +83,29 @@ int run_with(const AppOptions& options, Config config, std::vector<typename Kit:
   wr8::RunnerOptions runner_options;
   runner_options.connect_timeout =
       link::Duration(static_cast<link::Duration::rep>(options.connect_timeout_s * 1e9));
-  typename Kit::Runner runner(executor, session, runner_options);
+  typename Kit::Runner runner(program.executor(), session, runner_options);
   runner_ptr = &runner;
 
-  int exit_code = kExitOk;
   ConsoleOptions console_options;
   console_options.interactive = interactive;
   console_options.prompt = interactive && ::isatty(STDIN_FILENO) != 0;
   console_options.print_data = options.data;
   console_options.keep_going = options.keep_going;
   console_options.log_path = options.log_path;
-  BasicConsole<Kit> console(executor, session, runner, std::cout, console_options, [&](int code) {
-    exit_code = code;
-    // Let the close reach the socket before the loop ends.
-    asio::post(io, [&io] { io.stop(); });
-  });
+  // The loop ends once the close has reached the socket.
+  BasicConsole<Kit> console(program.executor(), session, runner, std::cout, console_options,
+                            [&](int code) { program.finish(code); });
   console_ptr = &console;
 
-  StopSignals signals(io);
-  signals.on_next([&](int) { console.interrupt(); });
+  program.on_stop_signal([&](int) { console.interrupt(); });
 
-  StdinLines reader(io, {.line = [&](std::string line) { console.line(std::move(line)); },
-                         .end =
-                             [&](std::string rest) {
-                               if (!rest.empty()) console.line(std::move(rest));
-                               console.end_of_input();
-                             },
-                         .more = [&] { return !console.exited(); }});
+  StdinLines reader(program.io(), {.line = [&](std::string line) { console.line(std::move(line)); },
+                                   .end =
+                                       [&](std::string rest) {
+                                         if (!rest.empty()) console.line(std::move(rest));
+                                         console.end_of_input();
+                                       },
+                                   .more = [&] { return !console.exited(); }});
   if (interactive) {
     const std::string profile = options.profile.empty() ? "document" : options.profile;
     std::cout << "wr8-client: vehicle at " << options.host << ":" << port << " (profile " << profile
@@ -127,8 +116,7 @@ int run_with(const AppOptions& options, Config config, std::vector<typename Kit:
   } else {
     console.run_batch(std::move(actions));
   }
-  io.run();
-  return exit_code;
+  return program.run();
 }
 
 }  // namespace

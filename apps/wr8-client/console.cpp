@@ -59,7 +59,7 @@ std::string underscores_to_spaces(std::string_view s) {
 }
 
 std::optional<std::string> connection_text(const wr8::ConnectionEvent& e) {
-  if (e.state == wr8::ConnectionState::waiting_to_reconnect)
+  if (e.state == wr8::ConnectionState::reconnecting)
     return "connection lost; reconnecting (attempt " + std::to_string(e.attempt + 1) + ")";
   if (e.state == wr8::ConnectionState::connecting && e.attempt > 0)
     return "reconnect attempt " + std::to_string(e.attempt);
@@ -91,29 +91,29 @@ std::string format_state(const wr8::Wr8ClientCore& core, link::Time now) {
 
 // ---- the document dialect ----
 
-wr8::ParsedLine DocumentKit::parse(const Session& session, std::string_view line) {
+wr8::ParsedLine parse_line(const wr8::Wr8Session& session, std::string_view line) {
   return wr8::parse_operator_line(line, session.core().config().profile);
 }
 
-std::string DocumentKit::to_text(const Session& session, const Action& action) {
+std::string action_text(const wr8::Wr8Session& session, const wr8::OperatorAction& action) {
   return wr8::to_text(action, session.core().config().profile);
 }
 
-std::string DocumentKit::state_text(const Session& session, link::Time now) {
+std::string state_text(const wr8::Wr8Session& session, link::Time now) {
   return format_state(session.core(), now);
 }
 
-std::string DocumentKit::help(const Session&) {
+std::string help_text(const wr8::Wr8Session&) {
   return std::string(kDocumentHelp) + std::string(kConsoleCommands);
 }
 
-std::optional<DataLine> DocumentKit::data_line(const Event& event) {
+std::optional<DataLine> data_line(const wr8::Event& event) {
   const auto* t = std::get_if<wr8::TelemetryEvent>(&event);
   if (t == nullptr) return std::nullopt;
   return DataLine{0, static_cast<int>(t->live.state), format_live(t->live)};
 }
 
-std::optional<std::string> DocumentKit::event_text(const Session& session, const Event& event) {
+std::optional<std::string> event_text(const wr8::Wr8Session& session, const wr8::Event& event) {
   return std::visit(
       Overloaded{
           [&](const wr8::ConnectionEvent& e) -> std::optional<std::string> {
@@ -124,7 +124,7 @@ std::optional<std::string> DocumentKit::event_text(const Session& session, const
           },
           [&](const wr8::StaleEvent& e) -> std::optional<std::string> {
             return e.stale ? "DATA stale: none for " +
-                                 wr8::format_duration(session.core().config().stale_after)
+                                 client::duration_text(session.core().config().stale_after)
                            : std::string("DATA flowing again");
           },
           [&](const wr8::RequestEvent& e) -> std::optional<std::string> {
@@ -183,7 +183,7 @@ void BasicConsole<Kit>::on_event(link::Time now, const typename Kit::Event& even
   if (exited_) return;
   if (!options_.interactive) {
     if (!options_.print_data) return;
-    const auto line = Kit::data_line(event);
+    const auto line = data_line(event);
     if (!line) return;
     // On a change of state code, else at most once a second, per stream.
     auto it = data_printed_.find(line->stream);
@@ -194,13 +194,13 @@ void BasicConsole<Kit>::on_event(link::Time now, const typename Kit::Event& even
     print(stamp(now) + "  data  " + line->text);
     return;
   }
-  if (const auto text = Kit::event_text(session_, event)) print(stamp(now) + "  " + *text);
+  if (const auto text = event_text(session_, event)) print(stamp(now) + "  " + *text);
   prompt();
 }
 
 template <class Kit>
 void BasicConsole<Kit>::result(const typename Kit::Result& r) {
-  const std::string text = Kit::to_text(session_, r.action);
+  const std::string text = action_text(session_, r.action);
   char head[64];
   std::snprintf(head, sizeof head, "%-24s %-4s", text.c_str(), r.ok ? "ok" : "FAIL");
   std::string line = stamp(r.finished) + "  " + head;
@@ -248,7 +248,7 @@ void BasicConsole<Kit>::process() {
     const std::string text = std::move(pending_.front());
     pending_.pop_front();
     if (builtin(text)) continue;
-    auto parsed = Kit::parse(session_, text);
+    auto parsed = parse_line(session_, text);
     if (parsed.error) {
       print("error: column " + std::to_string(parsed.error->column) + ": " + parsed.error->message);
       continue;
@@ -276,7 +276,7 @@ bool BasicConsole<Kit>::builtin(const std::string& raw) {
   const std::string rest = trim(text.substr(std::min(text.size(), word.size())));
   const auto& core = session_.core();
   if (word == "state") {
-    std::string s = Kit::state_text(session_, executor_.now());
+    std::string s = state_text(session_, executor_.now());
     s.pop_back();
     print(s);
   } else if (word == "log") {
@@ -289,11 +289,11 @@ bool BasicConsole<Kit>::builtin(const std::string& raw) {
         return true;
       }
     }
-    const auto entries = core.log()->snapshot();
+    const auto entries = core.log()->entries();
     wr8::CommLog tail;
     for (std::size_t i = entries.size() > n ? entries.size() - n : 0; i < entries.size(); ++i)
       tail.add(entries[i]);
-    std::string s = tail.export_text();
+    std::string s = tail.to_string(client::LogFormat::txt);
     if (!s.empty()) s.pop_back();
     print(s.empty() ? "(the log is empty)" : s);
   } else if (word == "history") {
@@ -306,11 +306,11 @@ bool BasicConsole<Kit>::builtin(const std::string& raw) {
       return true;
     }
     if (save_log(*core.log(), rest))
-      print("saved " + std::to_string(core.log()->snapshot().size()) + " log entries to " + rest);
+      print("saved " + std::to_string(core.log()->size()) + " log entries to " + rest);
     else
       print("error: cannot write " + rest);
   } else if (word == "help" || word == "?") {
-    std::string s = Kit::help(session_);
+    std::string s = help_text(session_);
     s.pop_back();
     print(s);
   } else if (word == "quit" || word == "exit") {

@@ -56,39 +56,40 @@ struct DataLine {
   std::string text;
 };
 
-/// The console's view of the document dialect's client (Wr8Session).
-struct DocumentKit {
-  using Session = wr8::Wr8Session;
-  using Runner = wr8::OperatorRunner;
-  using Action = wr8::OperatorAction;
-  using Event = wr8::Event;
-  using Result = wr8::ActionResult;
-  static wr8::ParsedLine parse(const Session& session, std::string_view line);
-  static std::string to_text(const Session& session, const Action& action);
-  static std::string state_text(const Session& session, link::Time now);
-  /// The interactive line an event prints (without its time), if any.
-  static std::optional<std::string> event_text(const Session& session, const Event& event);
-  static std::optional<DataLine> data_line(const Event& event);
-  static std::string help(const Session& session);
+/// One dialect's client as the console drives it. What a dialect prints
+/// is in overloads on its Session (parse_line, action_text, state_text,
+/// event_text, data_line, help_text): the document's in console.cpp, the
+/// real programs' below.
+template <class SessionT, class RunnerT, class ActionT, class EventT, class ResultT>
+struct ConsoleKit {
+  using Session = SessionT;
+  using Runner = RunnerT;
+  using Action = ActionT;
+  using Event = EventT;
+  using Result = ResultT;
 };
+using DocumentKit = ConsoleKit<wr8::Wr8Session, wr8::OperatorRunner, wr8::OperatorAction,
+                               wr8::Event, wr8::ActionResult>;
+using SvguiKit = ConsoleKit<wr8::SvguiSession, wr8::SvguiRunner, wr8::SvguiAction, wr8::SvguiEvent,
+                            wr8::SvguiActionResult>;
 
-/// The console's view of the real programs' dialects (SvguiSession).
-struct SvguiKit {
-  using Session = wr8::SvguiSession;
-  using Runner = wr8::SvguiRunner;
-  using Action = wr8::SvguiAction;
-  using Event = wr8::SvguiEvent;
-  using Result = wr8::SvguiActionResult;
-  static wr8::ParsedSvguiLine parse(const Session& session, std::string_view line);
-  static std::string to_text(const Session& session, const Action& action);
-  static std::string state_text(const Session& session, link::Time now);
-  static std::optional<std::string> event_text(const Session& session, const Event& event);
-  static std::optional<DataLine> data_line(const Event& event);
-  static std::string help(const Session& session);
-};
+// ---- what the real programs' dialects print (svgui_console.cpp) ----
 
 /// The state command's text for a real program's vehicle.
 std::string format_svgui_state(const wr8::SvguiClientCore& core, link::Time now);
+/// A typed line as an action of the session's profile.
+wr8::ParsedSvguiLine parse_line(const wr8::SvguiSession& session, std::string_view line);
+/// An action as the history and the result lines show it.
+std::string action_text(const wr8::SvguiSession& session, const wr8::SvguiAction& action);
+/// The `state` command's text.
+std::string state_text(const wr8::SvguiSession& session, link::Time now);
+/// The interactive line an event prints (without its time), if any.
+std::optional<std::string> event_text(const wr8::SvguiSession& session,
+                                      const wr8::SvguiEvent& event);
+/// What `--data` prints of an event, if it is a DATA packet.
+std::optional<DataLine> data_line(const wr8::SvguiEvent& event);
+/// The `help` command's text.
+std::string help_text(const wr8::SvguiSession& session);
 
 /// wr8-client's console over one dialect's session and runner.
 template <class Kit>

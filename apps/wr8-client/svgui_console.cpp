@@ -69,28 +69,7 @@ std::string low_freq_text(const svgui::LowFreqData& d) {
 }
 
 std::string request_text(const wr8::RequestEvent& e) {
-  std::string what;
-  if (e.kind == wr8::RequestKind::settings) {
-    what = e.coi == 0 ? "set" : "settings";
-  } else {
-    switch (e.task) {
-      case wr8::proto::TaskCode::drive:
-        what = "forward";
-        break;
-      case wr8::proto::TaskCode::turn:
-        what = "wheels";
-        break;
-      case wr8::proto::TaskCode::blink:
-        what = "signals";
-        break;
-      case wr8::proto::TaskCode::get_settings:
-        what = "set-request";
-        break;
-      case wr8::proto::TaskCode::check:
-        what = "task 0";
-        break;
-    }
-  }
+  std::string what = wr8::svgui_request_name(e);
   if (e.coi != 0) what += " (COI " + std::to_string(e.coi) + ")";
   what += " " + underscores_to_spaces(wr8::to_string(e.state));
   if (!e.note.empty()) what += ": " + e.note;
@@ -115,16 +94,13 @@ std::string format_svgui_state(const wr8::SvguiClientCore& core, link::Time now)
     out += "open tasks: " + std::to_string(core.open_requests()) + "\n";
     return out;
   }
-  if (const auto& h = core.high_freq())
-    out += "high-freq:  " + high_freq_text(h->value) + "  (age " + age(now, h->at) + ")" +
-           stale(wr8::DataStream::high_freq) + "\n";
-  else
-    out += "high-freq:  none received yet\n";
-  if (const auto& l = core.low_freq())
-    out += "low-freq:   " + low_freq_text(l->value) + "  (age " + age(now, l->at) + ")" +
-           stale(wr8::DataStream::low_freq) + "\n";
-  else
-    out += "low-freq:   none received yet\n";
+  // A stream's last packet with its age, or that none came yet.
+  const auto stream = [&](std::string label, const auto& last, wr8::DataStream s, auto text) {
+    if (!last) return label + "none received yet\n";
+    return label + text(last->value) + "  (age " + age(now, last->at) + ")" + stale(s) + "\n";
+  };
+  out += stream("high-freq:  ", core.high_freq(), wr8::DataStream::high_freq, high_freq_text);
+  out += stream("low-freq:   ", core.low_freq(), wr8::DataStream::low_freq, low_freq_text);
   if (const auto& m = core.map())
     out += "map:        " + std::to_string(m->width) + " x " + std::to_string(m->height) + "\n";
   else
@@ -137,24 +113,24 @@ std::string format_svgui_state(const wr8::SvguiClientCore& core, link::Time now)
   return out;
 }
 
-wr8::ParsedSvguiLine SvguiKit::parse(const Session& session, std::string_view line) {
+wr8::ParsedSvguiLine parse_line(const wr8::SvguiSession& session, std::string_view line) {
   return wr8::parse_svgui_line(line, session.core().version());
 }
 
-std::string SvguiKit::to_text(const Session&, const Action& action) {
+std::string action_text(const wr8::SvguiSession&, const wr8::SvguiAction& action) {
   return wr8::to_text(action);
 }
 
-std::string SvguiKit::state_text(const Session& session, link::Time now) {
+std::string state_text(const wr8::SvguiSession& session, link::Time now) {
   return format_svgui_state(session.core(), now);
 }
 
-std::string SvguiKit::help(const Session& session) {
+std::string help_text(const wr8::SvguiSession& session) {
   const bool v2019 = session.core().version() == svgui::Version::v2019;
   return std::string(v2019 ? kHelp2019 : kHelpHead) + std::string(kConsoleCommands);
 }
 
-std::optional<DataLine> SvguiKit::data_line(const Event& event) {
+std::optional<DataLine> data_line(const wr8::SvguiEvent& event) {
   if (const auto* d = std::get_if<wr8::DataEvent>(&event))
     return DataLine{0, static_cast<int>(d->data.state), data_text(d->data)};
   if (const auto* h = std::get_if<wr8::HighFreqEvent>(&event))
@@ -164,7 +140,8 @@ std::optional<DataLine> SvguiKit::data_line(const Event& event) {
   return std::nullopt;
 }
 
-std::optional<std::string> SvguiKit::event_text(const Session& session, const Event& event) {
+std::optional<std::string> event_text(const wr8::SvguiSession& session,
+                                      const wr8::SvguiEvent& event) {
   const auto& core = session.core();
   return std::visit(Overloaded{
                         [&](const wr8::ConnectionEvent& e) -> std::optional<std::string> {
@@ -181,7 +158,7 @@ std::optional<std::string> SvguiKit::event_text(const Session& session, const Ev
                               e.stream == wr8::DataStream::high_freq  ? c.high_freq_stale_after
                               : e.stream == wr8::DataStream::low_freq ? c.low_freq_stale_after
                                                                       : c.data_stale_after;
-                          return name + " stale: none for " + wr8::format_duration(after);
+                          return name + " stale: none for " + client::duration_text(after);
                         },
                         [&](const wr8::RequestEvent& e) -> std::optional<std::string> {
                           // A sent request says something only when no answer will come.

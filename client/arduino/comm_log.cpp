@@ -1,18 +1,13 @@
 #include "client/arduino/comm_log.hpp"
 
+#include <cstdio>
 #include <ctime>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "protocol/common/bytes.hpp"
 
 namespace hil::client::arduino {
-
-std::string_view to_string(LogDirection d) {
-  return d == LogDirection::tx ? "TX" : "RX";
-}
 
 std::string iso8601_utc(std::int64_t utc_us) {
   // Floor division, so times before 1970 still get a valid fraction.
@@ -32,39 +27,7 @@ std::string iso8601_utc(std::int64_t utc_us) {
   return buffer;
 }
 
-void CommLog::add(LogEntry entry) {
-  std::lock_guard lock(mutex_);
-  entries_.push_back(std::move(entry));
-}
-
-void CommLog::tx(std::int64_t utc_us, std::string raw, std::optional<std::uint8_t> seq) {
-  add({LogDirection::tx, utc_us, std::move(raw), seq});
-}
-
-void CommLog::rx(std::int64_t utc_us, std::string raw, std::optional<std::uint8_t> seq) {
-  add({LogDirection::rx, utc_us, std::move(raw), seq});
-}
-
-std::vector<LogEntry> CommLog::entries() const {
-  std::lock_guard lock(mutex_);
-  return entries_;
-}
-
-std::size_t CommLog::size() const {
-  std::lock_guard lock(mutex_);
-  return entries_.size();
-}
-
-void CommLog::clear() {
-  std::lock_guard lock(mutex_);
-  entries_.clear();
-}
-
 namespace {
-
-std::string hex_of(const std::string& raw) {
-  return protocol::to_hex(protocol::to_bytes(raw));
-}
 
 std::string seq_text(const std::optional<std::uint8_t>& seq) {
   if (!seq) return "";
@@ -73,64 +36,25 @@ std::string seq_text(const std::optional<std::uint8_t>& seq) {
   return buffer;
 }
 
-// RFC 4180 quoting: raw frames may hold commas and quotes.
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
-
 }  // namespace
 
-std::string CommLog::to_string(LogFormat format) const {
-  const auto all = entries();
-  std::ostringstream out;
-  if (format == LogFormat::csv) out << "time,direction,seq,raw,hex\n";
-  for (const auto& e : all) {
-    const std::string time = iso8601_utc(e.utc_us);
-    const std::string hex = hex_of(e.raw);
-    switch (format) {
-      case LogFormat::txt:
-        out << time << ' ' << arduino::to_string(e.direction)
-            << " seq=" << (e.seq ? seq_text(e.seq) : "--") << ' '
-            << protocol::escape(protocol::to_bytes(e.raw)) << " [" << hex << "]\n";
-        break;
-      case LogFormat::csv:
-        out << time << ',' << arduino::to_string(e.direction) << ',' << seq_text(e.seq) << ','
-            << csv_field(e.raw) << ',' << hex << '\n';
-        break;
-      case LogFormat::ndjson: {
-        nlohmann::json j = {{"time", time},
-                            {"direction", arduino::to_string(e.direction)},
-                            {"raw", e.raw},
-                            {"hex", hex}};
-        j["seq"] = e.seq ? nlohmann::json(*e.seq) : nlohmann::json(nullptr);
-        out << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
-        break;
-      }
+std::string LogEntry::line(LogFormat format) const {
+  const std::string time = iso8601_utc(utc_us);
+  const std::string direction(to_string(kind));
+  const std::string hex = protocol::to_hex(protocol::to_bytes(raw));
+  switch (format) {
+    case LogFormat::txt:
+      return time + ' ' + direction + " seq=" + (seq ? seq_text(seq) : "--") + ' ' +
+             protocol::escape(protocol::to_bytes(raw)) + " [" + hex + "]\n";
+    case LogFormat::csv:
+      return time + ',' + direction + ',' + seq_text(seq) + ',' + csv_field(raw) + ',' + hex + '\n';
+    case LogFormat::ndjson: {
+      nlohmann::json j = {{"time", time}, {"direction", direction}, {"raw", raw}, {"hex", hex}};
+      j["seq"] = seq ? nlohmann::json(*seq) : nlohmann::json(nullptr);
+      return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + '\n';
     }
   }
-  return out.str();
-}
-
-bool CommLog::save(const std::string& path, LogFormat format) const {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) return false;
-  file << to_string(format);
-  return static_cast<bool>(file);
-}
-
-LogFormat CommLog::format_for(std::string_view path) {
-  auto ends_with = [&](std::string_view s) {
-    return path.size() >= s.size() && path.substr(path.size() - s.size()) == s;
-  };
-  if (ends_with(".csv")) return LogFormat::csv;
-  if (ends_with(".json") || ends_with(".ndjson")) return LogFormat::ndjson;
-  return LogFormat::txt;
+  return {};
 }
 
 }  // namespace hil::client::arduino

@@ -29,7 +29,7 @@ OperatorLine error_at(std::size_t column, std::string message) {
 
 OperatorLine command_line(OperatorCommand command) {
   OperatorLine out;
-  out.command = std::move(command);
+  out.action = std::move(command);
   return out;
 }
 
@@ -200,8 +200,8 @@ Script parse_script(std::string_view text, const std::string& file) {
     auto parsed = parse_operator_line(line);
     if (parsed.error) {
       script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
-    } else if (parsed.command) {
-      script.steps.push_back({std::move(*parsed.command), number});
+    } else if (parsed.action) {
+      script.steps.push_back({std::move(*parsed.action), number});
     }
   }
   return script;
@@ -341,7 +341,7 @@ void OperatorRunner::start(Queued queued) {
     return;
   }
   if (auto* save = std::get_if<SaveLogCommand>(&queued.command)) {
-    const auto format = CommLog::format_for(save->path);
+    const auto format = log_format_for(save->path);
     const std::size_t frames = session_.log().size();
     CommandOutcome done = std::move(*current_);
     done.ok = session_.log().save(save->path, format);
@@ -365,9 +365,9 @@ void OperatorRunner::start(Queued queued) {
           wait_timer_ = 0;
           session_.open();
           // The port may open (or fail) within open(); else a LinkChanged ends it.
-          if (awaiting_reconnect_ &&
-              (session_.state() == LinkState::open || session_.state() == LinkState::down)) {
-            finish_reconnect(session_.state() == LinkState::open, "");
+          if (awaiting_reconnect_ && (session_.state() == ConnectionState::connected ||
+                                      session_.state() == ConnectionState::down)) {
+            finish_reconnect(session_.state() == ConnectionState::connected, "");
           }
         });
     return;
@@ -381,10 +381,11 @@ void OperatorRunner::start(Queued queued) {
 void OperatorRunner::on_session_event(const Event& event) {
   if (awaiting_reconnect_ && current_) {
     if (auto* change = std::get_if<LinkChanged>(&event);
-        change && (change->to == LinkState::open || change->to == LinkState::down)) {
+        change &&
+        (change->to == ConnectionState::connected || change->to == ConnectionState::down)) {
       // The caller's handler sees the change before the outcome.
       if (on_event_) on_event_(event);
-      finish_reconnect(change->to == LinkState::open, change->reason);
+      finish_reconnect(change->to == ConnectionState::connected, change->reason);
       return;
     }
   }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "client/arduino/session.hpp"
+#include "client/common/operator_text.hpp"
 #include "link/executor.hpp"
 #include "link/time.hpp"
 #include "protocol/arduino/message.hpp"
@@ -64,18 +65,10 @@ std::string to_text(const OperatorCommand& command);
 
 // ---- parsing ----
 
-struct OperatorParseError {
-  std::size_t column = 1;  ///< 1-based, where the offending token starts (or the line ends)
-  std::string message;     ///< what was expected, e.g. "V needs a number 0..255"
-  friend bool operator==(const OperatorParseError&, const OperatorParseError&) = default;
-};
-
-/// One parsed line: a command, nothing (blank or a comment), or an error.
-struct OperatorLine {
-  std::optional<OperatorCommand> command;
-  std::optional<OperatorParseError> error;
-  bool ok() const { return !error.has_value(); }
-};
+/// Where a line is wrong, e.g. "V needs a number 0..255".
+using OperatorParseError = client::LineError;
+/// One parsed line: a command (`action`), nothing (blank or a comment), or an error.
+using OperatorLine = client::ParseResult<OperatorCommand>;
 
 /// Parses one line. Command words ignore letter case ("PING", "ping", "v 160",
 /// "V:160"); '#' starts a comment that runs to the end of the line.

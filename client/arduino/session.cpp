@@ -45,7 +45,8 @@ void ArduinoSession::drain() {
     // reads in wire order (a NACK BAD_CS, then its resend).
     for (auto& e : events) {
       if (auto* frame = std::get_if<FrameReceived>(&e)) {
-        log_->rx(wall_clock_(), std::string(frame->raw.begin(), frame->raw.end()), frame->seq);
+        log_->add({LogKind::rx, wall_clock_(), std::string(frame->raw.begin(), frame->raw.end()),
+                   frame->seq});
       }
     }
     for (auto& a : actions)
@@ -58,7 +59,8 @@ void ArduinoSession::drain() {
 
 void ArduinoSession::perform(Action& action) {
   if (auto* send = std::get_if<SendFrame>(&action)) {
-    log_->tx(wall_clock_(), std::string(send->bytes.begin(), send->bytes.end()), send->seq);
+    log_->add({LogKind::tx, wall_clock_(), std::string(send->bytes.begin(), send->bytes.end()),
+               send->seq});
     binding_.write(send->bytes);
   } else if (std::holds_alternative<ClosePort>(action)) {
     binding_.close();

@@ -9,8 +9,8 @@
 #include <optional>
 #include <string_view>
 
-#include "client/arduino/client_core.hpp"
 #include "client/arduino/comm_log.hpp"
+#include "client/arduino/core.hpp"
 #include "client/common/pipe_binding.hpp"
 #include "link/endpoint.hpp"
 #include "link/transport.hpp"
@@ -61,7 +61,7 @@ class ArduinoSession {
   RequestId ir(Callback done = {}) { return request(protocol::arduino::IrRead{}, std::move(done)); }
   RequestId help(Callback done = {}) { return request(protocol::arduino::Help{}, std::move(done)); }
 
-  LinkState state() const { return core_.state(); }
+  ConnectionState state() const { return core_.state(); }
   const ArduinoClientCore& core() const { return core_; }
   CommLog& log() { return *log_; }
   std::shared_ptr<CommLog> shared_log() const { return log_; }

@@ -1,10 +1,32 @@
 #include "client/common/comm_log.hpp"
 
-#include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 namespace hil::client {
+
+LogFormat log_format_for(std::string_view path) {
+  if (path.ends_with(".csv")) return LogFormat::csv;
+  if (path.ends_with(".ndjson") || path.ends_with(".jsonl") || path.ends_with(".json"))
+    return LogFormat::ndjson;
+  return LogFormat::txt;
+}
+
+bool write_log_file(const std::string& path, std::string_view text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  return out && out.write(text.data(), static_cast<std::streamsize>(text.size())) && out.flush();
+}
+
+std::string csv_field(std::string_view text) {
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
 
 std::string_view to_string(LogKind kind) {
   switch (kind) {
@@ -20,40 +42,6 @@ std::string_view to_string(LogKind kind) {
   return "?";
 }
 
-void CommLog::add(LogEntry entry) {
-  std::lock_guard lock(mutex_);
-  entries_.push_back(std::move(entry));
-  if (entries_.size() > max_entries_) {
-    // Drop a tenth at once so a full log does not shift on every frame.
-    const std::size_t n = std::max<std::size_t>(1, max_entries_ / 10);
-    entries_.erase(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(n));
-    dropped_ += n;
-  }
-}
-
-std::vector<LogEntry> CommLog::snapshot() const {
-  std::lock_guard lock(mutex_);
-  return entries_;
-}
-
-std::vector<LogEntry> CommLog::since(std::uint64_t from) const {
-  std::lock_guard lock(mutex_);
-  const std::uint64_t first = from > dropped_ ? from - dropped_ : 0;
-  if (first >= entries_.size()) return {};
-  return {entries_.begin() + static_cast<std::ptrdiff_t>(first), entries_.end()};
-}
-
-std::uint64_t CommLog::total() const {
-  std::lock_guard lock(mutex_);
-  return dropped_ + entries_.size();
-}
-
-void CommLog::clear() {
-  std::lock_guard lock(mutex_);
-  dropped_ += entries_.size();
-  entries_.clear();
-}
-
 namespace {
 
 std::string time_ms(link::Time at) {
@@ -62,7 +50,8 @@ std::string time_ms(link::Time at) {
   return buf;
 }
 
-std::string csv_field(std::string_view s) {
+// Every field quoted, as a spreadsheet reads the LOGI and WR8 logs.
+std::string quoted_csv(std::string_view s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"') out += '"';
@@ -91,41 +80,29 @@ std::string printable(std::string_view s) {
 
 }  // namespace
 
-std::string CommLog::export_text() const {
-  std::string out;
-  for (const auto& e : snapshot()) {
-    char head[48];
-    std::snprintf(head, sizeof head, "%12.3f ms %-4s ", link::to_ms(e.at),
-                  std::string(to_string(e.kind)).c_str());
-    out += head;
-    out += printable(e.raw);
-    if (!e.raw.empty() && !e.description.empty()) out += "  ";
-    out += e.description;
-    out += '\n';
+std::string LogEntry::line(LogFormat format) const {
+  switch (format) {
+    case LogFormat::txt: {
+      char head[48];
+      std::snprintf(head, sizeof head, "%12.3f ms %-4s ", link::to_ms(at),
+                    std::string(to_string(kind)).c_str());
+      std::string out = head + printable(raw);
+      if (!raw.empty() && !description.empty()) out += "  ";
+      return out + description + '\n';
+    }
+    case LogFormat::csv:
+      return time_ms(at) + "," + std::string(to_string(kind)) + "," + quoted_csv(printable(raw)) +
+             "," + quoted_csv(description) + "\r\n";
+    case LogFormat::ndjson: {
+      nlohmann::json j;
+      j["time_ms"] = link::to_ms(at);
+      j["kind"] = std::string(to_string(kind));
+      j["raw"] = printable(raw);
+      j["description"] = printable(description);
+      return j.dump() + "\n";
+    }
   }
-  return out;
-}
-
-std::string CommLog::export_csv() const {
-  std::string out = "time_ms,kind,raw,description\r\n";
-  for (const auto& e : snapshot()) {
-    out += time_ms(e.at) + "," + std::string(to_string(e.kind)) + "," +
-           csv_field(printable(e.raw)) + "," + csv_field(e.description) + "\r\n";
-  }
-  return out;
-}
-
-std::string CommLog::export_ndjson() const {
-  std::string out;
-  for (const auto& e : snapshot()) {
-    nlohmann::json j;
-    j["time_ms"] = link::to_ms(e.at);
-    j["kind"] = std::string(to_string(e.kind));
-    j["raw"] = printable(e.raw);
-    j["description"] = printable(e.description);
-    out += j.dump() + "\n";
-  }
-  return out;
+  return {};
 }
 
 }  // namespace hil::client

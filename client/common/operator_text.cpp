@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <numeric>
 
+#include "base/duration.hpp"
+
 namespace hil::client {
 
 std::string to_lower(std::string_view text) {
@@ -136,13 +138,31 @@ std::optional<link::Duration> parse_duration(std::string_view text, link::Durati
   return link::Duration(ns);
 }
 
-std::string duration_text(link::Duration d) {
+namespace {
+
+// "<whole>.<part>" with `part` written in `digits` digits, trailing zeros dropped.
+std::string decimal_text(std::int64_t whole, std::int64_t part, std::size_t digits) {
+  std::string frac = std::to_string(part);
+  frac.insert(0, digits - frac.size(), '0');
+  while (frac.back() == '0')
+    frac.pop_back();
+  return std::to_string(whole) + "." + frac;
+}
+
+}  // namespace
+
+std::string duration_text(link::Duration d, DurationStyle style) {
+  constexpr std::int64_t kMinute = 60'000'000'000;
+  constexpr std::int64_t kSecond = 1'000'000'000;
+  constexpr std::int64_t kMilli = 1'000'000;
   const auto ns = d.count();
-  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
-  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%gms", static_cast<double>(ns) / 1e6);
-  return buf;
+  const bool largest = style == DurationStyle::largest_unit;
+  if (largest && ns != 0 && ns % kMinute == 0) return std::to_string(ns / kMinute) + "m";
+  // Whole seconds or milliseconds: "2s", "250ms" (and "1500ms" unless largest).
+  if (ns % kSecond == 0 || (ns % kMilli == 0 && (ns < kSecond || !largest)))
+    return hil::duration_literal(d);
+  if (ns % kMilli == 0) return decimal_text(ns / kSecond, ns % kSecond / kMilli, 3) + "s";
+  return decimal_text(ns / kMilli, ns % kMilli, 6) + "ms";
 }
 
 std::vector<std::string_view> split_lines(std::string_view text) {

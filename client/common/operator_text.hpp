@@ -73,8 +73,35 @@ ParsedInteger parse_integer(std::string_view text, std::int64_t lo, std::int64_t
 /// otherwise. A point needs a digit after it ("1.s" is refused).
 std::optional<link::Duration> parse_duration(std::string_view text, link::Duration max);
 
-/// "2s", "250ms", "1.5ms": whole seconds, else milliseconds.
-std::string duration_text(link::Duration d);
+/// How duration_text writes a duration that is not whole seconds, or
+/// whole milliseconds under a second.
+enum class DurationStyle : std::uint8_t {
+  milliseconds,  ///< "1500ms", "120s" (WR8, Arduino)
+  largest_unit,  ///< "1.5s", "2m" for whole minutes (LOGI)
+};
+
+/// A duration as an operator writes it, read back exactly by
+/// parse_duration: "2s", "250ms", finer than a millisecond "1.5ms", the
+/// rest as `style` says.
+std::string duration_text(link::Duration d, DurationStyle style = DurationStyle::milliseconds);
+
+/// Where an operator's line is wrong: the 1-based column of the offending
+/// word (one past the end of the line when a word is missing) and what was
+/// expected.
+struct LineError {
+  std::size_t column = 1;
+  std::string message;
+  friend bool operator==(const LineError&, const LineError&) = default;
+};
+
+/// One parsed line of an operator language: an action, nothing (a blank
+/// line or a comment), or an error.
+template <class Action>
+struct ParseResult {
+  std::optional<Action> action;  ///< empty for a blank line, a comment, or an error
+  std::optional<LineError> error;
+  bool ok() const { return !error.has_value(); }
+};
 
 /// The lines of a script, without their '\n'; no last empty line after a
 /// final newline.

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/connection.hpp"
 #include "link/time.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/leka/codec.hpp"
@@ -25,6 +26,8 @@ using link::Time;
 using protocol::Bytes;
 using protocol::ByteView;
 namespace proto = protocol::leka;
+using client::ConnectionState;
+using client::to_string;
 
 /// Why a builder call was refused; `field` names the wrong value.
 /// not_in_profile: a command the client's profile does not have
@@ -157,6 +160,10 @@ class LekaClientCore {
 
   std::size_t queued_frames() const { return queue_.size(); }
   bool connected() const { return connected_; }
+  /// The port in the shared vocabulary: connected (open) or disconnected.
+  ConnectionState state() const {
+    return connected_ ? ConnectionState::connected : ConnectionState::disconnected;
+  }
   const ClientConfig& config() const { return config_; }
 
  private:

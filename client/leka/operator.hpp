@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/operator_text.hpp"
 #include "client/leka/core.hpp"
 #include "client/leka/session.hpp"
 #include "link/executor.hpp"
@@ -35,11 +36,9 @@ struct OperatorLine {
   std::size_t commands = 0;     ///< commands in the line, infos included
 };
 
-/// Where a line is wrong: the 1-based column and what was expected.
-struct OperatorError {
-  std::size_t column = 1;
-  std::string message;  ///< e.g. "belt single: led must be 0..19, got 25"
-};
+/// Where a line is wrong: the 1-based column and what was expected, e.g.
+/// "belt single: led must be 0..19, got 25".
+using OperatorError = client::LineError;
 
 /// Parses one line. Never throws on input.
 std::variant<OperatorLine, OperatorError> parse_operator_line(

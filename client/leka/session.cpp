@@ -51,7 +51,7 @@ void LekaSession::drain() {
   drain_core(core_, draining_, [this](auto& actions, auto& events) {
     for (auto& e : events) {
       if (auto* line = std::get_if<LineReceived>(&e)) {
-        log_->add({LogDirection::rx, wall_clock_(),
+        log_->add({LogKind::rx, wall_clock_(),
                    protocol::Bytes(line->line.begin(), line->line.end()), line->line});
       }
     }
@@ -60,7 +60,7 @@ void LekaSession::drain() {
       if (auto item = proto::decode_frame(a.bytes);
           auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item))
         note = proto::describe(frame->message);
-      log_->add({LogDirection::tx, wall_clock_(), a.bytes, std::move(note)});
+      log_->add({LogKind::tx, wall_clock_(), a.bytes, std::move(note)});
       binding_.write(a.bytes);
     }
     for (auto& e : events) {

@@ -32,6 +32,7 @@ class LekaSession {
   void open();
   void close();
   bool is_open() const { return core_.connected(); }
+  ConnectionState state() const { return core_.state(); }
 
   BuildResult send(const GroupBuilder& builder);
   RequestId info(InfoCallback done = {});

@@ -5,20 +5,6 @@
 
 namespace hil::client::logi {
 
-std::string_view to_string(ConnectionState s) {
-  switch (s) {
-    case ConnectionState::disconnected:
-      return "Disconnected";
-    case ConnectionState::connecting:
-      return "Connecting";
-    case ConnectionState::connected:
-      return "Connected";
-    case ConnectionState::waiting_to_reconnect:
-      return "WaitingToReconnect";
-  }
-  return "?";
-}
-
 std::string_view to_string(CommandState s) {
   switch (s) {
     case CommandState::sent:
@@ -53,38 +39,37 @@ std::string_view to_string(Refusal r) {
   return "?";
 }
 
-LogiClientCore::LogiClientCore(ClientConfig config, std::shared_ptr<CommLog> log)
-    : config_(std::move(config)), log_(std::move(log)), decoder_(config_.decoder) {
-  if (config_.reconnect_delays.empty()) config_.reconnect_delays = {link::seconds(1)};
-  if (!log_) log_ = std::make_shared<CommLog>();
+namespace {
+
+ClientConfig with_reconnect_delays(ClientConfig config) {
+  if (config.reconnect_delays.empty()) config.reconnect_delays = {link::seconds(1)};
+  return config;
 }
+
+}  // namespace
+
+LogiClientCore::LogiClientCore(ClientConfig config, std::shared_ptr<CommLog> log)
+    : ConnectionCore(std::move(log),
+                     Backoff::ladder(with_reconnect_delays(config).reconnect_delays)),
+      config_(with_reconnect_delays(std::move(config))),
+      decoder_(config_.decoder) {}
 
 // ---- connection ----
 
 void LogiClientCore::connect(Time now) {
-  want_connected_ = true;
-  if (state_ == ConnectionState::connecting || state_ == ConnectionState::connected) return;
-  reconnect_at_.reset();
-  note(now, "connect");
-  set_state(ConnectionState::connecting, 0);
-  actions_.emplace_back(OpenConnection{});
+  if (open_wanted(now, 0)) update_movement();
 }
 
 void LogiClientCore::disconnect(Time now) {
-  want_connected_ = false;
-  reconnect_at_.reset();
-  reconnect_attempt_ = 0;
-  if (state_ == ConnectionState::connected || state_ == ConnectionState::connecting) {
-    actions_.emplace_back(CloseConnection{});
-  }
-  if (state_ == ConnectionState::disconnected) return;
+  close_unwanted();
+  if (state() == ConnectionState::disconnected) return;
   note(now, "disconnect");
   lost(now, "disconnected by the operator");
   set_state(ConnectionState::disconnected);
 }
 
 void LogiClientCore::on_connected(Time now) {
-  if (state_ != ConnectionState::connecting) return;
+  if (state() != ConnectionState::connecting) return;
   // The reconnect ladder starts again only once the car has sent a valid
   // frame (on_frame): a car that accepts and hangs up at once is a failed
   // attempt, not a reason to hammer it every second.
@@ -98,9 +83,9 @@ void LogiClientCore::on_connected(Time now) {
 }
 
 void LogiClientCore::on_connect_failed(Time now) {
-  if (state_ != ConnectionState::connecting) return;
+  if (state() != ConnectionState::connecting) return;
   note(now, "connect failed");
-  if (want_connected_) {
+  if (connection_.wanted()) {
     schedule_reconnect(now);
   } else {
     set_state(ConnectionState::disconnected);
@@ -108,10 +93,10 @@ void LogiClientCore::on_connect_failed(Time now) {
 }
 
 void LogiClientCore::on_closed(Time now) {
-  if (state_ != ConnectionState::connected) return;
+  if (state() != ConnectionState::connected) return;
   note(now, "connection lost");
   lost(now, "connection lost");
-  if (want_connected_) {
+  if (connection_.wanted()) {
     schedule_reconnect(now);
   } else {
     set_state(ConnectionState::disconnected);
@@ -119,14 +104,12 @@ void LogiClientCore::on_closed(Time now) {
 }
 
 void LogiClientCore::schedule_reconnect(Time now) {
-  const auto& d = config_.reconnect_delays;
-  const auto index =
-      std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), d.size() - 1);
-  ++reconnect_attempt_;
-  reconnect_at_ = planted(PlantedBug::no_backoff) ? now : now + d[index];
-  note(now, "reconnect attempt " + std::to_string(reconnect_attempt_) + " in " +
-                link::format_ms(d[index]));
-  set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
+  auto& reconnect = connection_.reconnect();
+  const Duration delay = reconnect.next_delay();
+  reconnect.schedule_at(reconnect_time(now, delay));
+  note(now, "reconnect attempt " + std::to_string(reconnect.attempt()) + " in " +
+                link::format_ms(delay));
+  set_state(ConnectionState::reconnecting, reconnect.attempt());
 }
 
 void LogiClientCore::lost(Time now, std::string_view why) {
@@ -149,14 +132,11 @@ void LogiClientCore::lost(Time now, std::string_view why) {
 }
 
 void LogiClientCore::set_state(ConnectionState s, int attempt) {
-  if (s == state_) return;
-  state_ = s;
-  emit(ConnectionEvent{s, attempt});
-  update_movement();
+  if (change_state(s, attempt)) update_movement();
 }
 
 bool LogiClientCore::movement_enabled() const {
-  return state_ == ConnectionState::connected && mode_confirmed_ && speed_confirmed_;
+  return state() == ConnectionState::connected && mode_confirmed_ && speed_confirmed_;
 }
 
 void LogiClientCore::update_movement() {
@@ -166,15 +146,11 @@ void LogiClientCore::update_movement() {
   movement_reported_value_ = enabled;
   std::string reason;
   if (!enabled) {
-    reason = state_ != ConnectionState::connected
+    reason = state() != ConnectionState::connected
                  ? std::string(to_string(Refusal::not_connected))
                  : std::string(to_string(Refusal::mode_speed_unconfirmed));
   }
   emit(MovementEvent{enabled, std::move(reason)});
-}
-
-void LogiClientCore::note(Time now, std::string text) {
-  log_->add(LogEntry{now, LogKind::note, {}, std::move(text)});
 }
 
 // ---- operator requests ----
@@ -186,11 +162,8 @@ bool LogiClientCore::is_movement(const proto::Message& m) {
 }
 
 bool LogiClientCore::retryable(const proto::Message& m) const {
-  if (std::holds_alternative<proto::SetSpeed>(m)) return !planted(PlantedBug::no_sp_retry);
+  if (std::holds_alternative<proto::SetSpeed>(m)) return true;
   if (std::holds_alternative<proto::SetMode>(m)) return true;
-  if (const auto* st = std::get_if<proto::SetRun>(&m)) {
-    return st->run && planted(PlantedBug::retry_run);
-  }
   const auto* mv = std::get_if<proto::Move>(&m);
   return mv != nullptr && mv->direction == proto::Direction::stop;
 }
@@ -202,7 +175,7 @@ bool LogiClientCore::resend_on_confirm(const proto::Message& m) {
 
 SubmitResult LogiClientCore::submit(Time now, const proto::Message& command) {
   if (!proto::command_of(command)) return {0, Refusal::not_a_command};
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   if (is_movement(command) && !(mode_confirmed_ && speed_confirmed_)) {
     return {0, Refusal::mode_speed_unconfirmed};
   }
@@ -227,14 +200,14 @@ SubmitResult LogiClientCore::release(Time now) {
   if (!held_) return {0, Refusal::not_held};
   held_.reset();
   keepalive_at_.reset();
-  if (planted(PlantedBug::no_stop_on_release)) return {next_id_++, Refusal::none};
+  if (!stop_on_release()) return {next_id_++, Refusal::none};
   return submit(now, proto::Move{proto::Direction::stop});
 }
 
 SubmitResult LogiClientCore::emergency_stop(Time now) {
   held_.reset();
   keepalive_at_.reset();
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   // Queued motion would undo the stop once its turn came.
   std::deque<Pending> kept;
   for (auto& p : queue_) {
@@ -248,28 +221,29 @@ SubmitResult LogiClientCore::emergency_stop(Time now) {
   note(now, "emergency stop");
   // Written at once, beside whatever is in flight: a stop must not wait up
   // to a feedback timeout (and its retries) behind an unanswered command.
-  Pending stop{next_id_++, proto::Move{proto::Direction::stop}};
-  stop.switch_mode_on_reject = false;
-  const RequestId id = stop.id;
-  const bool also_st_stop = mode_ != proto::Mode::manual;
-  if (also_st_stop && planted(PlantedBug::st_stop_first)) {
-    send(now, Pending{next_id_++, proto::SetRun{false}});
-    send(now, std::move(stop));
-    return {id, Refusal::none};
-  }
-  send(now, std::move(stop));
-  if (also_st_stop) {
-    Pending st{next_id_++, proto::SetRun{false}};
-    send(now, std::move(st));
+  RequestId id = 0;  // the MV:STOP's
+  for (auto& command : emergency_stop_commands()) {
+    Pending p{next_id_++, std::move(command)};
+    if (std::holds_alternative<proto::Move>(p.command)) {
+      p.switch_mode_on_reject = false;
+      if (id == 0) id = p.id;
+    }
+    send(now, std::move(p));
   }
   return {id, Refusal::none};
+}
+
+std::vector<proto::Message> LogiClientCore::emergency_stop_commands() const {
+  std::vector<proto::Message> commands{proto::Move{proto::Direction::stop}};
+  if (mode_ != proto::Mode::manual) commands.emplace_back(proto::SetRun{false});
+  return commands;
 }
 
 SubmitResult LogiClientCore::confirm_resend(Time now, RequestId request) {
   auto it = std::find_if(awaiting_confirm_.begin(), awaiting_confirm_.end(),
                          [&](const Pending& p) { return p.id == request; });
   if (it == awaiting_confirm_.end()) return {0, Refusal::unknown_request};
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   Pending p = std::move(*it);
   awaiting_confirm_.erase(it);
   note(now, "operator confirmed resend of request " + std::to_string(request));
@@ -294,7 +268,7 @@ RequestId LogiClientCore::enqueue(Time /*now*/, proto::Message command, bool fro
 }
 
 void LogiClientCore::pump(Time now) {
-  while (state_ == ConnectionState::connected && flight_.empty() && !queue_.empty()) {
+  while (state() == ConnectionState::connected && flight_.empty() && !queue_.empty()) {
     Pending p = std::move(queue_.front());
     queue_.pop_front();
     send(now, std::move(p));
@@ -362,28 +336,23 @@ void LogiClientCore::on_timeout(Time now, Pending p) {
 // ---- input ----
 
 void LogiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
-  if (state_ != ConnectionState::connected) return;
-  if (planted(PlantedBug::read_is_frame)) decoder_ = proto::Decoder(config_.decoder);
-  decoder_.feed(bytes, items_);
+  if (state() != ConnectionState::connected) return;
+  decode(bytes, items_);
   auto items = std::exchange(items_, {});
   for (const auto& item : items) {
     if (const auto* frame = std::get_if<protocol::Frame<proto::Message>>(&item)) {
       on_frame(now, *frame);
     } else {
       const auto& error = std::get<protocol::DecodeError>(item);
-      std::string description = std::string(protocol::to_string(error.kind));
-      if (!error.detail.empty()) description += ": " + error.detail;
-      log_->add(LogEntry{now, LogKind::parse_error, std::string(error.raw.begin(), error.raw.end()),
-                         std::move(description)});
-      emit(ParseErrorEvent{error});
+      parse_error(now, std::string(error.raw.begin(), error.raw.end()), error);
     }
-    if (state_ != ConnectionState::connected) break;
+    if (state() != ConnectionState::connected) break;
   }
   pump(now);
 }
 
 void LogiClientCore::on_frame(Time now, const protocol::Frame<proto::Message>& frame) {
-  reconnect_attempt_ = 0;
+  connection_.reconnect().succeeded();
   log_->add(LogEntry{now, LogKind::rx, std::string(frame.raw.begin(), frame.raw.end()),
                      proto::describe(frame.message)});
   if (const auto* status = std::get_if<proto::Status>(&frame.message)) {
@@ -406,12 +375,7 @@ void LogiClientCore::on_frame(Time now, const protocol::Frame<proto::Message>& f
 // ---- time ----
 
 void LogiClientCore::on_timer(Time now) {
-  if (reconnect_at_ && now >= *reconnect_at_) {
-    reconnect_at_.reset();
-    note(now, "reconnect attempt " + std::to_string(reconnect_attempt_));
-    set_state(ConnectionState::connecting, reconnect_attempt_);
-    actions_.emplace_back(OpenConnection{});
-  }
+  if (reconnect_if_due(now)) update_movement();
   for (;;) {
     auto it = std::min_element(
         flight_.begin(), flight_.end(),
@@ -421,7 +385,7 @@ void LogiClientCore::on_timer(Time now) {
     flight_.erase(it);
     on_timeout(now, std::move(p));
   }
-  if (state_ == ConnectionState::connected && !stale_ && last_stat_ &&
+  if (state() == ConnectionState::connected && !stale_ && last_stat_ &&
       now >= *last_stat_ + stale_after()) {
     stale_ = true;
     note(now, "stale: no STAT for " + link::format_ms(now - *last_stat_));
@@ -429,7 +393,7 @@ void LogiClientCore::on_timer(Time now) {
   }
   if (held_ && keepalive_at_ && now >= *keepalive_at_) {
     // Only when the line is idle: a keepalive never queues behind a command.
-    if (state_ == ConnectionState::connected && queue_.empty() && flight_.empty()) {
+    if (state() == ConnectionState::connected && queue_.empty() && flight_.empty()) {
       enqueue(now, proto::Move{*held_});
     }
     while (*keepalive_at_ <= now)
@@ -439,21 +403,21 @@ void LogiClientCore::on_timer(Time now) {
 }
 
 std::optional<Time> LogiClientCore::next_wakeup() const {
-  std::optional<Time> next = reconnect_at_;
+  std::optional<Time> next = connection_.reconnect().due();
   auto consider = [&](Time t) {
     if (!next || t < *next) next = t;
   };
   for (const auto& p : flight_)
     consider(p.deadline);
-  if (state_ == ConnectionState::connected && !stale_ && last_stat_) {
+  if (state() == ConnectionState::connected && !stale_ && last_stat_) {
     consider(*last_stat_ + stale_after());
   }
   if (held_ && keepalive_at_) consider(*keepalive_at_);
   return next;
 }
 
-Duration LogiClientCore::stale_after() const {
-  return planted(PlantedBug::stale_at_5s) ? link::seconds(5) : config_.stale_after;
+void LogiClientCore::decode(protocol::ByteView bytes, std::vector<proto::Item>& items) {
+  decoder_.feed(bytes, items);
 }
 
 }  // namespace hil::client::logi

@@ -11,7 +11,9 @@
 #include <variant>
 #include <vector>
 
-#include "client/logi/comm_log.hpp"
+#include "client/common/comm_log.hpp"
+#include "client/common/connection.hpp"
+#include "client/common/connection_core.hpp"
 #include "link/time.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/logi/codec.hpp"
@@ -26,19 +28,6 @@ namespace proto = protocol::logi;
 /// Local id of one operator request; 0 is never used (unsolicited feedback).
 using RequestId = std::uint64_t;
 
-/// TEST-ONLY: a known bug planted on purpose so the property tests
-/// (tests/property/) can show that they catch it. Never set outside tests.
-enum class PlantedBug : std::uint8_t {
-  none,
-  no_backoff,          ///< reconnect at once after every loss
-  retry_run,           ///< ST:RUN is resent after a timeout like SP
-  no_stop_on_release,  ///< release() sends no MV:STOP
-  read_is_frame,       ///< each read is decoded alone: a partial frame is dropped
-  stale_at_5s,         ///< the stale warning waits 5 s instead of stale_after
-  no_sp_retry,         ///< SP is never resent after a timeout
-  st_stop_first,       ///< the emergency stop writes ST:STOP before MV:STOP
-};
-
 struct ClientConfig {
   Duration feedback_timeout = link::milliseconds(800);
   /// Resends after a timeout for SP, MD and MV:STOP (3 sends in all).
@@ -51,36 +40,29 @@ struct ClientConfig {
   bool keepalive = false;
   Duration keepalive_period = link::milliseconds(300);
   proto::DecoderOptions decoder;
-  /// TEST-ONLY (see PlantedBug); none in every real use.
-  PlantedBug planted_bug = PlantedBug::none;
 };
 
-enum class ConnectionState : std::uint8_t {
-  disconnected,
-  connecting,
-  connected,
-  waiting_to_reconnect
-};
-std::string_view to_string(ConnectionState s);
+/// The states of the shared vocabulary the LOGI core reaches:
+/// disconnected, connecting, connected, reconnecting.
+using client::ConnectionEvent;
+using client::ConnectionState;
+using client::to_string;
+
+/// The log: one entry per frame sent or received, per parse error and per note.
+using client::CommLog;
+using client::LogEntry;
+using client::LogKind;
 
 // ---- actions for the driver ----
-struct OpenConnection {
-  friend bool operator==(const OpenConnection&, const OpenConnection&) = default;
-};
+using client::CloseConnection;
+using client::OpenConnection;
 struct SendBytes {
   std::string text;  ///< one complete frame
   friend bool operator==(const SendBytes&, const SendBytes&) = default;
 };
-struct CloseConnection {
-  friend bool operator==(const CloseConnection&, const CloseConnection&) = default;
-};
 using Action = std::variant<OpenConnection, SendBytes, CloseConnection>;
 
-// ---- events for a UI ----
-struct ConnectionEvent {
-  ConnectionState state = ConnectionState::disconnected;
-  int attempt = 0;  ///< reconnect attempt number (0: operator's connect)
-};
+// ---- events for a UI (and ConnectionEvent) ----
 /// A decoded STAT.
 struct StatusEvent {
   proto::Status status;
@@ -114,9 +96,7 @@ struct StaleEvent {
 struct NoticeEvent {
   std::string text;
 };
-struct ParseErrorEvent {
-  protocol::DecodeError error;
-};
+using client::ParseErrorEvent;
 /// Whether movement controls should be enabled, and why not.
 struct MovementEvent {
   bool enabled = false;
@@ -142,13 +122,18 @@ struct SubmitResult {
   explicit operator bool() const { return refusal == Refusal::none; }
 };
 
-class LogiClientCore {
+class LogiClientCore : public ConnectionCore<Action, Event> {
  public:
   explicit LogiClientCore(ClientConfig config = {},
                           std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
+  virtual ~LogiClientCore() = default;
+  LogiClientCore(const LogiClientCore&) = default;
+  LogiClientCore(LogiClientCore&&) = default;
+  LogiClientCore& operator=(const LogiClientCore&) = default;
+  LogiClientCore& operator=(LogiClientCore&&) = default;
 
   // ---- operator ----
-  /// Connects (at once, also from WaitingToReconnect); reconnects from then on.
+  /// Connects (at once, also while reconnecting); reconnects from then on.
   void connect(Time now);
   /// Closes and stays disconnected (no reconnect).
   void disconnect(Time now);
@@ -175,11 +160,7 @@ class LogiClientCore {
   void on_timer(Time now);
   std::optional<Time> next_wakeup() const;
 
-  std::vector<Action> take_actions() { return std::exchange(actions_, {}); }
-  std::vector<Event> take_events() { return std::exchange(events_, {}); }
-
-  // ---- state ----
-  ConnectionState state() const { return state_; }
+  // ---- state (and state(), log(), take_actions(), take_events()) ----
   bool movement_enabled() const;
   bool stale() const { return stale_; }
   std::optional<proto::Direction> held() const { return held_; }
@@ -188,8 +169,28 @@ class LogiClientCore {
   const std::optional<proto::Status>& last_status() const { return status_; }
   std::size_t queued() const { return queue_.size(); }
   std::size_t in_flight() const { return flight_.size(); }
-  const std::shared_ptr<CommLog>& log() const { return log_; }
   const ClientConfig& config() const { return config_; }
+
+ protected:
+  // ---- the protocol's rules, one function each (docs/clients/logi.md) ----
+  // The property tests (tests/property/) override them to show that a
+  // client that breaks one is caught; the client itself never does.
+
+  /// Whether a command without feedback is sent again by itself: SP, MD
+  /// and MV:STOP (max_retries times), never ST:RUN.
+  virtual bool retryable(const proto::Message& m) const;
+  /// When the reconnect attempt due `delay` after a loss at `now` goes out.
+  virtual Time reconnect_time(Time now, Duration delay) const { return now + delay; }
+  /// How long without a STAT raises the stale warning: stale_after.
+  virtual Duration stale_after() const { return config_.stale_after; }
+  /// Whether release() writes MV:STOP: always.
+  virtual bool stop_on_release() const { return true; }
+  /// What an emergency stop writes, in this order: MV:STOP, then ST:STOP
+  /// unless the car is known to be in MAN.
+  virtual std::vector<proto::Message> emergency_stop_commands() const;
+  /// Decodes one read's bytes into `items`, after what the earlier reads of
+  /// the connection left (a frame may span reads).
+  virtual void decode(protocol::ByteView bytes, std::vector<proto::Item>& items);
 
  private:
   enum class Origin : std::uint8_t { operator_request, internal };
@@ -213,25 +214,13 @@ class LogiClientCore {
   void schedule_reconnect(Time now);
   void set_state(ConnectionState s, int attempt = 0);
   void update_movement();
-  void note(Time now, std::string text);
-  void emit(Event e) { events_.push_back(std::move(e)); }
   static bool is_movement(const proto::Message& m);
-  bool retryable(const proto::Message& m) const;
   static bool resend_on_confirm(const proto::Message& m);
-  Duration stale_after() const;
-  bool planted(PlantedBug bug) const { return config_.planted_bug == bug; }
 
+  // connection_'s reconnect count goes back to 0 once the car sends a valid frame.
   ClientConfig config_;
-  std::shared_ptr<CommLog> log_;
   proto::Decoder decoder_;
   std::vector<proto::Item> items_;
-  std::vector<Action> actions_;
-  std::vector<Event> events_;
-
-  ConnectionState state_ = ConnectionState::disconnected;
-  bool want_connected_ = false;
-  int reconnect_attempt_ = 0;  // attempts since the car last sent a valid frame
-  std::optional<Time> reconnect_at_;
 
   RequestId next_id_ = 1;
   std::deque<Pending> queue_;

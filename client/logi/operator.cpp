@@ -34,36 +34,11 @@ std::string direction_list() {
 
 OperatorParseResult fail(int column, std::string message) {
   OperatorParseResult r;
-  r.error = OperatorSyntaxError{column, std::move(message)};
+  r.error = OperatorSyntaxError{static_cast<std::size_t>(column), std::move(message)};
   return r;
 }
 
 }  // namespace
-
-std::string format_duration(link::Duration d) {
-  using std::chrono::nanoseconds;
-  const auto ns = d.count();
-  const std::int64_t minute = 60'000'000'000;
-  const std::int64_t second = 1'000'000'000;
-  const std::int64_t milli = 1'000'000;
-  if (ns != 0 && ns % minute == 0) return std::to_string(ns / minute) + "m";
-  if (ns % second == 0) return std::to_string(ns / second) + "s";
-  if (ns % milli == 0) {
-    const auto ms = ns / milli;
-    if (ms < 1000) return std::to_string(ms) + "ms";
-    std::string frac = std::to_string(ms % 1000);
-    frac.insert(0, 3 - frac.size(), '0');
-    while (frac.back() == '0')
-      frac.pop_back();
-    return std::to_string(ms / 1000) + "." + frac + "s";
-  }
-  // Finer than a millisecond: fractional milliseconds, trailing zeros trimmed.
-  std::string frac = std::to_string(ns % milli);
-  frac.insert(0, 6 - frac.size(), '0');
-  while (frac.back() == '0')
-    frac.pop_back();
-  return std::to_string(ns / milli) + "." + frac + "ms";
-}
 
 std::optional<link::Duration> parse_duration(std::string_view text) {
   return client::parse_duration(text, link::seconds(24 * 3600));
@@ -180,7 +155,8 @@ OperatorScript parse_operator_script(std::string_view text, std::string_view fil
     ++line_number;
     auto parsed = parse_operator_action(line);
     if (parsed.error) {
-      script.error = OperatorScriptError{std::string(file_name), line_number, parsed.error->column,
+      script.error = OperatorScriptError{std::string(file_name), line_number,
+                                         static_cast<int>(parsed.error->column),
                                          parsed.error->message};
       return script;
     }
@@ -358,7 +334,7 @@ void OperatorRunner::on_event(Time /*now*/, const Event& event) {
   }
   if (const auto* c = std::get_if<ConnectionEvent>(&event)) {
     if (c->state != ConnectionState::connected) last_confirmable_.reset();
-    if (c->state == ConnectionState::waiting_to_reconnect) {
+    if (c->state == ConnectionState::reconnecting) {
       last_connect_problem_ =
           "the connection failed; reconnect attempt " + std::to_string(c->attempt) + " pending";
     }

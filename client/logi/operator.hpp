@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/operator_text.hpp"
 #include "client/logi/core.hpp"
 #include "client/logi/session.hpp"
 #include "link/executor.hpp"
@@ -70,21 +71,14 @@ using OperatorAction =
 /// The action written the canonical way ("speed 50", "press FWD", "wait 1.5s").
 std::string to_string(const OperatorAction& action);
 
-/// "1.5s", "500ms", "2m": the shortest exact form a `wait` accepts.
-std::string format_duration(link::Duration d);
+/// A duration as a `wait` takes it: "1.5s", "500ms", "2m".
+inline std::string format_duration(link::Duration d) {
+  return client::duration_text(d, client::DurationStyle::largest_unit);
+}
 
-struct OperatorSyntaxError {
-  int column = 0;  ///< 1-based column of the offending token (one past the end if missing)
-  std::string message;
-  friend bool operator==(const OperatorSyntaxError&, const OperatorSyntaxError&) = default;
-};
-
-struct OperatorParseResult {
-  /// Empty for a blank line or a comment (and on error).
-  std::optional<OperatorAction> action;
-  std::optional<OperatorSyntaxError> error;
-  bool ok() const { return !error.has_value(); }
-};
+using OperatorSyntaxError = client::LineError;
+/// An action, nothing (a blank line or a comment), or an error.
+using OperatorParseResult = client::ParseResult<OperatorAction>;
 
 /// Parses one line: an action, optionally followed by a `#` comment.
 /// Action words, modes and directions are case-insensitive.

@@ -14,6 +14,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/operator_text.hpp"
 #include "client/wr8/core.hpp"
 #include "link/executor.hpp"
 
@@ -58,8 +59,6 @@ struct RunnerOptions {
 
 /// "refused: not connected": a core's refusal as an action's failure.
 std::string refusal_text(Refusal refusal);
-/// "500ms", "2s": a duration as an operator reads it.
-std::string format_duration(Duration d);
 
 /// `Derived` carries out the words of its own dialect in execute() and
 /// passes every session event to on_event(); `Pending` is what it keeps
@@ -118,7 +117,7 @@ class ActionRunner {
       session_.connect();
       arm_timer(options_.connect_timeout, [this] {
         session_.disconnect();
-        finish(false, "not logged in within " + format_duration(options_.connect_timeout));
+        finish(false, "not logged in within " + duration_text(options_.connect_timeout));
       });
       return true;
     }
@@ -137,7 +136,7 @@ class ActionRunner {
         return true;
       }
       arm_timer(options_.data_timeout, [this] {
-        finish(false, "no DATA within " + format_duration(options_.data_timeout));
+        finish(false, "no DATA within " + duration_text(options_.data_timeout));
       });
       return true;
     }

@@ -9,22 +9,6 @@
 
 namespace hil::client::wr8 {
 
-std::string_view to_string(ConnectionState s) {
-  switch (s) {
-    case ConnectionState::disconnected:
-      return "disconnected";
-    case ConnectionState::connecting:
-      return "connecting";
-    case ConnectionState::authenticating:
-      return "authenticating";
-    case ConnectionState::connected:
-      return "connected";
-    case ConnectionState::waiting_to_reconnect:
-      return "waiting_to_reconnect";
-  }
-  return "?";
-}
-
 std::string_view to_string(RequestState s) {
   switch (s) {
     case RequestState::sent:
@@ -101,69 +85,33 @@ LogEntry tx_entry(Time now, const proto::Message& message, protocol::ByteView by
 }  // namespace
 
 Wr8ClientCore::Wr8ClientCore(ClientConfig config, std::shared_ptr<CommLog> log)
-    : config_(std::move(config)), log_(std::move(log)), decoder_(decoder_options(config_.profile)) {
-  if (config_.reconnect_delays.empty())
-    throw std::invalid_argument("wr8 client: reconnect_delays must not be empty");
-}
-
-void Wr8ClientCore::set_state(ConnectionState s, int attempt) {
-  if (s == state_) return;
-  state_ = s;
-  emit(ConnectionEvent{s, attempt});
-}
-
-void Wr8ClientCore::note(Time now, std::string text) {
-  log_->add({now, LogKind::note, {}, std::move(text)});
-}
+    : LoginCore(std::move(log), Backoff::ladder(config.reconnect_delays)),
+      config_(std::move(config)),
+      decoder_(decoder_options(config_.profile)) {}
 
 void Wr8ClientCore::connect(Time now) {
-  want_connected_ = true;
-  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
-      state_ == ConnectionState::connected)
-    return;
-  reconnect_at_.reset();
-  note(now, "connect");
-  set_state(ConnectionState::connecting, reconnect_attempt_);
-  actions_.push_back(OpenConnection{});
+  open_wanted(now, connection_.reconnect().attempt());
 }
 
 void Wr8ClientCore::disconnect(Time now) {
-  want_connected_ = false;
-  reconnect_at_.reset();
-  auth_deadline_.reset();
-  reconnect_attempt_ = 0;
-  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
-      state_ == ConnectionState::connected)
-    actions_.push_back(CloseConnection{});
+  drop_login_deadline();
+  close_unwanted();
   cancel_all();
   note(now, "disconnect");
-  set_state(ConnectionState::disconnected);
+  change_state(ConnectionState::disconnected);
 }
 
 void Wr8ClientCore::on_connected(Time now) {
-  if (state_ != ConnectionState::connecting) return;
+  if (state() != ConnectionState::connecting) return;
   decoder_ = proto::Decoder(decoder_options(config_.profile));
-  set_state(ConnectionState::authenticating, reconnect_attempt_);
-  auth_deadline_ = now + config_.auth_timeout;
+  await_login(now, config_.auth_timeout);
   send(now, proto::Auth{config_.profile.auth_text});
 }
 
-void Wr8ClientCore::on_connect_failed(Time now) {
-  if (state_ != ConnectionState::connecting) return;
-  login_failed(now, "connect failed");
-}
-
-void Wr8ClientCore::login_failed(Time now, std::string reason) {
-  note(now, "connection failed: " + reason);
-  emit(LoginFailedEvent{std::move(reason)});
-  auth_deadline_.reset();
-  schedule_reconnect(now);
-}
-
 void Wr8ClientCore::on_closed(Time now) {
-  if (state_ == ConnectionState::authenticating) {
+  if (state() == ConnectionState::authenticating) {
     login_failed(now, "closed before AUTH-REPLY");
-  } else if (state_ == ConnectionState::connected) {
+  } else if (state() == ConnectionState::connected) {
     lost(now, "connection closed by the vehicle");
   }
 }
@@ -171,7 +119,7 @@ void Wr8ClientCore::on_closed(Time now) {
 void Wr8ClientCore::lost(Time now, std::string_view why) {
   note(now, std::string(why));
   cancel_all();
-  schedule_reconnect(now);
+  retry_later(now);
 }
 
 void Wr8ClientCore::cancel_all() {
@@ -180,51 +128,25 @@ void Wr8ClientCore::cancel_all() {
   }
 }
 
-void Wr8ClientCore::schedule_reconnect(Time now) {
-  if (!want_connected_) {
-    set_state(ConnectionState::disconnected);
-    return;
-  }
-  const auto& delays = config_.reconnect_delays;
-  const std::size_t i =
-      std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), delays.size() - 1);
-  ++reconnect_attempt_;
-  reconnect_at_ = now + delays[i];
-  set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
-}
-
 void Wr8ClientCore::on_bytes(Time now, protocol::ByteView bytes) {
-  if (state_ != ConnectionState::authenticating && state_ != ConnectionState::connected) return;
-  items_.clear();
-  decoder_.feed(bytes, items_);
-  for (const auto& item : items_) {
-    if (const auto* err = std::get_if<protocol::DecodeError>(&item)) {
-      log_->add({now, LogKind::parse_error, protocol::to_hex(err->raw),
-                 std::string(protocol::to_string(err->kind)) + ": " + err->detail});
-      emit(ParseErrorEvent{*err});
-      continue;
-    }
-    const auto& frame = std::get<protocol::Frame<proto::Message>>(item);
-    log_->add({now, LogKind::rx, protocol::to_hex(frame.raw),
-               proto::describe(frame.message, config_.profile)});
-    handle(now, frame.message);
-    // A login failure or close inside handle() ends this connection's bytes.
-    if (state_ != ConnectionState::authenticating && state_ != ConnectionState::connected) break;
-  }
+  // A login failure or close inside handle() ends this connection's bytes.
+  receive(
+      now, bytes, decoder_, items_,
+      [this](const proto::Message& m) { return proto::describe(m, config_.profile); },
+      [this](Time t, const proto::Message& m) { handle(t, m); });
 }
 
 void Wr8ClientCore::handle(Time now, const proto::Message& message) {
   if (const auto* reply = std::get_if<proto::AuthReply>(&message)) {
-    if (state_ == ConnectionState::authenticating) {
-      auth_deadline_.reset();
-      reconnect_attempt_ = 0;
+    if (state() == ConnectionState::authenticating) {
+      login_done();
       last_data_.reset();
-      set_state(ConnectionState::connected);
+      change_state(ConnectionState::connected);
       emit(LoginEvent{*reply});
     }
     return;
   }
-  if (state_ != ConnectionState::connected) {
+  if (state() != ConnectionState::connected) {
     note(now, "ignored before login");
     return;
   }
@@ -341,7 +263,7 @@ void Wr8ClientCore::send(Time now, const proto::Message& message) {
 
 SubmitResult Wr8ClientCore::send_request(Time now, RequestKind kind, proto::TaskCode task,
                                          const proto::Message& message) {
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   // The next free COI after the last one used, wrapping FF -> 00.
   std::optional<std::uint8_t> coi;
   for (int i = 0; i < 256; ++i) {
@@ -396,17 +318,9 @@ std::size_t Wr8ClientCore::open_requests() const {
 }
 
 void Wr8ClientCore::on_timer(Time now) {
-  if (reconnect_at_ && now >= *reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) {
-    reconnect_at_.reset();
-    note(now, "reconnect attempt " + std::to_string(reconnect_attempt_));
-    set_state(ConnectionState::connecting, reconnect_attempt_);
-    actions_.push_back(OpenConnection{});
-  }
-  if (auth_deadline_ && now >= *auth_deadline_ && state_ == ConnectionState::authenticating) {
-    actions_.push_back(CloseConnection{});
-    login_failed(now, "AUTH-REPLY timeout");
-  }
-  if (state_ != ConnectionState::connected) return;
+  reconnect_if_due(now);
+  check_login_deadline(now);
+  if (state() != ConnectionState::connected) return;
   for (std::size_t coi = 0; coi < pending_.size(); ++coi) {
     if (pending_[coi] && now >= pending_[coi]->deadline) {
       note(now, "COI " + std::to_string(coi) + " timed out");
@@ -425,9 +339,9 @@ std::optional<Time> Wr8ClientCore::next_wakeup() const {
   auto take = [&next](Time t) {
     if (!next || t < *next) next = t;
   };
-  if (reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) take(*reconnect_at_);
-  if (auth_deadline_ && state_ == ConnectionState::authenticating) take(*auth_deadline_);
-  if (state_ == ConnectionState::connected) {
+  if (const auto due = connection_.reconnect().due()) take(*due);
+  if (const auto deadline = login_deadline()) take(*deadline);
+  if (state() == ConnectionState::connected) {
     for (const auto& p : pending_) {
       if (p) take(p->deadline);
     }

@@ -13,7 +13,9 @@
 #include <variant>
 #include <vector>
 
-#include "client/wr8/comm_log.hpp"
+#include "client/common/comm_log.hpp"
+#include "client/common/connection.hpp"
+#include "client/common/connection_core.hpp"
 #include "link/time.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/wr8/codec.hpp"
@@ -45,25 +47,24 @@ struct ClientConfig {
                                             link::seconds(8)};
 };
 
-enum class ConnectionState : std::uint8_t {
-  disconnected,
-  connecting,      ///< the transport is being opened
-  authenticating,  ///< AUTH sent, waiting for AUTH-REPLY
-  connected,       ///< logged in: DATA flows, requests may be sent
-  waiting_to_reconnect
-};
-std::string_view to_string(ConnectionState s);
+/// The states of the shared vocabulary the WR8 cores reach: disconnected,
+/// connecting, authenticating (AUTH sent, waiting for AUTH-REPLY),
+/// connected (logged in: DATA flows, requests may be sent), reconnecting.
+using client::ConnectionEvent;
+using client::ConnectionState;
+using client::to_string;
+
+/// The log: one entry per frame sent or received, per parse error and per note.
+using client::CommLog;
+using client::LogEntry;
+using client::LogKind;
 
 // ---- actions for the driver ----
-struct OpenConnection {
-  friend bool operator==(const OpenConnection&, const OpenConnection&) = default;
-};
+using client::CloseConnection;
+using client::OpenConnection;
 struct SendBytes {
   protocol::Bytes bytes;  ///< one complete packet
   friend bool operator==(const SendBytes&, const SendBytes&) = default;
-};
-struct CloseConnection {
-  friend bool operator==(const CloseConnection&, const CloseConnection&) = default;
 };
 using Action = std::variant<OpenConnection, SendBytes, CloseConnection>;
 
@@ -78,11 +79,7 @@ struct LiveState {
   Time received{0};  ///< when the client got it
 };
 
-// ---- events for a UI ----
-struct ConnectionEvent {
-  ConnectionState state = ConnectionState::disconnected;
-  int attempt = 0;  ///< reconnect attempt number (0: operator's connect)
-};
+// ---- events for a UI (and ConnectionEvent) ----
 /// Logged in: what AUTH-REPLY said.
 struct LoginEvent {
   proto::AuthReply reply;
@@ -134,9 +131,7 @@ struct SettingsEvent {
 struct IgnoredEvent {
   proto::Message message;
 };
-struct ParseErrorEvent {
-  protocol::DecodeError error;
-};
+using client::ParseErrorEvent;
 using Event = std::variant<ConnectionEvent, LoginEvent, LoginFailedEvent, TelemetryEvent,
                            StaleEvent, RequestEvent, SettingsEvent, IgnoredEvent, ParseErrorEvent>;
 
@@ -154,7 +149,87 @@ struct SubmitResult {
   explicit operator bool() const { return refusal == Refusal::none; }
 };
 
-class Wr8ClientCore {
+/// What both WR8 cores (the document's dialect here, the real programs'
+/// in svgui_core.hpp) share beyond the connection: the login once the
+/// connection opens (AUTH, then AUTH-REPLY within a time limit) and a
+/// failed login, reported and retried after the backoff delay.
+template <class Event>
+class LoginCore : public ConnectionCore<Action, Event> {
+  using Base = ConnectionCore<Action, Event>;
+
+ public:
+  /// The connection could not be opened: a failed login.
+  void on_connect_failed(Time now) {
+    if (this->state() != ConnectionState::connecting) return;
+    login_failed(now, "connect failed");
+  }
+
+ protected:
+  using Base::Base;
+
+  /// AUTH goes out: authenticating, and a failed login unless the login
+  /// ends within `timeout`.
+  void await_login(Time now, Duration timeout) {
+    this->change_state(ConnectionState::authenticating, this->connection_.reconnect().attempt());
+    login_deadline_ = now + timeout;
+  }
+  /// Logged in: no time limit, and the reconnect count is back to 0.
+  void login_done() {
+    login_deadline_.reset();
+    this->connection_.reconnect().succeeded();
+  }
+  /// No login is awaited any more (the operator disconnected).
+  void drop_login_deadline() { login_deadline_.reset(); }
+  /// The connection failed before the login: noted, reported, retried.
+  void login_failed(Time now, std::string reason) {
+    this->note(now, "connection failed: " + reason);
+    this->emit(LoginFailedEvent{std::move(reason)});
+    login_deadline_.reset();
+    this->retry_later(now);
+  }
+  /// When the login's time limit has passed at `now`: closed and failed.
+  void check_login_deadline(Time now) {
+    const auto deadline = login_deadline();
+    if (!deadline || now < *deadline) return;
+    this->actions_.push_back(CloseConnection{});
+    login_failed(now, "AUTH-REPLY timeout");
+  }
+  /// Bytes from the vehicle once AUTH went out: `decoder` turns
+  /// them into `items`; each packet is logged (its hex and `describe(m)`)
+  /// and handed to `handle(now, m)`, each parse error logged and reported.
+  /// A packet after which the connection is no longer up ends the rest.
+  template <class Decoder, class Item, class Describe, class Handle>
+  void receive(Time now, protocol::ByteView bytes, Decoder& decoder, std::vector<Item>& items,
+               Describe describe, Handle handle) {
+    const auto open = [this] {
+      return this->state() == ConnectionState::authenticating ||
+             this->state() == ConnectionState::connected;
+    };
+    if (!open()) return;
+    items.clear();
+    decoder.feed(bytes, items);
+    for (const auto& item : items) {
+      if (const auto* err = std::get_if<protocol::DecodeError>(&item)) {
+        this->parse_error(now, protocol::to_hex(err->raw), *err);
+        continue;
+      }
+      const auto& frame = std::get<0>(item);  // a Frame: not a DecodeError
+      this->log_->add({now, LogKind::rx, protocol::to_hex(frame.raw), describe(frame.message)});
+      handle(now, frame.message);
+      if (!open()) break;
+    }
+  }
+  /// The end of the login's time limit while authenticating.
+  std::optional<Time> login_deadline() const {
+    if (this->state() != ConnectionState::authenticating) return std::nullopt;
+    return login_deadline_;
+  }
+
+ private:
+  std::optional<Time> login_deadline_;
+};
+
+class Wr8ClientCore : public LoginCore<Event> {
  public:
   explicit Wr8ClientCore(ClientConfig config = {},
                          std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
@@ -170,9 +245,8 @@ class Wr8ClientCore {
   SubmitResult get_settings(Time now);
   SubmitResult set_settings(Time now, std::vector<proto::Setting> settings);
 
-  // ---- driver ----
+  // ---- driver (and on_connect_failed) ----
   void on_connected(Time now);
-  void on_connect_failed(Time now);
   void on_bytes(Time now, protocol::ByteView bytes);
   /// The connection ended without the core asking (peer close, reset).
   void on_closed(Time now);
@@ -180,17 +254,12 @@ class Wr8ClientCore {
   void on_timer(Time now);
   std::optional<Time> next_wakeup() const;
 
-  std::vector<Action> take_actions() { return std::exchange(actions_, {}); }
-  std::vector<Event> take_events() { return std::exchange(events_, {}); }
-
-  // ---- state ----
-  ConnectionState state() const { return state_; }
+  // ---- state (and state(), log(), take_actions(), take_events()) ----
   const std::optional<LiveState>& live() const { return live_; }
   bool stale() const { return stale_; }
   /// Settings from the last get-settings answer.
   const std::vector<proto::Setting>& settings() const { return settings_; }
   std::size_t open_requests() const;
-  const std::shared_ptr<CommLog>& log() const { return log_; }
   const ClientConfig& config() const { return config_; }
 
  private:
@@ -208,27 +277,14 @@ class Wr8ClientCore {
   void on_response(Time now, const proto::Response& r);
   void finish(std::uint8_t coi, RequestState state);
   void ignored(Time now, const proto::Message& message);
-  void login_failed(Time now, std::string reason);
   void lost(Time now, std::string_view why);
   void cancel_all();
-  void schedule_reconnect(Time now);
-  void set_state(ConnectionState s, int attempt = 0);
-  void note(Time now, std::string text);
-  void emit(Event e) { events_.push_back(std::move(e)); }
   double value_of(const proto::DataValue& v) const;
 
+  // connection_'s reconnect count goes back to 0 at login.
   ClientConfig config_;
-  std::shared_ptr<CommLog> log_;
   proto::Decoder decoder_;
   std::vector<proto::Item> items_;
-  std::vector<Action> actions_;
-  std::vector<Event> events_;
-
-  ConnectionState state_ = ConnectionState::disconnected;
-  bool want_connected_ = false;
-  int reconnect_attempt_ = 0;  // attempts since the last login
-  std::optional<Time> reconnect_at_;
-  std::optional<Time> auth_deadline_;
 
   std::uint8_t next_coi_ = 0;
   std::array<std::optional<Pending>, 256> pending_{};

@@ -219,10 +219,6 @@ Script parse_operator_script(std::string_view text, std::string file,
   return script;
 }
 
-std::string format_duration(Duration d) {
-  return duration_text(d);
-}
-
 std::string refusal_text(Refusal refusal) {
   std::string why(to_string(refusal));
   for (char& c : why)
@@ -258,7 +254,7 @@ std::string to_text(const OperatorAction& action, const proto::Profile& profile)
           },
           [](const op::GetSettings&) -> std::string { return "get-settings"; },
           [&](const op::SetSettings& a) { return "set " + format_settings(a.settings, profile); },
-          [](const op::Wait& a) { return "wait " + format_duration(a.duration); },
+          [](const op::Wait& a) { return "wait " + duration_text(a.duration); },
           [](const op::WaitData&) -> std::string { return "wait-data"; },
       },
       action);
@@ -312,9 +308,9 @@ void OperatorRunner::on_request(const RequestEvent& r) {
         const Duration limit = r.kind == RequestKind::task
                                    ? config.completion_timeout[static_cast<std::size_t>(r.task)]
                                    : config.answer_timeout;
-        finish(false, "started but not completed within " + format_duration(limit));
+        finish(false, "started but not completed within " + duration_text(limit));
       } else {
-        finish(false, "no answer within " + format_duration(config.answer_timeout));
+        finish(false, "no answer within " + duration_text(config.answer_timeout));
       }
       return;
     }

@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/operator_text.hpp"
 #include "client/wr8/action_runner.hpp"
 #include "client/wr8/session.hpp"
 #include "link/executor.hpp"
@@ -50,16 +51,9 @@ using OperatorAction = std::variant<op::Connect, op::Disconnect, op::Drive, op::
 std::string to_text(const OperatorAction& action,
                     const proto::Profile& profile = proto::default_profile());
 
-struct LineError {
-  std::size_t column = 1;  ///< 1-based column of the offending token
-  std::string message;     ///< what was wrong and what was expected
-};
-
+using client::LineError;
 /// One parsed line: an action, nothing (blank or `#` comment), or an error.
-struct ParsedLine {
-  std::optional<OperatorAction> action;
-  std::optional<LineError> error;
-};
+using ParsedLine = client::ParseResult<OperatorAction>;
 
 /// Parses one line of the document profile's vocabulary. Never throws on
 /// input. A word only the real programs' profiles have is an error naming

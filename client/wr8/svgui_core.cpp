@@ -13,10 +13,6 @@ namespace {
 
 using svgui::Version;
 
-std::string seconds_text(Duration d) {
-  return duration_text(d);
-}
-
 }  // namespace
 
 std::string svgui_request_name(const RequestEvent& r) {
@@ -82,21 +78,11 @@ std::string describe(const SvguiEvent& event) {
 }
 
 SvguiClientCore::SvguiClientCore(SvguiConfig config, std::shared_ptr<CommLog> log)
-    : config_(std::move(config)), log_(std::move(log)), decoder_(config_.version) {
-  if (config_.reconnect_delays.empty())
-    throw std::invalid_argument("wr8 client: reconnect_delays must not be empty");
+    : LoginCore(std::move(log), Backoff::ladder(config.reconnect_delays)),
+      config_(std::move(config)),
+      decoder_(config_.version) {
   if (config_.control_period <= Duration{0})
     throw std::invalid_argument("wr8 client: control_period must be positive");
-}
-
-void SvguiClientCore::set_state(ConnectionState s, int attempt) {
-  if (s == state_) return;
-  state_ = s;
-  emit(ConnectionEvent{s, attempt});
-}
-
-void SvguiClientCore::note(Time now, std::string text) {
-  log_->add({now, LogKind::note, {}, std::move(text)});
 }
 
 Duration SvguiClientCore::stale_after(DataStream s) const {
@@ -114,37 +100,25 @@ Duration SvguiClientCore::stale_after(DataStream s) const {
 // ---- connection ----
 
 void SvguiClientCore::connect(Time now) {
-  want_connected_ = true;
-  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
-      state_ == ConnectionState::connected)
-    return;
-  reconnect_at_.reset();
-  note(now, "connect");
-  set_state(ConnectionState::connecting, reconnect_attempt_);
-  actions_.push_back(OpenConnection{});
+  open_wanted(now, connection_.reconnect().attempt());
 }
 
 void SvguiClientCore::disconnect(Time now) {
-  want_connected_ = false;
-  reconnect_at_.reset();
-  login_deadline_.reset();
-  reconnect_attempt_ = 0;
-  if (state_ == ConnectionState::connected) {
+  drop_login_deadline();
+  if (state() == ConnectionState::connected) {
     if (control_) release_control(now);
     // What waits goes out now, before the close, and the release last.
     for (const auto& m : outbox_)
       write(now, m);
   }
-  if (state_ == ConnectionState::connecting || state_ == ConnectionState::authenticating ||
-      state_ == ConnectionState::connected)
-    actions_.push_back(CloseConnection{});
+  close_unwanted();
   end_connection(now);
   note(now, "disconnect");
-  set_state(ConnectionState::disconnected);
+  change_state(ConnectionState::disconnected);
 }
 
 void SvguiClientCore::on_connected(Time now) {
-  if (state_ != ConnectionState::connecting) return;
+  if (state() != ConnectionState::connecting) return;
   decoder_ = svgui::Decoder(config_.version);
   outbox_.clear();
   last_sent_.reset();
@@ -155,38 +129,24 @@ void SvguiClientCore::on_connected(Time now) {
     become_connected(now);
     return;
   }
-  set_state(ConnectionState::authenticating, reconnect_attempt_);
-  login_deadline_ = now + config_.login_timeout;
+  await_login(now, config_.login_timeout);
   send(now, svgui::Auth{svgui_auth_text(config_.version)});
 }
 
 void SvguiClientCore::become_connected(Time /*now*/) {
-  login_deadline_.reset();
-  reconnect_attempt_ = 0;
+  login_done();
   for (auto& s : streams_)
     s.last.reset();
-  set_state(ConnectionState::connected);
-}
-
-void SvguiClientCore::on_connect_failed(Time now) {
-  if (state_ != ConnectionState::connecting) return;
-  login_failed(now, "connect failed");
-}
-
-void SvguiClientCore::login_failed(Time now, std::string reason) {
-  note(now, "connection failed: " + reason);
-  emit(LoginFailedEvent{std::move(reason)});
-  login_deadline_.reset();
-  schedule_reconnect(now);
+  change_state(ConnectionState::connected);
 }
 
 void SvguiClientCore::on_closed(Time now) {
-  if (state_ == ConnectionState::authenticating) {
+  if (state() == ConnectionState::authenticating) {
     login_failed(now, "closed before AUTH-REPLY");
-  } else if (state_ == ConnectionState::connected) {
+  } else if (state() == ConnectionState::connected) {
     note(now, "connection closed by the vehicle");
     end_connection(now);
-    schedule_reconnect(now);
+    retry_later(now);
   }
 }
 
@@ -200,43 +160,19 @@ void SvguiClientCore::end_connection(Time) {
   outbox_.clear();
 }
 
-void SvguiClientCore::schedule_reconnect(Time now) {
-  if (!want_connected_) {
-    set_state(ConnectionState::disconnected);
-    return;
-  }
-  const auto& delays = config_.reconnect_delays;
-  const std::size_t i =
-      std::min<std::size_t>(static_cast<std::size_t>(reconnect_attempt_), delays.size() - 1);
-  ++reconnect_attempt_;
-  reconnect_at_ = now + delays[i];
-  set_state(ConnectionState::waiting_to_reconnect, reconnect_attempt_);
-}
-
 // ---- receiving ----
 
 void SvguiClientCore::on_bytes(Time now, protocol::ByteView bytes) {
-  if (state_ != ConnectionState::authenticating && state_ != ConnectionState::connected) return;
-  items_.clear();
-  decoder_.feed(bytes, items_);
-  for (const auto& item : items_) {
-    if (const auto* err = std::get_if<protocol::DecodeError>(&item)) {
-      log_->add({now, LogKind::parse_error, protocol::to_hex(err->raw),
-                 std::string(protocol::to_string(err->kind)) + ": " + err->detail});
-      emit(ParseErrorEvent{*err});
-      continue;
-    }
-    const auto& frame = std::get<protocol::Frame<svgui::Message>>(item);
-    log_->add({now, LogKind::rx, protocol::to_hex(frame.raw), svgui::describe(frame.message)});
-    handle(now, frame.message);
-  }
+  receive(
+      now, bytes, decoder_, items_, [](const svgui::Message& m) { return svgui::describe(m); },
+      [this](Time t, const svgui::Message& m) { handle(t, m); });
 }
 
 void SvguiClientCore::handle(Time now, const svgui::Message& message) {
   if (const auto* reply = std::get_if<svgui::AuthReply>(&message)) {
-    const bool awaited = state_ == ConnectionState::authenticating;
+    const bool awaited = state() == ConnectionState::authenticating;
     const bool late =
-        state_ == ConnectionState::connected && !config_.wait_for_login && !logged_in_;
+        state() == ConnectionState::connected && !config_.wait_for_login && !logged_in_;
     if (!awaited && !late) {
       ignored(now, message, "AUTH-REPLY after login");
       return;
@@ -248,7 +184,7 @@ void SvguiClientCore::handle(Time now, const svgui::Message& message) {
     emit(LoginEvent{*reply});
     return;
   }
-  if (state_ != ConnectionState::connected) {
+  if (state() != ConnectionState::connected) {
     ignored(now, message, "before login");
     return;
   }
@@ -397,7 +333,7 @@ std::size_t SvguiClientCore::open_requests() const {
 SubmitResult SvguiClientCore::send_task(Time now, proto::TaskCode type,
                                         std::vector<std::int32_t> params) {
   if (config_.version != Version::v2019) return {0, Refusal::bad_request};
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   const auto coi = free_coi();
   if (!coi) return {0, Refusal::busy};
   std::string busy_note;
@@ -425,7 +361,7 @@ SubmitResult SvguiClientCore::signals(Time now) {
 
 SubmitResult SvguiClientCore::settings(Time now, const std::array<std::int32_t, 4>& values) {
   if (config_.version != Version::v2019) return {0, Refusal::bad_request};
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   const auto coi = free_coi();
   if (!coi) return {0, Refusal::busy};
   std::string why = "the v2019 vehicle never answers SETTINGS, and counts them as a running task";
@@ -440,7 +376,7 @@ SubmitResult SvguiClientCore::settings(Time now, const std::array<std::int32_t, 
 SubmitResult SvguiClientCore::send_head_request(Time now, RequestKind kind, proto::TaskCode task,
                                                 const svgui::Message& message) {
   if (config_.version != Version::head) return {0, Refusal::bad_request};
-  if (state_ != ConnectionState::connected) return {0, Refusal::not_connected};
+  if (state() != ConnectionState::connected) return {0, Refusal::not_connected};
   auto& slot = kind == RequestKind::settings ? set_pending_ : set_request_pending_;
   if (slot) return {0, Refusal::busy};
   send(now, message);
@@ -465,7 +401,7 @@ Refusal SvguiClientCore::control(Time now, double x_axis, double y_axis) {
   if (config_.version != Version::head) return Refusal::bad_request;
   const auto in_range = [](double v) { return std::isfinite(v) && v >= -1.0 && v <= 1.0; };
   if (!in_range(x_axis) || !in_range(y_axis)) return Refusal::bad_request;
-  if (state_ != ConnectionState::connected) return Refusal::not_connected;
+  if (state() != ConnectionState::connected) return Refusal::not_connected;
   control_ = svgui::Control{x_axis, y_axis};
   send(now, *control_);
   // A change goes out at once; the repetition keeps its 100 ms grid.
@@ -475,7 +411,7 @@ Refusal SvguiClientCore::control(Time now, double x_axis, double y_axis) {
 
 Refusal SvguiClientCore::release_control(Time now) {
   if (config_.version != Version::head) return Refusal::bad_request;
-  if (state_ != ConnectionState::connected) return Refusal::not_connected;
+  if (state() != ConnectionState::connected) return Refusal::not_connected;
   if (!control_) return Refusal::none;
   control_.reset();
   next_control_.reset();
@@ -486,17 +422,9 @@ Refusal SvguiClientCore::release_control(Time now) {
 // ---- time ----
 
 void SvguiClientCore::on_timer(Time now) {
-  if (reconnect_at_ && now >= *reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) {
-    reconnect_at_.reset();
-    note(now, "reconnect attempt " + std::to_string(reconnect_attempt_));
-    set_state(ConnectionState::connecting, reconnect_attempt_);
-    actions_.push_back(OpenConnection{});
-  }
-  if (login_deadline_ && now >= *login_deadline_ && state_ == ConnectionState::authenticating) {
-    actions_.push_back(CloseConnection{});
-    login_failed(now, "AUTH-REPLY timeout");
-  }
-  if (state_ != ConnectionState::connected) return;
+  reconnect_if_due(now);
+  check_login_deadline(now);
+  if (state() != ConnectionState::connected) return;
   flush_outbox(now);
   for (std::size_t coi = 0; coi < pending_.size(); ++coi) {
     auto& p = pending_[coi];
@@ -504,20 +432,20 @@ void SvguiClientCore::on_timer(Time now) {
     const Duration limit = config_.task_timeout[static_cast<std::size_t>(p->task)];
     note(now, "COI " + std::to_string(coi) + " timed out");
     finish(p, static_cast<std::uint8_t>(coi), RequestState::timed_out,
-           "no ANSWER within " + seconds_text(limit) +
+           "no ANSWER within " + duration_text(limit) +
                ": the v2019 vehicle sends no \"started\" and drops a task without a word while "
                "another task or SETTINGS keeps it busy, so a timeout is the only sign");
   }
   if (set_pending_ && now >= set_pending_->deadline) {
     note(now, "SET timed out");
     finish(set_pending_, 0, RequestState::timed_out,
-           "no ANSWER within " + seconds_text(config_.answer_timeout) +
+           "no ANSWER within " + duration_text(config_.answer_timeout) +
                ": the head vehicle programs answer no SET; set-request reads the settings back");
   }
   if (set_request_pending_ && now >= set_request_pending_->deadline) {
     note(now, "SET-REQUEST timed out");
     finish(set_request_pending_, 0, RequestState::timed_out,
-           "no SET within " + seconds_text(config_.answer_timeout) +
+           "no SET within " + duration_text(config_.answer_timeout) +
                " (the head test vehicle does not answer SET-REQUEST)");
   }
   for (const DataStream stream : {DataStream::data, DataStream::high_freq, DataStream::low_freq}) {
@@ -540,9 +468,9 @@ std::optional<Time> SvguiClientCore::next_wakeup() const {
   auto take = [&next](Time t) {
     if (!next || t < *next) next = t;
   };
-  if (reconnect_at_ && state_ == ConnectionState::waiting_to_reconnect) take(*reconnect_at_);
-  if (login_deadline_ && state_ == ConnectionState::authenticating) take(*login_deadline_);
-  if (state_ != ConnectionState::connected) return next;
+  if (const auto due = connection_.reconnect().due()) take(*due);
+  if (const auto deadline = login_deadline()) take(*deadline);
+  if (state() != ConnectionState::connected) return next;
   for (const auto& p : pending_) {
     if (p) take(p->deadline);
   }

@@ -19,7 +19,6 @@
 #include <variant>
 #include <vector>
 
-#include "client/wr8/comm_log.hpp"
 #include "client/wr8/core.hpp"
 #include "protocol/wr8/svgui.hpp"
 
@@ -120,7 +119,7 @@ struct Received {
   Time at{0};  ///< when the client got it
 };
 
-class SvguiClientCore {
+class SvguiClientCore : public LoginCore<SvguiEvent> {
  public:
   explicit SvguiClientCore(SvguiConfig config = {},
                            std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
@@ -150,19 +149,14 @@ class SvguiClientCore {
   /// RequestEvent completed of task get_settings, COI 0).
   SubmitResult set_request(Time now);
 
-  // ---- driver ----
+  // ---- driver (and on_connect_failed) ----
   void on_connected(Time now);
-  void on_connect_failed(Time now);
   void on_bytes(Time now, protocol::ByteView bytes);
   void on_closed(Time now);
   void on_timer(Time now);
   std::optional<Time> next_wakeup() const;
 
-  std::vector<Action> take_actions() { return std::exchange(actions_, {}); }
-  std::vector<SvguiEvent> take_events() { return std::exchange(events_, {}); }
-
-  // ---- state ----
-  ConnectionState state() const { return state_; }
+  // ---- state (and state(), log(), take_actions(), take_events()) ----
   svgui::Version version() const { return config_.version; }
   const std::optional<Received<svgui::Data>>& data() const { return data_; }
   const std::optional<Received<svgui::HighFreqData>>& high_freq() const { return high_freq_; }
@@ -176,7 +170,6 @@ class SvguiClientCore {
   /// The axes CONTROL repeats, while held.
   const std::optional<svgui::Control>& held_control() const { return control_; }
   std::size_t open_requests() const;
-  const std::shared_ptr<CommLog>& log() const { return log_; }
   const SvguiConfig& config() const { return config_; }
 
  private:
@@ -206,27 +199,14 @@ class SvguiClientCore {
   void finish(std::optional<Pending>& slot, std::uint8_t coi, RequestState state,
               std::string note = {});
   void ignored(Time now, const svgui::Message& message, std::string why);
-  void login_failed(Time now, std::string reason);
   void end_connection(Time now);
-  void schedule_reconnect(Time now);
-  void set_state(ConnectionState s, int attempt = 0);
   void become_connected(Time now);
-  void note(Time now, std::string text);
-  void emit(SvguiEvent e) { events_.push_back(std::move(e)); }
   Duration stale_after(DataStream s) const;
 
+  // connection_'s reconnect count goes back to 0 at login.
   SvguiConfig config_;
-  std::shared_ptr<CommLog> log_;
   svgui::Decoder decoder_;
   std::vector<svgui::Item> items_;
-  std::vector<Action> actions_;
-  std::vector<SvguiEvent> events_;
-
-  ConnectionState state_ = ConnectionState::disconnected;
-  bool want_connected_ = false;
-  int reconnect_attempt_ = 0;
-  std::optional<Time> reconnect_at_;
-  std::optional<Time> login_deadline_;
   bool logged_in_ = false;  ///< an AUTH-REPLY came on this connection
 
   // v2019: tasks by COI.

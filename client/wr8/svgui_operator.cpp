@@ -259,7 +259,7 @@ std::string to_text(const SvguiAction& action) {
       Overloaded{
           [](const op::Connect&) -> std::string { return "connect"; },
           [](const op::Disconnect&) -> std::string { return "disconnect"; },
-          [](const op::Wait& a) { return "wait " + format_duration(a.duration); },
+          [](const op::Wait& a) { return "wait " + duration_text(a.duration); },
           [](const op::WaitData&) -> std::string { return "wait-data"; },
           [](const op::Forward& a) { return "forward " + std::to_string(a.distance_cm); },
           [](const op::Wheels& a) { return "wheels " + std::to_string(a.angle_deg); },
@@ -317,8 +317,8 @@ void SvguiRunner::execute(SvguiAction action, Done done) {
               refused(r);
               return;
             }
-            finish(true, "held: CONTROL every " +
-                             format_duration(session_.core().config().control_period));
+            finish(true,
+                   "held: CONTROL every " + duration_text(session_.core().config().control_period));
           },
           [&](const op::ControlOff&) {
             const bool held = session_.core().held_control().has_value();

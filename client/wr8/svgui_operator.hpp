@@ -77,10 +77,7 @@ std::string_view svgui_vocabulary(svgui::Version version);
 /// The action as a line the parser reads back ("forward 30", "control 0.5 -1").
 std::string to_text(const SvguiAction& action);
 
-struct ParsedSvguiLine {
-  std::optional<SvguiAction> action;
-  std::optional<LineError> error;
-};
+using ParsedSvguiLine = client::ParseResult<SvguiAction>;
 
 /// Parses one line of `version`'s vocabulary. Never throws on input. A word
 /// of another profile is an error naming the profile.

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "client/arduino/client_core.hpp"
+#include "client/arduino/core.hpp"
 #include "protocol/arduino/codec.hpp"
 
 namespace hil::client::arduino {
@@ -307,7 +307,7 @@ TEST(ArduinoClientCore, OtherNacksAreReturnedWithTheirCodeAtOnce) {
   EXPECT_EQ(h.done[0].result.nack, (proto::Nack{std::string("BUSY")}));
   EXPECT_EQ(h.done[1].result.nack, (proto::Nack{proto::NackCode::bad_v}));
   EXPECT_EQ(h.sent.size(), 2u) << "no resend for a NACK other than BAD_CS";
-  EXPECT_EQ(h.core.state(), LinkState::open);
+  EXPECT_EQ(h.core.state(), ConnectionState::connected);
 }
 
 TEST(ArduinoClientCore, AnswersWithAnotherSeqAreIgnoredWithinTheAttempt) {
@@ -354,14 +354,14 @@ TEST(ArduinoClientCore, NoAnswerToTheHealthCheckGoesDegradedThenReconnectingThen
   ASSERT_EQ(h.sent.size(), 1u);
   EXPECT_EQ(h.sent[0].frame, "^00|PING|*10$");
   h.run_until(milliseconds(13999));
-  EXPECT_EQ(h.core.state(), LinkState::open);
+  EXPECT_EQ(h.core.state(), ConnectionState::connected);
   h.run_until(seconds(14));  // 5 s + 9 s of attempts
-  EXPECT_EQ(h.core.state(), LinkState::degraded);
+  EXPECT_EQ(h.core.state(), ConnectionState::degraded);
   EXPECT_EQ(h.closes, (std::vector<Time>{seconds(14)}));
   h.run_until(milliseconds(14499));
   EXPECT_EQ(h.opens.size(), 1u);
   h.run_until(milliseconds(14500));
-  EXPECT_EQ(h.core.state(), LinkState::reconnecting);
+  EXPECT_EQ(h.core.state(), ConnectionState::reconnecting);
   ASSERT_EQ(h.opens.size(), 2u);
   EXPECT_EQ(h.opens[1], milliseconds(14500));
   h.at(milliseconds(14510));
@@ -370,14 +370,14 @@ TEST(ArduinoClientCore, NoAnswerToTheHealthCheckGoesDegradedThenReconnectingThen
   ASSERT_EQ(h.sent.size(), 5u);
   EXPECT_EQ(h.sent[4].frame, "^01|PING|*11$");
   h.answer(0x01, proto::Ack{"OK"});
-  EXPECT_EQ(h.core.state(), LinkState::open);
+  EXPECT_EQ(h.core.state(), ConnectionState::connected);
   ASSERT_EQ(h.changes.size(), 5u);
-  const std::vector<std::pair<LinkState, Time>> expected = {
-      {LinkState::opening, seconds(0)},
-      {LinkState::open, seconds(0)},
-      {LinkState::degraded, seconds(14)},
-      {LinkState::reconnecting, milliseconds(14500)},
-      {LinkState::open, milliseconds(14510)}};
+  const std::vector<std::pair<ConnectionState, Time>> expected = {
+      {ConnectionState::connecting, seconds(0)},
+      {ConnectionState::connected, seconds(0)},
+      {ConnectionState::degraded, seconds(14)},
+      {ConnectionState::reconnecting, milliseconds(14500)},
+      {ConnectionState::connected, milliseconds(14510)}};
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(h.changes[i].to, expected[i].first) << i;
     EXPECT_EQ(h.changes[i].at, expected[i].second) << i;
@@ -408,7 +408,7 @@ TEST(ArduinoClientCore, ReconnectAttemptsBackOffAndTheLinkIsDownAfterFourFailure
   EXPECT_EQ(attempts, (std::vector<Time>{milliseconds(9500), milliseconds(10500),
                                          milliseconds(12500), milliseconds(16500)}));
   EXPECT_EQ(h.opens.size(), 5u);
-  EXPECT_EQ(h.core.state(), LinkState::down);
+  EXPECT_EQ(h.core.state(), ConnectionState::down);
   EXPECT_FALSE(h.core.next_wakeup().has_value());
   ASSERT_EQ(h.done.size(), 2u);
   EXPECT_EQ(h.done[1].id, queued);
@@ -423,7 +423,7 @@ TEST(ArduinoClientCore, AReconnectPingWithoutAnswerCountsAsAFailedAttempt) {
   h.open_now();
   h.core.on_closed(h.now);  // the robot went away
   h.collect();
-  EXPECT_EQ(h.core.state(), LinkState::degraded);
+  EXPECT_EQ(h.core.state(), ConnectionState::degraded);
   h.run_until(milliseconds(500));
   h.core.on_connected(h.now);
   h.collect();
@@ -433,7 +433,7 @@ TEST(ArduinoClientCore, AReconnectPingWithoutAnswerCountsAsAFailedAttempt) {
   EXPECT_EQ(h.sent[1].at, milliseconds(1100));
   EXPECT_EQ(h.sent[2].at, milliseconds(2300));
   EXPECT_EQ(h.closes.back(), milliseconds(4700));
-  EXPECT_EQ(h.core.state(), LinkState::reconnecting);
+  EXPECT_EQ(h.core.state(), ConnectionState::reconnecting);
   EXPECT_EQ(h.core.next_wakeup(), milliseconds(5700));
 }
 
@@ -446,7 +446,7 @@ TEST(ArduinoClientCore, ThePortClosingDuringARequestEndsItAsLinkDown) {
   h.collect();
   ASSERT_EQ(h.done.size(), 1u);
   EXPECT_EQ(h.done[0].result.code, ResultCode::link_down);
-  EXPECT_EQ(h.core.state(), LinkState::degraded);
+  EXPECT_EQ(h.core.state(), ConnectionState::degraded);
   EXPECT_EQ(h.core.next_wakeup(), milliseconds(550));
 }
 
@@ -461,7 +461,7 @@ TEST(ArduinoClientCore, RequestsBeforeOpenOrAfterCloseEndAsLinkDown) {
   ASSERT_EQ(h.done.size(), 3u);
   for (auto& d : h.done)
     EXPECT_EQ(d.result.code, ResultCode::link_down);
-  EXPECT_EQ(h.core.state(), LinkState::closed);
+  EXPECT_EQ(h.core.state(), ConnectionState::disconnected);
   EXPECT_EQ(h.closes.size(), 1u);
 }
 

@@ -52,7 +52,7 @@ struct ArduinoDialects : ::testing::TestWithParam<proto::Dialect> {
   std::vector<std::string> sent() const {
     std::vector<std::string> out;
     for (const auto& e : session->log().entries()) {
-      if (e.direction == LogDirection::tx) out.push_back(e.raw);
+      if (e.kind == LogKind::tx) out.push_back(e.raw);
     }
     return out;
   }
@@ -188,10 +188,10 @@ TEST(ArduinoFirmwareFrames, APongProvesAReopenedPort) {
   core.ping(Time{0});
   (void)core.take_actions();
   core.on_closed(Time{0});  // lost with PING in flight: DEGRADED, a reopen is due
-  ASSERT_EQ(core.state(), LinkState::degraded);
+  ASSERT_EQ(core.state(), ConnectionState::degraded);
   const Time reopen = core.next_wakeup().value();
   core.on_timer(reopen);
-  ASSERT_EQ(core.state(), LinkState::reconnecting);
+  ASSERT_EQ(core.state(), ConnectionState::reconnecting);
   (void)core.take_actions();
   core.on_connected(reopen);
   std::string check;
@@ -200,7 +200,7 @@ TEST(ArduinoFirmwareFrames, APongProvesAReopenedPort) {
   }
   EXPECT_EQ(check, "^01|PING| *31$");
   core.on_bytes(reopen, protocol::to_bytes("^01|ACK|PONG*5E$"));
-  EXPECT_EQ(core.state(), LinkState::open);
+  EXPECT_EQ(core.state(), ConnectionState::connected);
 }
 
 }  // namespace

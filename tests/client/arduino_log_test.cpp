@@ -21,8 +21,8 @@ namespace {
 constexpr std::int64_t kT = 1'795'327'671'123'456;
 
 void add_two_frames(CommLog& log) {
-  log.tx(kT, "^01|PING|*11$", 0x01);
-  log.rx(kT + 15'000, "^01|ACK|OK*4C$", 0x01);
+  log.add({LogKind::tx, kT, "^01|PING|*11$", 0x01});
+  log.add({LogKind::rx, kT + 15'000, "^01|ACK|OK*4C$", 0x01});
 }
 
 std::string two_frames_as(LogFormat format) {
@@ -56,7 +56,7 @@ TEST(ArduinoCommLog, TextHasOneLinePerFrameWithDirectionSeqRawAndHex) {
 TEST(ArduinoCommLog, CsvHasAHeaderAndQuotesFieldsThatNeedIt) {
   CommLog log;
   add_two_frames(log);
-  log.rx(kT, "^02|ACK|a,\"b\"*00$", std::nullopt);
+  log.add({LogKind::rx, kT, "^02|ACK|a,\"b\"*00$", std::nullopt});
   const auto out = lines(log.to_string(LogFormat::csv));
   ASSERT_EQ(out.size(), 4u);
   EXPECT_EQ(out[0], "time,direction,seq,raw,hex");
@@ -77,14 +77,14 @@ TEST(ArduinoCommLog, NdjsonIsOneObjectPerLine) {
 }
 
 TEST(ArduinoCommLog, SaveWritesTheFormatTheFileNameAsksFor) {
-  EXPECT_EQ(CommLog::format_for("logs.csv"), LogFormat::csv);
-  EXPECT_EQ(CommLog::format_for("logs.json"), LogFormat::ndjson);
-  EXPECT_EQ(CommLog::format_for("logs.txt"), LogFormat::txt);
+  EXPECT_EQ(log_format_for("logs.csv"), LogFormat::csv);
+  EXPECT_EQ(log_format_for("logs.json"), LogFormat::ndjson);
+  EXPECT_EQ(log_format_for("logs.txt"), LogFormat::txt);
   const auto path = std::filesystem::temp_directory_path() /
                     ("hil-arduino-log-" + std::to_string(::getpid()) + ".csv");
   CommLog log;
   add_two_frames(log);
-  ASSERT_TRUE(log.save(path.string(), CommLog::format_for(path.string())));
+  ASSERT_TRUE(log.save(path.string(), log_format_for(path.string())));
   std::ifstream in(path);
   std::stringstream content;
   content << in.rdbuf();
@@ -99,7 +99,7 @@ TEST(ArduinoCommLog, ManyThreadsLoggingAtOnceLoseNothing) {
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&log, t] {
       for (int i = 0; i < 1000; ++i) {
-        log.tx(kT + i, "^00|PING|*10$", static_cast<std::uint8_t>(t));
+        log.add({LogKind::tx, kT + i, "^00|PING|*10$", static_cast<std::uint8_t>(t)});
         if (i % 100 == 0) (void)log.to_string(LogFormat::txt);
       }
     });

@@ -34,8 +34,8 @@ using link::seconds;
 OperatorCommand command_of(std::string_view line) {
   const auto parsed = parse_operator_line(line);
   EXPECT_TRUE(parsed.ok()) << line << ": " << parsed.error->message;
-  EXPECT_TRUE(parsed.command.has_value()) << line;
-  return parsed.command.value_or(QuitCommand{});
+  EXPECT_TRUE(parsed.action.has_value()) << line;
+  return parsed.action.value_or(QuitCommand{});
 }
 
 OperatorParseError error_of(std::string_view line) {
@@ -89,7 +89,7 @@ TEST(ArduinoOperatorParse, BlankLinesAndCommentsAreNoCommand) {
   for (const std::string line : {"", "   ", "\t", "# a comment", "   # indented"}) {
     const auto parsed = parse_operator_line(line);
     EXPECT_TRUE(parsed.ok()) << line;
-    EXPECT_FALSE(parsed.command) << line;
+    EXPECT_FALSE(parsed.action) << line;
   }
   EXPECT_EQ(command_of("PING # is it there?"), OperatorCommand(RobotRequest{proto::Ping{}}));
   EXPECT_EQ(command_of("V 160# no space"), OperatorCommand(RobotRequest{proto::SetSpeed{160}}));
@@ -137,10 +137,10 @@ TEST(ArduinoOperatorParse, ARawTokenHilWouldRefuseIsSentAsGiven) {
   for (const std::string token : {"V:999", "V:fast", "V:", "PING:x", "reconnect:1", "x:1"}) {
     const auto parsed = parse_operator_line(token);
     ASSERT_TRUE(parsed.ok()) << token << ": " << parsed.error->message;
-    const auto* request = std::get_if<RobotRequest>(&*parsed.command);
+    const auto* request = std::get_if<RobotRequest>(&*parsed.action);
     ASSERT_NE(request, nullptr) << token;
     EXPECT_EQ(request->raw, token);
-    EXPECT_EQ(to_text(*parsed.command), token);
+    EXPECT_EQ(to_text(*parsed.action), token);
   }
   EXPECT_EQ(error_of("V 999").message, "V needs a number 0..255, not '999'");
   EXPECT_EQ(error_of("V:999 now").message, "V needs a number 0..255, not '999'");
@@ -179,7 +179,7 @@ RC_GTEST_PROP(ArduinoOperatorParse, EveryCommandReadsBackFromItsCanonicalText, (
   }
   const auto parsed = parse_operator_line(to_text(command));
   RC_ASSERT(parsed.ok());
-  RC_ASSERT(parsed.command == std::optional<OperatorCommand>(command));
+  RC_ASSERT(parsed.action == std::optional<OperatorCommand>(command));
 }
 
 TEST(ArduinoOperatorScript, StepsKeepTheirLineNumbers) {
@@ -420,8 +420,8 @@ TEST_F(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
       << "the board reset when the port opened: " << outcomes[2].result->info;
   EXPECT_EQ(firmware->state().boots, boots + 1);
   ASSERT_GE(changes.size(), 2u);
-  EXPECT_EQ(changes[changes.size() - 2].to, LinkState::opening);
-  EXPECT_EQ(changes.back().to, LinkState::open);
+  EXPECT_EQ(changes[changes.size() - 2].to, ConnectionState::connecting);
+  EXPECT_EQ(changes.back().to, ConnectionState::connected);
 }
 
 TEST_F(ArduinoOperatorRunner, QuitDropsWhatComesAfterIt) {
@@ -436,7 +436,7 @@ TEST_F(ArduinoOperatorRunner, QuitDropsWhatComesAfterIt) {
 
 TEST_F(ArduinoOperatorRunner, APortThatDoesNotOpenFailsTheRequestAndReconnect) {
   connect("nobody-listens");
-  EXPECT_EQ(session->state(), LinkState::down);
+  EXPECT_EQ(session->state(), ConnectionState::down);
   runner->add(RobotRequest{proto::Ping{}});
   run_to_idle();
   ASSERT_EQ(outcomes.size(), 1u);

@@ -40,8 +40,9 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
 
   ArduinoSession session(context, link::parse_endpoint(uri));
   session.open();
-  ASSERT_TRUE(link::test::run_until(io, [&] { return session.state() == LinkState::open; }))
-      << "the port never opened";
+  ASSERT_TRUE(link::test::run_until(io, [&] {
+    return session.state() == ConnectionState::connected;
+  })) << "the port never opened";
 
   auto run = [&](auto submit) {
     std::optional<Result> result;
@@ -68,11 +69,11 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   const auto entries = session.log().entries();
   ASSERT_GE(entries.size(), 8u);
   EXPECT_EQ(entries[0].raw, "^00|PING| *30$");
-  EXPECT_EQ(entries[0].direction, LogDirection::tx);
-  EXPECT_EQ(entries[1].direction, LogDirection::rx);
+  EXPECT_EQ(entries[0].kind, LogKind::tx);
+  EXPECT_EQ(entries[1].kind, LogKind::rx);
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
   session.close();
-  EXPECT_EQ(session.state(), LinkState::closed);
+  EXPECT_EQ(session.state(), ConnectionState::disconnected);
 }
 
 }  // namespace

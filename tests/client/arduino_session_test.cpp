@@ -39,7 +39,7 @@ struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFir
     });
     session->open();
     executor.run_for(Duration::zero());
-    ASSERT_EQ(session->state(), LinkState::open);
+    ASSERT_EQ(session->state(), ConnectionState::connected);
   }
 
   /// Runs a request to its end; the result and when it came.
@@ -59,7 +59,7 @@ struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFir
   std::vector<Time> tx_times() const {
     std::vector<Time> out;
     for (auto& e : session->log().entries()) {
-      if (e.direction == LogDirection::tx) out.push_back(milliseconds(e.utc_us / 1000));
+      if (e.kind == LogKind::tx) out.push_back(milliseconds(e.utc_us / 1000));
     }
     return out;
   }
@@ -87,8 +87,9 @@ TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ping(cb); })), "PONG");
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.set_v(160, cb); })), "OK");
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.move_cm(10, cb); })), "ACCEPTED");
-  EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.status(cb); }))
-                .rfind("STATUS:V=160,DIR=fwd,MOT:MOVE,tleft:", 0),
+  EXPECT_EQ(ok(run([](auto& s, auto cb) {
+              return s.status(cb);
+            })).rfind("STATUS:V=160,DIR=fwd,MOT:MOVE,tleft:", 0),
             0u);
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.stop(cb); })), "STOPPED");
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.raw("R:-90", cb); })), "ACCEPTED");
@@ -105,7 +106,7 @@ TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   ASSERT_EQ(entries.size(), 20u);
   EXPECT_EQ(entries[0].raw, "^00|PING| *30$");
   EXPECT_EQ(entries[1].raw, "^00|ACK|PONG*5F$");
-  EXPECT_EQ(entries[1].direction, LogDirection::rx);
+  EXPECT_EQ(entries[1].kind, LogKind::rx);
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
 }
 
@@ -157,7 +158,7 @@ TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
   const auto entries = session->log().entries();
   ASSERT_EQ(entries.size(), 4u);
   EXPECT_EQ(entries[1].raw, "^00|NACK|BAD_CS*0F$");
-  EXPECT_EQ(entries[2].direction, LogDirection::tx);
+  EXPECT_EQ(entries[2].kind, LogKind::tx);
   EXPECT_EQ(entries[2].raw, entries[0].raw);
   EXPECT_EQ(entries[2].utc_us, entries[1].utc_us) << "resent the moment the NACK arrived";
   EXPECT_EQ(firmware->state().pwm, 200);
@@ -206,12 +207,12 @@ TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRo
                  .action = mocks::Ignore{.match = "", .count = {}, .duration = seconds(10)}});
   executor.run_until(seconds(20));
   ASSERT_EQ(changes.size(), 5u);
-  const std::vector<std::pair<LinkState, Time>> expected = {
-      {LinkState::opening, seconds(0)},
-      {LinkState::open, seconds(0)},
-      {LinkState::degraded, seconds(14)},  // PING at 5 s, 9 s of attempts
-      {LinkState::reconnecting, milliseconds(14500)},
-      {LinkState::open, milliseconds(14500)}};
+  const std::vector<std::pair<ConnectionState, Time>> expected = {
+      {ConnectionState::connecting, seconds(0)},
+      {ConnectionState::connected, seconds(0)},
+      {ConnectionState::degraded, seconds(14)},  // PING at 5 s, 9 s of attempts
+      {ConnectionState::reconnecting, milliseconds(14500)},
+      {ConnectionState::connected, milliseconds(14500)}};
   for (std::size_t i = 0; i < expected.size(); ++i) {
     EXPECT_EQ(changes[i].to, expected[i].first) << i;
     EXPECT_EQ(changes[i].at, expected[i].second) << i;
@@ -233,7 +234,7 @@ TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
   EXPECT_EQ(r->code, ResultCode::timeout);
   executor.run_until(seconds(60));
   ASSERT_FALSE(changes.empty());
-  EXPECT_EQ(changes.back().to, LinkState::down);
+  EXPECT_EQ(changes.back().to, ConnectionState::down);
   // 9 s, +0.5 s, +4.2 s of reconnect PING, +1 s, +4.2 s.
   EXPECT_EQ(changes.back().at, milliseconds(9000 + 500 + 4200 + 1000 + 4200));
 }
@@ -244,7 +245,7 @@ TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueued
   at_1s.at = seconds(1);
   firmware->arm({.name = "", .when = at_1s, .action = mocks::CloseConnection{}});
   executor.run_until(seconds(1));
-  ASSERT_EQ(session->state(), LinkState::degraded);
+  ASSERT_EQ(session->state(), ConnectionState::degraded);
   EXPECT_EQ(changes.back().at, seconds(1));
   std::optional<Result> queued;
   session->sonar([&](const Result& r) {
@@ -252,7 +253,7 @@ TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueued
     done_at = executor.now();
   });
   executor.run_until(seconds(3));
-  EXPECT_EQ(session->state(), LinkState::open);
+  EXPECT_EQ(session->state(), ConnectionState::connected);
   EXPECT_EQ(changes.back().at, milliseconds(1500));
   ASSERT_TRUE(queued.has_value());
   EXPECT_EQ(queued->code, ResultCode::ok);

@@ -265,8 +265,8 @@ TEST(LekaInfo, ClosingThePortEndsWaitingRequests) {
 
 TEST(LekaCommLog, ExportsTextCsvAndNdjson) {
   CommLog log;
-  log.add({LogDirection::tx, 1000, Bytes{0x2A, 0x01}, "info"});
-  log.add({LogDirection::rx, 2000, bytes_of("LEKA a=\"b\""), "LEKA a=\"b\""});
+  log.add({LogKind::tx, 1000, Bytes{0x2A, 0x01}, "info"});
+  log.add({LogKind::rx, 2000, bytes_of("LEKA a=\"b\""), "LEKA a=\"b\""});
   EXPECT_EQ(log.to_string(LogFormat::txt),
             "1000 TX info [2A 01]\n2000 RX LEKA a=\"b\" [4C 45 4B 41 20 61 3D 22 62 22]\n");
   EXPECT_EQ(log.to_string(LogFormat::csv),

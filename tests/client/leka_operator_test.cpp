@@ -316,7 +316,7 @@ struct LekaOperatorRunner : ::testing::Test, test::VirtualCar<mocks::LekaFirmwar
   std::vector<std::pair<std::int64_t, std::size_t>> tx_times() {
     std::vector<std::pair<std::int64_t, std::size_t>> out;
     for (const auto& e : session->log().entries())
-      if (e.direction == LogDirection::tx) out.push_back({e.utc_us / 1000, e.raw.size()});
+      if (e.kind == LogKind::tx) out.push_back({e.utc_us / 1000, e.raw.size()});
     return out;
   }
 

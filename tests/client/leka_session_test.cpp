@@ -42,7 +42,7 @@ struct LekaSessionOnMem : ::testing::Test, test::VirtualCar<mocks::LekaFirmware>
   std::vector<std::pair<std::int64_t, std::size_t>> tx_times() {
     std::vector<std::pair<std::int64_t, std::size_t>> out;
     for (const auto& e : session->log().entries())
-      if (e.direction == LogDirection::tx) out.push_back({e.utc_us / 1000, e.raw.size()});
+      if (e.kind == LogKind::tx) out.push_back({e.utc_us / 1000, e.raw.size()});
     return out;
   }
 
@@ -120,7 +120,7 @@ TEST_F(LekaSessionOnMem, InfoIsAnsweredAtTheNextPassAndParsed) {
   EXPECT_EQ(result->reply->state, "ok");
   const auto entries = session->log().entries();
   ASSERT_EQ(entries.size(), 2u);
-  EXPECT_EQ(entries[1].direction, LogDirection::rx);
+  EXPECT_EQ(entries[1].kind, LogKind::rx);
   EXPECT_EQ(entries[1].note, "LEKA name=leka firmware=1.0.0 buffer=128 state=ok");
 }
 

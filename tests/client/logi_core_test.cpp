@@ -151,7 +151,7 @@ TEST(LogiClientCore, ReconnectsAfterADropAt1s2s3sThen3sForever) {
   h.now = seconds(10);
   h.core.on_closed(h.now);
   h.drain();
-  EXPECT_EQ(h.core.state(), ConnectionState::waiting_to_reconnect);
+  EXPECT_EQ(h.core.state(), ConnectionState::reconnecting);
   for (Time at : {seconds(11), seconds(13), seconds(16), seconds(19), seconds(22)}) {
     const int before = h.opens;
     h.run_until(at - std::chrono::nanoseconds(1));
@@ -244,7 +244,7 @@ TEST(LogiClientCore, AnInvalidFrameIsDroppedAndLoggedWithItsRawText) {
   ASSERT_EQ(h.of<ParseErrorEvent>().size(), 1u);
   EXPECT_EQ(h.of<ParseErrorEvent>()[0].second.error.kind, protocol::ErrorKind::bad_checksum);
   bool logged = false;
-  for (const auto& e : h.core.log()->snapshot()) {
+  for (const auto& e : h.core.log()->entries()) {
     if (e.kind == LogKind::parse_error && e.raw == "LOGI:FB:SP:1:00#") logged = true;
   }
   EXPECT_TRUE(logged);
@@ -524,19 +524,19 @@ TEST(LogiCommLog, RecordsTxRxAndErrorsAndExportsThem) {
   h.now = ms(5);
   h.feed(f("FB:SP:1") + "xx");
   std::vector<LogKind> kinds;
-  for (const auto& e : h.core.log()->snapshot()) {
+  for (const auto& e : h.core.log()->entries()) {
     if (e.kind != LogKind::note) kinds.push_back(e.kind);
   }
   EXPECT_EQ(kinds, (std::vector<LogKind>{LogKind::tx, LogKind::rx}))
       << "the trailing bytes stay in the decoder until a frame or the end";
   const auto& log = *h.core.log();
-  const std::string txt = log.export_text();
+  const std::string txt = log.to_string(client::LogFormat::txt);
   EXPECT_NE(txt.find("TX   LOGI:SP:050:D7#  SetSpeed percent=50"), std::string::npos) << txt;
   EXPECT_NE(txt.find("RX   LOGI:FB:SP:1:"), std::string::npos) << txt;
-  const std::string csv = log.export_csv();
+  const std::string csv = log.to_string(client::LogFormat::csv);
   EXPECT_EQ(csv.rfind("time_ms,kind,raw,description\r\n", 0), 0u);
   EXPECT_NE(csv.find("5.000,RX,\"LOGI:FB:SP:1:"), std::string::npos) << csv;
-  const std::string nd = log.export_ndjson();
+  const std::string nd = log.to_string(client::LogFormat::ndjson);
   EXPECT_NE(nd.find(R"("kind":"TX")"), std::string::npos) << nd;
   EXPECT_NE(nd.find(R"("raw":"LOGI:SP:050:D7#")"), std::string::npos) << nd;
 }
@@ -544,9 +544,11 @@ TEST(LogiCommLog, RecordsTxRxAndErrorsAndExportsThem) {
 TEST(LogiCommLog, CsvQuotesFieldsAndJsonEscapesOddBytes) {
   CommLog log;
   log.add({ms(1), LogKind::parse_error, std::string("a\"b,\x01", 5), "garbage"});
-  EXPECT_NE(log.export_csv().find("\"a\"\"b,\\x01\""), std::string::npos) << log.export_csv();
-  EXPECT_NE(log.export_ndjson().find(R"("raw":"a\"b,\\x01")"), std::string::npos)
-      << log.export_ndjson();
+  EXPECT_NE(log.to_string(client::LogFormat::csv).find("\"a\"\"b,\\x01\""), std::string::npos)
+      << log.to_string(client::LogFormat::csv);
+  EXPECT_NE(log.to_string(client::LogFormat::ndjson).find(R"("raw":"a\"b,\\x01")"),
+            std::string::npos)
+      << log.to_string(client::LogFormat::ndjson);
 }
 
 TEST(LogiCommLog, AReaderThreadSeesEveryEntryWhileTheWriterAppends) {

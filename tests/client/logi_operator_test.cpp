@@ -94,7 +94,7 @@ TEST(OperatorParser, BlankLinesAndCommentsAreNoAction) {
 TEST(OperatorParser, EveryErrorNamesItsColumnAndWhatWasExpected) {
   struct Case {
     const char* line;
-    int column;
+    std::size_t column;
     const char* says;
   };
   const Case cases[] = {
@@ -175,7 +175,7 @@ TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsTheFirstErrorAsFileLineColu
   const auto bad = parse_operator_script("connect\nspeed 50\npress  UP\nmode HALF\n", "drive.txt");
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error->line, 3);
-  EXPECT_EQ(bad.error->column, 8);
+  EXPECT_EQ(bad.error->column, 8u);
   EXPECT_EQ(bad.error->to_string().rfind("drive.txt:3:8: expected a direction", 0), 0u)
       << bad.error->to_string();
   EXPECT_TRUE(parse_operator_script("", "empty.txt").steps.empty());
@@ -225,7 +225,7 @@ class RunnerBench {
 
   /// Time of the first received frame whose raw text contains `text`.
   std::optional<Time> rx_time(const std::string& text, Time after = Time{0}) const {
-    for (const auto& e : session_->log()->snapshot()) {
+    for (const auto& e : session_->log()->entries()) {
       if (e.kind == LogKind::rx && e.at >= after && e.raw.find(text) != std::string::npos)
         return e.at;
     }
@@ -233,7 +233,7 @@ class RunnerBench {
   }
   std::vector<std::string> sent() const {
     std::vector<std::string> out;
-    for (const auto& e : session_->log()->snapshot()) {
+    for (const auto& e : session_->log()->entries()) {
       if (e.kind == LogKind::tx) out.push_back(e.raw);
     }
     return out;

@@ -82,7 +82,7 @@ class VirtualBench {
   /// (time, raw) of every frame the client sent.
   std::vector<std::pair<Time, std::string>> sent() const {
     std::vector<std::pair<Time, std::string>> out;
-    for (const auto& e : session_->log()->snapshot()) {
+    for (const auto& e : session_->log()->entries()) {
       if (e.kind == LogKind::tx) out.emplace_back(e.at, e.raw);
     }
     return out;
@@ -205,7 +205,7 @@ TEST(LogiSession, AResetConnectionIsFollowedByReconnectAttemptsAt1s3s6s9s) {
   ASSERT_NE(b.session().core().state(), ConnectionState::connected);
   Time dropped{0};
   for (auto& [t, e] : b.of<ConnectionEvent>()) {
-    if (e.state == ConnectionState::waiting_to_reconnect) {
+    if (e.state == ConnectionState::reconnecting) {
       dropped = t;
       break;
     }
@@ -280,9 +280,12 @@ TEST(LogiSession, AFrameWithABadChecksumIsDroppedAndLoggedAndTheLinkStaysUp) {
   EXPECT_EQ(errors[0].first, seconds(1) + milliseconds(100));
   EXPECT_EQ(errors[0].second.error.kind, protocol::ErrorKind::bad_checksum);
   EXPECT_TRUE(b.of<FeedbackEvent>().empty());
-  EXPECT_NE(b.session().log()->export_text().find("ERR  LOGI:FB:SP:1:00#  bad_checksum"),
+  EXPECT_NE(b.session()
+                .log()
+                ->to_string(client::LogFormat::txt)
+                .find("ERR  LOGI:FB:SP:1:00#  bad_checksum"),
             std::string::npos)
-      << b.session().log()->export_text();
+      << b.session().log()->to_string(client::LogFormat::txt);
   EXPECT_EQ(b.session().core().state(), ConnectionState::connected);
   EXPECT_EQ(b.of<StatusEvent>().size(), 4u);
 }

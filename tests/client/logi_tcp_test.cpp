@@ -68,7 +68,7 @@ TEST(LogiSessionTcp, DrivesTheMockCarOverRealTcpAndNoticesItsLoss) {
   // The car goes away: the client enters the safe state and waits to reconnect.
   server.close();
   ASSERT_TRUE(link::test::run_until(io, [&] {
-    return session.core().state() == ConnectionState::waiting_to_reconnect ||
+    return session.core().state() == ConnectionState::reconnecting ||
            session.core().state() == ConnectionState::connecting;
   }));
   EXPECT_FALSE(session.core().movement_enabled());
@@ -76,7 +76,7 @@ TEST(LogiSessionTcp, DrivesTheMockCarOverRealTcpAndNoticesItsLoss) {
 
   session.disconnect();
   EXPECT_EQ(session.core().state(), ConnectionState::disconnected);
-  const std::string log = session.log()->export_text();
+  const std::string log = session.log()->to_string(client::LogFormat::txt);
   EXPECT_NE(log.find("TX   LOGI:MV:FWD:23#"), std::string::npos) << log;
   EXPECT_NE(log.find("RX   LOGI:FB:MV:1:"), std::string::npos) << log;
 }

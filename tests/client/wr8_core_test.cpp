@@ -105,7 +105,7 @@ TEST(Wr8ClientCore, NoAuthReplyWithinTwoSecondsIsAFailedConnectionRetriedWithBac
   const auto failed = events_of<LoginFailedEvent>(core.take_events());
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_EQ(failed[0].reason, "AUTH-REPLY timeout");
-  EXPECT_EQ(core.state(), ConnectionState::waiting_to_reconnect);
+  EXPECT_EQ(core.state(), ConnectionState::reconnecting);
 
   // Attempts 1 s, 2 s, 4 s, 8 s, 8 s after each failure.
   Time t = seconds(2);
@@ -117,7 +117,7 @@ TEST(Wr8ClientCore, NoAuthReplyWithinTwoSecondsIsAFailedConnectionRetriedWithBac
     core.on_timer(t);
     EXPECT_TRUE(has_open(core.take_actions()));
     core.on_connect_failed(t);
-    EXPECT_EQ(core.state(), ConnectionState::waiting_to_reconnect);
+    EXPECT_EQ(core.state(), ConnectionState::reconnecting);
   }
 }
 
@@ -235,7 +235,7 @@ TEST(Wr8ClientCore, AnUnansweredTaskTimesOutAt500MsAndItsLateAnswerIsIgnoredAndL
 
   feed(core, milliseconds(700), proto::Response{r.coi, proto::ResponseCode::completed});
   EXPECT_TRUE(events_of<RequestEvent>(core.take_events()).empty());
-  const auto log = core.log()->snapshot();
+  const auto log = core.log()->entries();
   ASSERT_FALSE(log.empty());
   EXPECT_EQ(log.back().kind, LogKind::note);
   EXPECT_NE(log.back().description.find("ignored (late or unknown COI)"), std::string::npos);
@@ -298,7 +298,7 @@ TEST(Wr8ClientCore, ALostConnectionCancelsOpenRequests) {
   const auto reqs = events_of<RequestEvent>(core.take_events());
   ASSERT_EQ(reqs.size(), 1u);
   EXPECT_EQ(reqs[0].state, RequestState::cancelled);
-  EXPECT_EQ(core.state(), ConnectionState::waiting_to_reconnect);
+  EXPECT_EQ(core.state(), ConnectionState::reconnecting);
   EXPECT_EQ(core.next_wakeup(), milliseconds(1010));
 }
 
@@ -308,13 +308,13 @@ TEST(Wr8ClientCore, TheLogExportsTxAndRxAsHexInTextCsvAndNdjson) {
   const auto out = sent(core.take_actions());
   ASSERT_EQ(out.size(), 1u);
   const std::string task = protocol::to_hex(out[0]);
-  const std::string text = core.log()->export_text();
+  const std::string text = core.log()->to_string(client::LogFormat::txt);
   EXPECT_NE(text.find("TX   " + task), std::string::npos) << text;
   EXPECT_NE(text.find("RX   02 08 01 02"), std::string::npos) << text;
-  const std::string csv = core.log()->export_csv();
+  const std::string csv = core.log()->to_string(client::LogFormat::csv);
   EXPECT_EQ(csv.rfind("time_ms,kind,raw,description\r\n", 0), 0u);
   EXPECT_NE(csv.find("10.000,TX,\"" + task + "\""), std::string::npos) << csv;
-  const std::string nd = core.log()->export_ndjson();
+  const std::string nd = core.log()->to_string(client::LogFormat::ndjson);
   EXPECT_NE(nd.find("\"kind\":\"RX\""), std::string::npos) << nd;
   EXPECT_NE(nd.find("\"raw\":\"02 08 01 02\""), std::string::npos) << nd;
 }
@@ -328,12 +328,13 @@ TEST(Wr8ClientCore, TheLogNeverShowsTheAuthenticationString) {
   std::copy(secret.begin(), secret.end(), config.profile.auth_text.begin());
   auto core = logged_in(config);
   const std::string hex = "53 45 43 52 45 54 2D 30 34 32";
-  for (const std::string& out :
-       {core.log()->export_text(), core.log()->export_csv(), core.log()->export_ndjson()}) {
+  for (const std::string& out : {core.log()->to_string(client::LogFormat::txt),
+                                 core.log()->to_string(client::LogFormat::csv),
+                                 core.log()->to_string(client::LogFormat::ndjson)}) {
     EXPECT_EQ(out.find(secret), std::string::npos) << out;
     EXPECT_EQ(out.find(hex), std::string::npos) << out;
   }
-  const auto log = core.log()->snapshot();
+  const auto log = core.log()->entries();
   const auto auth =
       std::find_if(log.begin(), log.end(), [](const LogEntry& e) { return e.kind == LogKind::tx; });
   ASSERT_NE(auth, log.end());

@@ -175,7 +175,7 @@ TEST(SvguiCore, NoReplyWithinTheLoginTimeoutClosesAndRetriesOnTheBackoff) {
   const auto failed = events_of<LoginFailedEvent>(core.take_events());
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_EQ(failed[0].reason, "AUTH-REPLY timeout");
-  EXPECT_EQ(core.state(), ConnectionState::waiting_to_reconnect);
+  EXPECT_EQ(core.state(), ConnectionState::reconnecting);
   EXPECT_EQ(core.next_wakeup(), seconds(4));
   core.on_timer(seconds(4));
   EXPECT_TRUE(has(core.take_actions(), OpenConnection{}));
@@ -638,7 +638,7 @@ TEST(SvguiCore, ADropCancelsWhatIsOpenStopsControlAndReconnects) {
   ASSERT_EQ(req.size(), 1u);
   EXPECT_EQ(req[0].state, RequestState::cancelled);
   EXPECT_FALSE(core.held_control());
-  EXPECT_EQ(core.state(), ConnectionState::waiting_to_reconnect);
+  EXPECT_EQ(core.state(), ConnectionState::reconnecting);
   EXPECT_EQ(core.next_wakeup(), milliseconds(1050));
 
   // disconnect() releases a held control first: CONTROL 0 0, then the close.
@@ -657,7 +657,7 @@ TEST(SvguiCore, ADropCancelsWhatIsOpenStopsControlAndReconnects) {
 TEST(SvguiCore, TheLogHoldsEveryPacketWithItsLengthByte) {
   auto core = logged_in(Version::v2019);
   core.forward(milliseconds(1), 100);
-  const auto entries = core.log()->snapshot();
+  const auto entries = core.log()->entries();
   ASSERT_GE(entries.size(), 3u);
   const auto& auth = entries[entries.size() - 3];
   EXPECT_EQ(auth.kind, LogKind::tx);

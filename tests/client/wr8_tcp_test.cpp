@@ -55,7 +55,7 @@ TEST(Wr8SessionTcp, LogsInReadsDataAndCompletesATurnOverRealTcp) {
   ASSERT_TRUE(link::test::run_until(io, [&] { return final_state().has_value(); }));
   EXPECT_EQ(final_state(), RequestState::completed);
   EXPECT_NEAR(firmware.state().commanded_wheel_angle_deg, 10.0, 1e-9);
-  EXPECT_FALSE(session.core().log()->export_ndjson().empty());
+  EXPECT_FALSE(session.core().log()->to_string(client::LogFormat::ndjson).empty());
 }
 
 }  // namespace

@@ -184,7 +184,7 @@ std::string check_backoff(const Rig& rig, bool also_connected) {
       count = 0;
     const auto* c = std::get_if<ConnectionEvent>(&e);
     if (c == nullptr) continue;
-    if (c->state == ConnectionState::waiting_to_reconnect) {
+    if (c->state == ConnectionState::reconnecting) {
       ++count;
       if (c->attempt != count) {
         return "waiting for attempt " + std::to_string(c->attempt) + " at " + ms(t) +
@@ -535,7 +535,7 @@ std::string check_safe_state(Rig& rig) {
 }
 
 std::string check_bad_checksum(const Rig& rig) {
-  const auto log = rig.core().log()->snapshot();
+  const auto log = rig.core().log()->entries();
   for (const auto& [t, e] : rig.events) {
     const auto* p = std::get_if<ParseErrorEvent>(&e);
     if (p == nullptr || p->error.kind != protocol::ErrorKind::bad_checksum) continue;
@@ -609,7 +609,7 @@ std::string check_frames(const Rig& rig) {
   }
   // Every send, in order, is the documented frame of its command...
   std::vector<std::string> tx;
-  for (const auto& l : rig.core().log()->snapshot()) {
+  for (const auto& l : rig.core().log()->entries()) {
     if (l.kind == LogKind::tx) tx.push_back(l.raw);
   }
   std::map<RequestId, std::string> first_send;
@@ -769,7 +769,7 @@ std::string check_connect_disconnect(const Rig& rig) {
 }
 
 std::string check_log(const Rig& rig) {
-  const auto log = rig.core().log()->snapshot();
+  const auto log = rig.core().log()->entries();
   std::vector<std::pair<Time, std::string>> tx, rx, err, want_tx, want_err;
   for (const auto& l : log) {
     if (l.kind == LogKind::tx) tx.emplace_back(l.at, l.raw);
@@ -864,7 +864,7 @@ bool exercised(Prop p, const Rig& rig) {
     case Prop::backoff_delays:
     case Prop::safe_state_and_reconfirm:
       return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {
-        return c.state == ConnectionState::waiting_to_reconnect;
+        return c.state == ConnectionState::reconnecting;
       });
     case Prop::reconnects_automatically:
       return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {

@@ -1,9 +1,11 @@
 #pragma once
-// The LOGI client's stateful property test bench: a LogiSession against the
-// mock LOGI car (physics included) over mem:// with fault rules, in virtual
-// time; rapidcheck commands for operator actions, car-side events and time;
-// a recorder of everything the client, the wire and the car did; and one
-// named check per rule of the LOGI documentation's sections 5, 9 and 10.
+// The LOGI client's stateful property test bench: the client (with a
+// planted bug if asked, tests/property/planted_bug.hpp) against the mock
+// LOGI car (physics included) over mem:// with fault rules, in virtual time
+// (logi_rig.cpp); rapidcheck commands for operator actions, car-side events
+// and time (logi_commands.cpp); a recorder of everything the client, the
+// wire and the car did; and one named check per rule of the LOGI
+// documentation's sections 5, 9 and 10 (logi_checks.cpp).
 
 #include <rapidcheck.h>
 #include <rapidcheck/state.h>
@@ -20,6 +22,7 @@
 #include "client/logi/session.hpp"
 #include "link/link.hpp"
 #include "mocks/logi.hpp"
+#include "tests/property/planted_bug.hpp"
 #include "tests/client/client_test_support.hpp"
 
 namespace hil::client::logi::prop {
@@ -153,7 +156,7 @@ class Rig {
   explicit Rig(PlantedBug bug = PlantedBug::none, std::uint64_t link_seed = 1);
   ~Rig();
 
-  LogiSession& session() { return *session_; }
+  PlantedBugSession& session() { return *session_; }
   const LogiClientCore& core() const { return session_->core(); }
   mocks::LogiFirmware& firmware() { return *car_.firmware; }
   mocks::MockServer& server() { return *car_.server; }
@@ -213,7 +216,7 @@ class Rig {
   void end_op(OpRecord r);
 
   test::VirtualCar<mocks::LogiFirmware> car_;
-  std::unique_ptr<LogiSession> session_;
+  std::unique_ptr<PlantedBugSession> session_;
   std::shared_ptr<Observer> observer_;
   std::multimap<Time, std::size_t> chassis_checks_;  // due -> index of the stop in car_frames
   std::multimap<Time, std::size_t> rest_checks_;     // due -> index of the release/stop in ops

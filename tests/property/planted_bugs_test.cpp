@@ -1,7 +1,7 @@
 // The LOGI properties have teeth: each known bug, planted in the client on
-// its own through the test-only ClientConfig::planted_bug, makes at least
-// one named property fail within a fixed number of random sessions, and the
-// same property passes on the same sessions without the bug.
+// its own through PlantedBugCore (tests/property/planted_bug.hpp), makes at
+// least one named property fail within a fixed number of random sessions,
+// and the same property passes on the same sessions without the bug.
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>

@@ -43,7 +43,7 @@ TEST(LogiClientStdinActions, EventLinesNameStatesAsHilsReferenceClientRecordsThe
   EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::connected, 0}),
             "event connection connected");
   EXPECT_EQ(
-      lc::contract_event_line(logi::ConnectionEvent{ConnectionState::waiting_to_reconnect, 2}),
+      lc::contract_event_line(logi::ConnectionEvent{ConnectionState::reconnecting, 2}),
       "event connection reconnecting");
   EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::disconnected, 0}),
             "event connection disconnected");

@@ -271,7 +271,7 @@ TEST_F(TuiModelTest, AnEmergencyStopWhileDisconnectedIsSentOnConnect) {
   ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
   // Once sent, a later reconnect does not stop the car again.
   EXPECT_CALL(session, emergency_stop()).Times(0);
-  model.on_event(ms(300), logi::ConnectionEvent{ConnectionState::waiting_to_reconnect, 0});
+  model.on_event(ms(300), logi::ConnectionEvent{ConnectionState::reconnecting, 0});
   connected(ms(1300));
 }
 
@@ -393,7 +393,7 @@ TEST_F(TuiModelTest, TheConnectKeyConnectsWhenDisconnectedAndDisconnectsOtherwis
 TEST_F(TuiModelTest, TheLogIsSavedInEachFormat) {
   {
     InSequence order;
-    EXPECT_CALL(session, save_log(LogFormat::text)).WillOnce(Return("saved a.txt"));
+    EXPECT_CALL(session, save_log(LogFormat::txt)).WillOnce(Return("saved a.txt"));
     EXPECT_CALL(session, save_log(LogFormat::csv)).WillOnce(Return("saved a.csv"));
     EXPECT_CALL(session, save_log(LogFormat::ndjson)).WillOnce(Return("saved a.ndjson"));
   }
@@ -485,7 +485,7 @@ TEST_F(TuiModelTest, TheLogPanelShowsTheNewestLinesAndScrollsBack) {
 TEST_F(TuiModelTest, DisconnectingShowsItAndForgetsTheHeldDirection) {
   connected();
   model.on_key(ms(0), 'w');
-  model.on_event(ms(100), logi::ConnectionEvent{ConnectionState::waiting_to_reconnect, 0});
+  model.on_event(ms(100), logi::ConnectionEvent{ConnectionState::reconnecting, 0});
   EXPECT_FALSE(model.held());
   EXPECT_CALL(session, release()).Times(0);
   model.on_time(ms(700));

@@ -1,7 +1,8 @@
 #pragma once
 // The Arduino robot client as a sans-I/O core: one framed request at a time
 // with SEQ matching, timeout doubling, BAD_CS resends, and the link state
-// machine (OPEN, DEGRADED, RECONNECTING, DOWN). It takes inputs with the
+// machine (OPEN, DEGRADED, RECONNECTING, DOWN, in the shared vocabulary
+// connected, degraded, reconnecting, down). It takes inputs with the
 // time and hands back actions, events and its next wakeup (docs/clients/arduino.md).
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "client/common/connection.hpp"
 #include "link/time.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/message.hpp"
@@ -46,8 +48,13 @@ struct ClientConfig {
   int reconnect_ping_retries = 2;
 };
 
-enum class LinkState : std::uint8_t { closed, opening, open, degraded, reconnecting, down };
-std::string_view to_string(LinkState s);
+/// The link's states, in the shared vocabulary: disconnected (closed),
+/// connecting (opening), connected (open), degraded, reconnecting, down.
+using client::ConnectionState;
+using client::to_string;
+/// The link state as docs/clients/arduino.md and the program name it:
+/// "CLOSED", "OPENING", "OPEN", "DEGRADED", "RECONNECTING", "DOWN".
+std::string_view link_name(ConnectionState s);
 
 enum class ResultCode : std::uint8_t {
   ok,               ///< ACK; `info` holds its payload
@@ -89,8 +96,8 @@ struct RequestDone {
   Result result;
 };
 struct LinkChanged {
-  LinkState from = LinkState::closed;
-  LinkState to = LinkState::closed;
+  ConnectionState from = ConnectionState::disconnected;
+  ConnectionState to = ConnectionState::disconnected;
   Time at{0};
   std::string reason;
 };
@@ -142,7 +149,7 @@ class ArduinoClientCore {
   std::vector<Action> take_actions();
   std::vector<Event> take_events();
 
-  LinkState state() const { return state_; }
+  ConnectionState state() const { return state_; }
   bool busy() const { return inflight_.has_value(); }
   std::size_t queued() const { return queue_.size(); }
   /// The SEQ the next request will carry.
@@ -176,7 +183,7 @@ class ArduinoClientCore {
   void pump(Time now);
   void send_current(Time now);
   void finish(Time now, Result result);
-  void set_state(Time now, LinkState to, std::string reason);
+  void set_state(Time now, ConnectionState to, std::string reason);
   void link_failed(Time now, std::string reason);
   void reconnect_failed(Time now, std::string reason);
   void fail_all(Time now, ResultCode code, const std::string& detail);
@@ -184,15 +191,15 @@ class ArduinoClientCore {
   void handle_message(Time now, const protocol::arduino::Message& m);
 
   ClientConfig config_;
-  LinkState state_ = LinkState::closed;
+  ConnectionState state_ = ConnectionState::disconnected;
   bool connected_ = false;
   std::deque<Pending> queue_;
   std::optional<Inflight> inflight_;
   std::uint8_t next_seq_ = 0;
   RequestId next_id_ = 1;
   Time last_exchange_{0};
-  std::optional<Time> reconnect_due_;
-  int reconnect_failures_ = 0;
+  // Its attempt count is the failed reopen attempts since the link degraded.
+  ReconnectSchedule reconnect_;
   protocol::arduino::Decoder decoder_;
   std::vector<protocol::arduino::Item> items_;
   std::vector<Action> actions_;

@@ -1,4 +1,4 @@
-#include "client/arduino/client_core.hpp"
+#include "client/arduino/core.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -21,20 +21,22 @@ Result outcome(ResultCode code, std::string detail) {
 
 }  // namespace
 
-std::string_view to_string(LinkState s) {
+std::string_view link_name(ConnectionState s) {
   switch (s) {
-    case LinkState::closed:
+    case ConnectionState::disconnected:
       return "CLOSED";
-    case LinkState::opening:
+    case ConnectionState::connecting:
       return "OPENING";
-    case LinkState::open:
+    case ConnectionState::connected:
       return "OPEN";
-    case LinkState::degraded:
+    case ConnectionState::degraded:
       return "DEGRADED";
-    case LinkState::reconnecting:
+    case ConnectionState::reconnecting:
       return "RECONNECTING";
-    case LinkState::down:
+    case ConnectionState::down:
       return "DOWN";
+    case ConnectionState::authenticating:
+      break;
   }
   return "?";
 }
@@ -55,7 +57,8 @@ std::string_view to_string(ResultCode c) {
   return "?";
 }
 
-ArduinoClientCore::ArduinoClientCore(ClientConfig config) : config_(config) {
+ArduinoClientCore::ArduinoClientCore(ClientConfig config)
+    : config_(config), reconnect_(Backoff::doubling(config_.reconnect_base_delay)) {
   if (config_.base_timeout <= Duration::zero() || config_.max_retries < 0 ||
       config_.max_bad_cs_resends < 0 || config_.max_reconnect_attempts < 1 ||
       config_.reconnect_ping_retries < 0 || config_.reconnect_base_delay < Duration::zero() ||
@@ -88,18 +91,19 @@ Bytes ArduinoClientCore::frame_of(const Pending& pending, std::uint8_t seq) cons
 }
 
 void ArduinoClientCore::open(Time now) {
-  if (state_ != LinkState::closed && state_ != LinkState::down) return;
-  reconnect_failures_ = 0;
-  set_state(now, LinkState::opening, "open requested");
+  if (state_ != ConnectionState::disconnected && state_ != ConnectionState::down) return;
+  reconnect_.reset();
+  set_state(now, ConnectionState::connecting, "open requested");
   actions_.push_back(OpenPort{});
 }
 
 void ArduinoClientCore::close(Time now) {
   if (connected_) actions_.push_back(ClosePort{});
   connected_ = false;
-  reconnect_due_.reset();
+  reconnect_.cancel();
   fail_all(now, ResultCode::link_down, "the port was closed");
-  if (state_ != LinkState::closed) set_state(now, LinkState::closed, "close requested");
+  if (state_ != ConnectionState::disconnected)
+    set_state(now, ConnectionState::disconnected, "close requested");
 }
 
 RequestId ArduinoClientCore::request(Time now, proto::Body body) {
@@ -114,9 +118,9 @@ RequestId ArduinoClientCore::request(Time now, proto::Body body) {
     complete(id, outcome(ResultCode::invalid_request, e.what()));
     return id;
   }
-  if (state_ == LinkState::closed || state_ == LinkState::down) {
+  if (state_ == ConnectionState::disconnected || state_ == ConnectionState::down) {
     complete(id, outcome(ResultCode::link_down,
-                         std::string("the link is ") + std::string(to_string(state_))));
+                         std::string("the link is ") + std::string(link_name(state_))));
     return id;
   }
   queue_.push_back({id, Purpose::user, std::move(body)});
@@ -146,9 +150,9 @@ RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
   }
   if (envelope.payload.empty())
     envelope.payload = std::string(proto::empty_payload(config_.dialect));
-  if (state_ == LinkState::closed || state_ == LinkState::down) {
+  if (state_ == ConnectionState::disconnected || state_ == ConnectionState::down) {
     complete(id, outcome(ResultCode::link_down,
-                         std::string("the link is ") + std::string(to_string(state_))));
+                         std::string("the link is ") + std::string(link_name(state_))));
     return id;
   }
   queue_.push_back({id, Purpose::user, std::move(envelope)});
@@ -159,11 +163,11 @@ RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
 void ArduinoClientCore::on_connected(Time now) {
   connected_ = true;
   decoder_ = proto::Decoder{};
-  if (state_ == LinkState::opening) {
+  if (state_ == ConnectionState::connecting) {
     last_exchange_ = now;
-    set_state(now, LinkState::open, "port open");
+    set_state(now, ConnectionState::connected, "port open");
     pump(now);
-  } else if (state_ == LinkState::reconnecting) {
+  } else if (state_ == ConnectionState::reconnecting) {
     // The reopened port must answer a PING before requests flow again.
     inflight_ = Inflight{};
     inflight_->pending = {0, Purpose::reconnect_check, proto::Ping{}};
@@ -176,10 +180,10 @@ void ArduinoClientCore::on_connected(Time now) {
 
 void ArduinoClientCore::on_connect_failed(Time now, std::string_view why) {
   connected_ = false;
-  if (state_ == LinkState::opening) {
-    set_state(now, LinkState::down, "the port did not open: " + std::string(why));
+  if (state_ == ConnectionState::connecting) {
+    set_state(now, ConnectionState::down, "the port did not open: " + std::string(why));
     fail_all(now, ResultCode::link_down, "the port did not open");
-  } else if (state_ == LinkState::reconnecting) {
+  } else if (state_ == ConnectionState::reconnecting) {
     reconnect_failed(now, "the port did not reopen: " + std::string(why));
   }
 }
@@ -199,7 +203,7 @@ void ArduinoClientCore::on_closed(Time now) {
                lost_result(lost, ResultCode::link_down, "the port closed before the answer"));
     }
   }
-  if (state_ == LinkState::open) link_failed(now, "the port closed");
+  if (state_ == ConnectionState::connected) link_failed(now, "the port closed");
 }
 
 void ArduinoClientCore::on_bytes(Time now, ByteView bytes) {
@@ -256,14 +260,13 @@ void ArduinoClientCore::on_timer(Time now) {
       finish(now, outcome(ResultCode::timeout, "no answer after every attempt"));
     }
   }
-  if (reconnect_due_ && now >= *reconnect_due_) {
-    reconnect_due_.reset();
-    if (state_ != LinkState::reconnecting) {
-      set_state(now, LinkState::reconnecting, "reopening the port");
+  if (reconnect_.take_due(now)) {
+    if (state_ != ConnectionState::reconnecting) {
+      set_state(now, ConnectionState::reconnecting, "reopening the port");
     }
     actions_.push_back(OpenPort{});
   }
-  if (state_ == LinkState::open && connected_ && !inflight_ && queue_.empty() &&
+  if (state_ == ConnectionState::connected && connected_ && !inflight_ && queue_.empty() &&
       config_.health_check_interval > Duration::zero() &&
       now >= last_exchange_ + config_.health_check_interval) {
     queue_.push_back({0, Purpose::health_check, proto::Ping{}});
@@ -277,8 +280,8 @@ std::optional<Time> ArduinoClientCore::next_wakeup() const {
     if (!due || t < *due) due = t;
   };
   if (inflight_) consider(inflight_->deadline);
-  if (reconnect_due_) consider(*reconnect_due_);
-  if (state_ == LinkState::open && connected_ && !inflight_ && queue_.empty() &&
+  if (const auto reopen = reconnect_.due()) consider(*reopen);
+  if (state_ == ConnectionState::connected && connected_ && !inflight_ && queue_.empty() &&
       config_.health_check_interval > Duration::zero()) {
     consider(last_exchange_ + config_.health_check_interval);
   }
@@ -293,7 +296,7 @@ std::vector<Event> ArduinoClientCore::take_events() {
 }
 
 void ArduinoClientCore::pump(Time now) {
-  if (inflight_ || state_ != LinkState::open || !connected_ || queue_.empty()) return;
+  if (inflight_ || state_ != ConnectionState::connected || !connected_ || queue_.empty()) return;
   Pending next = std::move(queue_.front());
   queue_.pop_front();
   inflight_ = Inflight{};
@@ -327,9 +330,9 @@ void ArduinoClientCore::finish(Time now, Result result) {
       break;
     case Purpose::reconnect_check:
       if (result.code == ResultCode::ok) {
-        reconnect_failures_ = 0;
+        reconnect_.reset();
         last_exchange_ = now;
-        set_state(now, LinkState::open, "the reopened port answered PING");
+        set_state(now, ConnectionState::connected, "the reopened port answered PING");
       } else {
         reconnect_failed(now, "no ACK to PING on the reopened port");
       }
@@ -338,31 +341,31 @@ void ArduinoClientCore::finish(Time now, Result result) {
   pump(now);
 }
 
-void ArduinoClientCore::set_state(Time now, LinkState to, std::string reason) {
+void ArduinoClientCore::set_state(Time now, ConnectionState to, std::string reason) {
   if (to == state_) return;
   events_.push_back(LinkChanged{state_, to, now, std::move(reason)});
   state_ = to;
 }
 
 void ArduinoClientCore::link_failed(Time now, std::string reason) {
-  if (state_ != LinkState::open) return;
-  set_state(now, LinkState::degraded, std::move(reason));
+  if (state_ != ConnectionState::connected) return;
+  set_state(now, ConnectionState::degraded, std::move(reason));
   if (connected_) actions_.push_back(ClosePort{});
   connected_ = false;
-  reconnect_failures_ = 0;
-  reconnect_due_ = now + config_.reconnect_base_delay;
+  reconnect_.reset();
+  reconnect_.schedule(now);  // reconnect_base_delay
 }
 
 void ArduinoClientCore::reconnect_failed(Time now, std::string reason) {
   if (connected_) actions_.push_back(ClosePort{});
   connected_ = false;
-  ++reconnect_failures_;
-  if (reconnect_failures_ >= config_.max_reconnect_attempts) {
-    set_state(now, LinkState::down, std::move(reason));
+  // The attempts scheduled so far all failed.
+  if (reconnect_.attempt() >= config_.max_reconnect_attempts) {
+    set_state(now, ConnectionState::down, std::move(reason));
     fail_all(now, ResultCode::link_down, "the link is DOWN");
     return;
   }
-  reconnect_due_ = now + config_.reconnect_base_delay * (std::int64_t{1} << reconnect_failures_);
+  reconnect_.schedule(now);  // twice the last wait
 }
 
 void ArduinoClientCore::fail_all(Time /*now*/, ResultCode code, const std::string& detail) {
