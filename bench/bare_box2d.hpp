@@ -5,52 +5,21 @@
 
 #include <box2d/box2d.h>
 
-#include <variant>
-
 #include "sim/arena.hpp"
+#include "sim/box2d_shapes.hpp"
 #include "sim/geometry.hpp"
 #include "sim/mecanum.hpp"
 
 namespace hil::bench {
 
 /// The arena's four walls and its obstacles as static fixtures of one
-/// ground body, as World::build_arena makes them.
+/// ground body, with the shapes World::build_arena makes.
 inline void add_bare_arena(b2World& world, const sim::Arena& arena) {
   b2BodyDef ground_def;
   b2Body* ground = world.CreateBody(&ground_def);
-  auto add_box = [&](double cx, double cy, double hw, double hh, double angle) {
-    b2PolygonShape shape;
-    shape.SetAsBox(static_cast<float>(hw), static_cast<float>(hh),
-                   b2Vec2(static_cast<float>(cx), static_cast<float>(cy)),
-                   static_cast<float>(angle));
-    b2FixtureDef fixture;
-    fixture.shape = &shape;
-    fixture.friction = 0.3f;
-    ground->CreateFixture(&fixture);
-  };
-  const double t = arena.wall_thickness_m;
-  const double w = arena.width_m;
-  const double h = arena.height_m;
-  add_box(w / 2, -t / 2, w / 2 + t, t / 2, 0);
-  add_box(w / 2, h + t / 2, w / 2 + t, t / 2, 0);
-  add_box(-t / 2, h / 2, t / 2, h / 2 + t, 0);
-  add_box(w + t / 2, h / 2, t / 2, h / 2 + t, 0);
-  for (const auto& obstacle : arena.obstacles) {
-    if (const auto* box = std::get_if<sim::BoxObstacle>(&obstacle)) {
-      add_box(box->center_m.x_m, box->center_m.y_m, box->width_m / 2, box->height_m / 2,
-              box->angle_rad);
-    } else {
-      const auto& circle = std::get<sim::CircleObstacle>(obstacle);
-      b2CircleShape shape;
-      shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
-                    static_cast<float>(circle.center_m.y_m));
-      shape.m_radius = static_cast<float>(circle.radius_m);
-      b2FixtureDef fixture;
-      fixture.shape = &shape;
-      fixture.friction = 0.3f;
-      ground->CreateFixture(&fixture);
-    }
-  }
+  sim::add_wall_fixtures(*ground, arena);
+  for (const auto& obstacle : arena.obstacles)
+    sim::add_obstacle_fixture(*ground, obstacle);
 }
 
 /// A car's body (its footprint as one box, its mass), awake for good, at
@@ -67,7 +36,7 @@ inline b2Body* add_bare_car(b2World& world, const sim::MecanumDef& car, sim::Pos
   b2FixtureDef fixture;
   fixture.shape = &shape;
   fixture.density = static_cast<float>(car.mass_kg / (car.length_m * car.width_m));
-  fixture.friction = 0.3f;
+  fixture.friction = sim::kFixtureFriction;
   body->CreateFixture(&fixture);
   return body;
 }

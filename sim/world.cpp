@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "sim/box2d_shapes.hpp"
 #include "sim/fixture_tag.hpp"
 
 namespace hil::sim {
@@ -89,57 +90,18 @@ World::~World() {
 }
 
 void World::build_arena() {
-  const Arena& arena = def_.arena;
   b2BodyDef body_def;  // static, at the origin
-  b2Body* ground = b2_->CreateBody(&body_def);
-  auto add_box = [&](double cx, double cy, double hw, double hh, double angle, std::uintptr_t tag) {
-    b2PolygonShape shape;
-    shape.SetAsBox(static_cast<float>(hw), static_cast<float>(hh),
-                   b2Vec2(static_cast<float>(cx), static_cast<float>(cy)),
-                   static_cast<float>(angle));
-    b2FixtureDef fixture;
-    fixture.shape = &shape;
-    fixture.friction = 0.3f;
-    fixture.userData.pointer = tag;
-    ground->CreateFixture(&fixture);
-  };
-  if (arena.walls) {
-    const double t = arena.wall_thickness_m;
-    const double w = arena.width_m;
-    const double h = arena.height_m;
-    const auto wall = fixture_tag(FixtureKind::wall, 0);
-    add_box(w / 2, -t / 2, w / 2 + t, t / 2, 0, wall);
-    add_box(w / 2, h + t / 2, w / 2 + t, t / 2, 0, wall);
-    add_box(-t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
-    add_box(w + t / 2, h / 2, t / 2, h / 2 + t, 0, wall);
-  }
-  ground_ = ground;
-  for (std::size_t i = 0; i < arena.obstacles.size(); ++i)
+  ground_ = b2_->CreateBody(&body_def);
+  if (def_.arena.walls) add_wall_fixtures(*ground_, def_.arena, fixture_tag(FixtureKind::wall, 0));
+  for (std::size_t i = 0; i < def_.arena.obstacles.size(); ++i)
     add_obstacle_fixture(i);
 }
 
 void World::add_obstacle_fixture(std::size_t index) {
-  const auto tag = fixture_tag(FixtureKind::obstacle, index);
-  b2FixtureDef fixture;
-  fixture.friction = 0.3f;
-  fixture.userData.pointer = tag;
-  b2PolygonShape box_shape;
-  b2CircleShape circle_shape;
-  if (const auto* box = std::get_if<BoxObstacle>(&def_.arena.obstacles[index])) {
-    box_shape.SetAsBox(
-        static_cast<float>(box->width_m / 2), static_cast<float>(box->height_m / 2),
-        b2Vec2(static_cast<float>(box->center_m.x_m), static_cast<float>(box->center_m.y_m)),
-        static_cast<float>(box->angle_rad));
-    fixture.shape = &box_shape;
-  } else {
-    const auto& circle = std::get<CircleObstacle>(def_.arena.obstacles[index]);
-    circle_shape.m_p.Set(static_cast<float>(circle.center_m.x_m),
-                         static_cast<float>(circle.center_m.y_m));
-    circle_shape.m_radius = static_cast<float>(circle.radius_m);
-    fixture.shape = &circle_shape;
-  }
+  b2Fixture* fixture = sim::add_obstacle_fixture(*ground_, def_.arena.obstacles[index],
+                                                 fixture_tag(FixtureKind::obstacle, index));
   if (obstacle_fixtures_.size() <= index) obstacle_fixtures_.resize(index + 1, nullptr);
-  obstacle_fixtures_[index] = ground_->CreateFixture(&fixture);
+  obstacle_fixtures_[index] = fixture;
 }
 
 std::size_t World::add_obstacle(Obstacle obstacle) {

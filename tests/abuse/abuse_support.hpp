@@ -45,36 +45,34 @@ inline bool full_form() {
   return v != nullptr && std::string(v) == "1";
 }
 
-/// True in an AddressSanitizer or ThreadSanitizer build. The short form
-/// sends less there (the same properties are asserted): every process is
-/// 2-15x slower under a sanitizer and CI runs the suite under both.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-inline constexpr bool kSanitizerBuild = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-inline constexpr bool kSanitizerBuild = true;
+// __has_feature is clang's; GCC says __SANITIZE_ADDRESS__/__SANITIZE_THREAD__.
+#if defined(__has_feature)
+#define HIL_TEST_HAS_FEATURE(feature) __has_feature(feature)
 #else
-inline constexpr bool kSanitizerBuild = false;
-#endif
-#else
-inline constexpr bool kSanitizerBuild = false;
+#define HIL_TEST_HAS_FEATURE(feature) 0
 #endif
 
 /// True in an AddressSanitizer build: freed blocks wait in ASan's quarantine
 /// (256 MiB by default) instead of going back to the allocator, so resident
 /// memory after an abuse says nothing about leaks or unbounded queues there
 /// (ASan's own leak check does, at exit).
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kAddressSanitizerBuild = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+#if defined(__SANITIZE_ADDRESS__) || HIL_TEST_HAS_FEATURE(address_sanitizer)
 inline constexpr bool kAddressSanitizerBuild = true;
 #else
 inline constexpr bool kAddressSanitizerBuild = false;
 #endif
+
+/// True in a ThreadSanitizer build.
+#if defined(__SANITIZE_THREAD__) || HIL_TEST_HAS_FEATURE(thread_sanitizer)
+inline constexpr bool kThreadSanitizerBuild = true;
 #else
-inline constexpr bool kAddressSanitizerBuild = false;
+inline constexpr bool kThreadSanitizerBuild = false;
 #endif
+
+/// True in an AddressSanitizer or ThreadSanitizer build. The short form
+/// sends less there (the same properties are asserted): every process is
+/// 2-15x slower under a sanitizer and CI runs the suite under both.
+inline constexpr bool kSanitizerBuild = kAddressSanitizerBuild || kThreadSanitizerBuild;
 
 /// Raises this process's open-file soft limit to the hard limit (for a
 /// thousand sockets at once); processes started earlier keep theirs.
@@ -284,18 +282,15 @@ class Conn {
     const auto deadline = Clock::now() + limit;
     std::size_t done = 0;
     while (done < size) {
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-      if (left.count() <= 0) return false;
-      pollfd pfd{fd_, POLLOUT | POLLIN, 0};
-      if (::poll(&pfd, 1, static_cast<int>(left.count())) <= 0) return false;
-      if ((pfd.revents & POLLIN) != 0) drain();
-      if ((pfd.revents & (POLLERR | POLLNVAL)) != 0) return false;
-      if ((pfd.revents & POLLOUT) != 0) {
+      const short revents = poll_until(POLLOUT | POLLIN, deadline);
+      if (revents == 0) return false;
+      if ((revents & POLLIN) != 0) drain();
+      if ((revents & (POLLERR | POLLNVAL)) != 0) return false;
+      if ((revents & POLLOUT) != 0) {
         const ssize_t n = send_or_write(p + done, size - done);
         if (n < 0 && errno != EAGAIN && errno != EINTR) return false;
         if (n > 0) done += static_cast<std::size_t>(n);
-      } else if ((pfd.revents & POLLHUP) != 0) {
+      } else if ((revents & POLLHUP) != 0) {
         return false;
       }
     }
@@ -307,12 +302,7 @@ class Conn {
   bool read_until(const std::string& text, std::chrono::milliseconds limit = 10s) {
     const auto deadline = Clock::now() + limit;
     while (received.find(text) == std::string::npos) {
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-      if (left.count() <= 0) return false;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
-      if (!read_once()) return false;
+      if (poll_until(POLLIN, deadline) == 0 || !read_once()) return false;
     }
     return true;
   }
@@ -321,11 +311,7 @@ class Conn {
   bool read_to_end(std::chrono::milliseconds limit = 10s) {
     const auto deadline = Clock::now() + limit;
     for (;;) {
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-      if (left.count() <= 0) return false;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
+      if (poll_until(POLLIN, deadline) == 0) return false;
       if (!read_once()) return true;
     }
   }
@@ -333,6 +319,16 @@ class Conn {
   std::string received;
 
  private:
+  // Waits for `events` until `deadline`: the events that came, or 0 when
+  // the time ran out first.
+  short poll_until(short events, Clock::time_point deadline) const {
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) return 0;
+    pollfd p{fd_, events, 0};
+    if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return 0;
+    return p.revents;
+  }
   ssize_t send_or_write(const char* p, std::size_t n) {
     const ssize_t sent = ::send(fd_, p, n, MSG_NOSIGNAL | MSG_DONTWAIT);
     if (sent < 0 && errno == ENOTSOCK) return ::write(fd_, p, n);

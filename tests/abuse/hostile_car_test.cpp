@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "client/arduino/client_core.hpp"
+#include "client/arduino/core.hpp"
 #include "client/leka/core.hpp"
 #include "client/logi/core.hpp"
 #include "client/wr8/core.hpp"
@@ -49,6 +49,16 @@ std::vector<std::pair<std::string, std::string>> hostile_streams(std::uint64_t s
           {"a frame that never ends", start + std::string(4 << 20, 'A')}};
 }
 
+/// Hands `bytes` to `car`'s client core 4 KiB at a time, taking what each
+/// piece made it do.
+template <class Car>
+void feed(Car& car, const std::string& bytes) {
+  for (std::size_t at = 0; at < bytes.size(); at += 4096) {
+    car.core.on_bytes(car.now, view(bytes.substr(at, 4096)));
+    car.collect();
+  }
+}
+
 // ---------------------------------------------------------------- LOGI
 
 namespace logi = client::logi;
@@ -78,6 +88,12 @@ struct LogiCar {
         ++accepted;
     }
   }
+  /// Connects and takes what connecting did.
+  void open_link() {
+    core.connect(now);
+    core.on_connected(now);
+    collect();
+  }
   void run_for(link::Duration d) {
     const Time end = now + d;
     while (now < end) {
@@ -95,9 +111,7 @@ struct LogiCar {
 
 TEST(HostileCar, LogiClientNeverTakesADamagedFeedbackAsConfirmation) {
   LogiCar car;
-  car.core.connect(car.now);
-  car.core.on_connected(car.now);
-  car.collect();
+  car.open_link();
   ASSERT_TRUE(car.core.submit(car.now, protocol::logi::SetMode{protocol::logi::Mode::manual}));
   ASSERT_TRUE(car.core.submit(car.now, protocol::logi::SetSpeed{50}));
   // Forward, queued behind MD and SP: it goes out only once they are
@@ -153,13 +167,8 @@ TEST(HostileCar, LogiClientSurvivesHostileStreamsAndReportsThem) {
   for (const auto& [name, bytes] : hostile_streams(seed, "LOGI:", stat)) {
     SCOPED_TRACE(name);
     LogiCar car;
-    car.core.connect(car.now);
-    car.core.on_connected(car.now);
-    car.collect();
-    for (std::size_t at = 0; at < bytes.size(); at += 4096) {
-      car.core.on_bytes(car.now, view(bytes.substr(at, 4096)));
-      car.collect();
-    }
+    car.open_link();
+    feed(car, bytes);
     EXPECT_GT(car.parse_errors, 0);
     EXPECT_FALSE(car.sent_movement());
     // Still reading: a STAT after the stream is taken.
@@ -190,6 +199,12 @@ struct ArduinoCar {
         ++invalid_frames;
     }
   }
+  /// Opens the port and takes what opening did.
+  void open_link() {
+    core.open(now);
+    core.on_connected(now);
+    collect();
+  }
   void step(link::Duration d) {
     now += d;
     if (auto w = core.next_wakeup(); w && *w <= now) core.on_timer(now);
@@ -207,9 +222,7 @@ std::string arduino_ack(const std::string& sent, bool good) {
 
 TEST(HostileCar, ArduinoClientNeverMovesOnADamagedAck) {
   ArduinoCar car;
-  car.core.open(car.now);
-  car.core.on_connected(car.now);
-  car.collect();
+  car.open_link();
   car.core.set_v(car.now, 160);
   car.core.move_cm(car.now, 50);
   car.collect();
@@ -239,13 +252,8 @@ TEST(HostileCar, ArduinoClientSurvivesHostileStreams) {
        hostile_streams(seed, "^", protocol::arduino::frame_text({7, "ACK", ""}))) {
     SCOPED_TRACE(name);
     ArduinoCar car;
-    car.core.open(car.now);
-    car.core.on_connected(car.now);
-    car.collect();
-    for (std::size_t at = 0; at < bytes.size(); at += 4096) {
-      car.core.on_bytes(car.now, view(bytes.substr(at, 4096)));
-      car.collect();
-    }
+    car.open_link();
+    feed(car, bytes);
     EXPECT_GT(car.core.parse_errors() + car.core.stale_frames(), 0u);
     for (const auto& s : car.sent)
       EXPECT_EQ(s.find("|M|"), std::string::npos);

@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/harness/scratch_dir.hpp"
+
 namespace hil::harness {
 namespace {
 
@@ -19,14 +21,6 @@ namespace fs = std::filesystem;
 
 class AtomicFile : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("hil-atomic-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
   static std::string read(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -35,7 +29,8 @@ class AtomicFile : public ::testing::Test {
     return static_cast<std::size_t>(
         std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
   }
-  fs::path dir_;
+  test::ScratchDir scratch_{"hil-atomic"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(AtomicFile, WritesTheBytesExactlyAndLeavesNoTemporaryFile) {

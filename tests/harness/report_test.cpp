@@ -50,28 +50,32 @@ ReportEntry entry(ScenarioOutcome outcome, int repeat = 0, int repeats = 1) {
   return e;
 }
 
-ScenarioOutcome passing() {
+/// A run of scenarios/logi/`stem`.yaml, named `name`, with `seed`, that
+/// took `run_ms` of run time in `wall_seconds`; its repro command is
+/// `hil run FILE --seed SEED`.
+ScenarioOutcome logi_run(const std::string& stem, const std::string& name, std::uint64_t seed,
+                         int run_ms, double wall_seconds) {
   ScenarioOutcome o;
-  o.file = "scenarios/logi/drive.yaml";
-  o.name = "drive-forward";
+  o.file = "scenarios/logi/" + stem + ".yaml";
+  o.name = name;
+  o.seed = seed;
+  o.run_time = milliseconds(run_ms);
+  o.wall_seconds = wall_seconds;
+  o.repro_command = "hil run " + o.file + " --seed " + std::to_string(seed);
+  return o;
+}
+
+ScenarioOutcome passing() {
+  ScenarioOutcome o = logi_run("drive", "drive-forward", 7, 12345, 0.25);
   o.tags = {"logi", "smoke"};
-  o.seed = 7;
-  o.run_time = milliseconds(12345);
-  o.wall_seconds = 0.25;
   o.steps = {step(4, "connect", true, "", 0, 120), step(5, "speed 50", true, "", 120, 130)};
   o.expectations = {ExpectationOutcome{9, "car received SP:050", true, "", {}, {}, {}}};
   o.timeline.add(frame(125, "to_car", "delivered", "LOGI:SP:050:D7#"));
-  o.repro_command = "hil run scenarios/logi/drive.yaml --seed 7";
   return o;
 }
 
 ScenarioOutcome failed_step() {
-  ScenarioOutcome o;
-  o.file = "scenarios/logi/reject.yaml";
-  o.name = "rejected-mode";
-  o.seed = 11;
-  o.run_time = milliseconds(2000);
-  o.wall_seconds = 0.1;
+  ScenarioOutcome o = logi_run("reject", "rejected-mode", 11, 2000, 0.1);
   o.timeline.add(milliseconds(1000), Source::step, "start", {{"text", "mode MAN"}});
   o.timeline.add(frame(1000, "to_car", "delivered", "LOGI:MO:MAN:xx#"));
   o.timeline.add(milliseconds(1100), Source::sim, "sample", {{"x_m", 1.0}});
@@ -80,17 +84,11 @@ ScenarioOutcome failed_step() {
              step(6, "mode MAN", false, "the car refused MO:MAN", 1000, 1500),
              step(7, "press FWD", false, "not run", 1500, 1500)};
   o.steps[2].ran = false;
-  o.repro_command = "hil run scenarios/logi/reject.yaml --seed 11";
   return o;
 }
 
 ScenarioOutcome failed_expectation() {
-  ScenarioOutcome o;
-  o.file = "scenarios/logi/release.yaml";
-  o.name = "release-sends-stop";
-  o.seed = 42;
-  o.run_time = milliseconds(6000);
-  o.wall_seconds = 0.5;
+  ScenarioOutcome o = logi_run("release", "release-sends-stop", 42, 6000, 0.5);
   o.steps = {step(4, "press FWD", true, "", 0, 10)};
   ExpectationOutcome e;
   e.line = 31;
@@ -102,7 +100,6 @@ ScenarioOutcome failed_expectation() {
   e.evidence = {frame(5000, "to_car", "sent", "LOGI:MV:STOP:A1#"),
                 frame(5812, "to_car", "delivered", "LOGI:MV:STOP:A1#")};
   o.expectations = {e};
-  o.repro_command = "hil run scenarios/logi/release.yaml --seed 42";
   return o;
 }
 
@@ -133,6 +130,12 @@ std::vector<std::string> lines_of(const std::string& text) {
   return lines;
 }
 
+/// Expects `text` to contain each of `parts`.
+void expect_contains(const std::string& text, const std::vector<std::string>& parts) {
+  for (const auto& part : parts)
+    EXPECT_THAT(text, HasSubstr(part));
+}
+
 std::string read(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream s;
@@ -159,13 +162,13 @@ TEST(ReportConsole, OneRowPerRunAndTheSummaryLineLast) {
 
 TEST(ReportConsole, EveryFailureHasItsBlockWithEvidenceAndTheCommandThatRepeatsIt) {
   const std::string text = console(all_four());
-  EXPECT_THAT(text, HasSubstr("FAIL release-sends-stop  (scenarios/logi/release.yaml, seed 42)"));
-  EXPECT_THAT(text, HasSubstr("    window: 5.000 s .. 5.300 s\n"));
-  EXPECT_THAT(text, HasSubstr("        5.000 s  wire    client sent  LOGI:MV:STOP:A1#\n"));
-  EXPECT_THAT(text, HasSubstr("        5.812 s  wire    car received  LOGI:MV:STOP:A1#\n"));
-  EXPECT_THAT(text, HasSubstr("\n  repeat: hil run scenarios/logi/release.yaml --seed 42\n"));
-  EXPECT_THAT(text, HasSubstr("\n  repeat: hil run scenarios/logi/reject.yaml --seed 11\n"));
-  EXPECT_THAT(text, HasSubstr("\n  repeat: hil run scenarios/logi/broken.yaml\n"));
+  expect_contains(text, {"FAIL release-sends-stop  (scenarios/logi/release.yaml, seed 42)",
+                         "    window: 5.000 s .. 5.300 s\n",
+                         "        5.000 s  wire    client sent  LOGI:MV:STOP:A1#\n",
+                         "        5.812 s  wire    car received  LOGI:MV:STOP:A1#\n",
+                         "\n  repeat: hil run scenarios/logi/release.yaml --seed 42\n",
+                         "\n  repeat: hil run scenarios/logi/reject.yaml --seed 11\n",
+                         "\n  repeat: hil run scenarios/logi/broken.yaml\n"});
   EXPECT_THAT(text, Not(HasSubstr("repeat: hil run scenarios/logi/drive.yaml")));
 }
 
@@ -381,12 +384,10 @@ TEST(ReportFolder, EachRunGetsItsPageTimelineAndTrajectory) {
 
   const auto run = dir / "release-sends-stop";
   const std::string page = read(run / "index.html");
-  EXPECT_THAT(page, HasSubstr("<span class=\"fail\">FAIL</span>"));
-  EXPECT_THAT(page, HasSubstr("hil run scenarios/logi/release.yaml --seed 42"));
-  EXPECT_THAT(page, HasSubstr("<p>window: 5.000 s .. 5.300 s</p>"));
-  EXPECT_THAT(page, HasSubstr("car received  LOGI:MV:STOP:A1#"));
-  EXPECT_THAT(page, HasSubstr("<img src=\"trajectory.svg\""));
-  EXPECT_THAT(page, HasSubstr("function filterTimeline"));
+  expect_contains(
+      page, {"<span class=\"fail\">FAIL</span>", "hil run scenarios/logi/release.yaml --seed 42",
+             "<p>window: 5.000 s .. 5.300 s</p>", "car received  LOGI:MV:STOP:A1#",
+             "<img src=\"trajectory.svg\"", "function filterTimeline"});
   // Nothing from outside the folder: it must open from a CI artifact.
   EXPECT_THAT(page, Not(HasSubstr("http")));
   expect_well_escaped(without_scripts(page.substr(page.find("<body>"))));

@@ -2,14 +2,13 @@
 // unless hil run --allow-outside-paths: ../ escapes, absolute paths and
 // symlinks that lead out are refused where they are written.
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
 
 #include "harness/scenario_yaml.hpp"
+#include "tests/harness/scratch_dir.hpp"
 
 namespace hil::harness {
 namespace {
@@ -25,10 +24,6 @@ namespace fs = std::filesystem;
 class Library : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    tmp_ = fs::temp_directory_path() /
-           ("hil-paths-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(tmp_);
     fs::create_directories(tmp_ / "lib" / "faults");
     fs::create_directories(tmp_ / "lib" / "logi");
     write(tmp_ / "outside.yaml", kProfile);
@@ -36,8 +31,6 @@ class Library : public ::testing::Test {
     fs::create_symlink("../../outside.yaml", tmp_ / "lib" / "logi" / "out.yaml");
     fs::create_symlink("../faults/drop.yaml", tmp_ / "lib" / "logi" / "in.yaml");
   }
-  void TearDown() override { fs::remove_all(tmp_); }
-
   static void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
   std::string scenario_file() const { return (tmp_ / "lib" / "logi" / "s.yaml").string(); }
@@ -57,7 +50,8 @@ class Library : public ::testing::Test {
   std::string root() const { return (tmp_ / "lib").string(); }
 
   static constexpr const char* kProfile = "rules:\n  - kind: drop\n    first: 1\n";
-  fs::path tmp_;
+  test::ScratchDir scratch_{"hil-paths"};
+  const fs::path& tmp_ = scratch_.path();
 };
 
 TEST_F(Library, TheRootIsTheParentOfTheScenariosFolder) {

@@ -1,6 +1,7 @@
-// Scenario files as QA writes them: every key, step, matcher, window and
-// quantifier becomes the model the runner and the checker read, and every
-// mistake is reported at its file, line and column.
+// Scenario files as QA writes them: every key and step becomes the model the
+// runner and the checker read, and every mistake is reported at its file,
+// line and column (matchers, windows and quantifiers:
+// scenario_yaml_matchers_test.cpp).
 
 #include <gtest/gtest.h>
 
@@ -8,83 +9,21 @@
 #include <string>
 
 #include "harness/scenario_yaml.hpp"
+#include "tests/harness/scenario_yaml_support.hpp"
 
 namespace hil::harness {
 namespace {
 
-using link::milliseconds;
-using link::seconds;
-using Op = FieldTest::Op;
-
-const std::string kData = std::string(HIL_SOURCE_DIR) + "/tests/harness/data/scenario_yaml";
-
-Scenario parse(const std::string& yaml) {
-  return parse_scenario_text(yaml, "t.yaml");
-}
-
-/// A LOGI scenario with the usual steps, then `tail` (expectations and so on).
-Scenario logi(const std::string& tail) {
-  return parse(
-      "name: t\n"
-      "car: logi\n"
-      "steps:\n"
-      "  - connect\n"
-      "  - mode MAN\n"
-      "  - speed 50\n"
-      "  - press FWD\n"
-      "  - release\n"
-      "  - station 2\n"
-      "  - run\n"
-      "  - estop\n" +
-      tail);
-}
-
-/// The message of the error `yaml` raises, or "" when it loads.
-std::string error_of(const std::string& yaml,
-                     const std::map<std::string, std::string>& overrides = {}) {
-  try {
-    parse_scenario_text(yaml, "t.yaml", overrides);
-  } catch (const config::ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-/// A step that must succeed, as the loader makes it.
-Step step_of(int line, std::string text, StepAction action) {
-  Step s;
-  s.line = line;
-  s.text = std::move(text);
-  s.action = std::move(action);
-  return s;
-}
-
-Matcher car_received(const std::string& frame) {
-  return Matcher{Source::wire,
-                 "frame",
-                 {{"dir", Op::equals, "to_car"},
-                  {"stage", Op::equals, "delivered"},
-                  {"frame", Op::kind_prefix, frame}},
-                 "car received " + frame};
-}
-
-Matcher step_ended(const std::string& text) {
-  return Matcher{Source::step, "end", {{"text", Op::equals, text}}, "step '" + text + "' ended"};
-}
-
-Matcher step_started(const std::string& text) {
-  return Matcher{
-      Source::step, "start", {{"text", Op::equals, text}}, "step '" + text + "' started"};
-}
+using namespace test;
 
 // ------------------------------------------ the six release checks of docs/scenarios.md
 
 TEST(ScenarioYamlReleaseChecks, MvStopWithin300msOfTheRelease) {
-  const auto s = logi(
-      "expect:\n"
-      "  - received: \"MV:STOP\"\n"
-      "    within: 300ms\n"
-      "    after: {step: release, at: start}\n");
+  const auto s = logi(R"(expect:
+  - received: "MV:STOP"
+    within: 300ms
+    after: {step: release, at: start}
+)");
   ASSERT_EQ(s.expectations.size(), 1u);
   const auto& e = s.expectations[0];
   EXPECT_EQ(e.line, 13);
@@ -98,15 +37,15 @@ TEST(ScenarioYamlReleaseChecks, MvStopWithin300msOfTheRelease) {
 }
 
 TEST(ScenarioYamlReleaseChecks, ReconnectAttemptsAt6s8s11sEachWithin250ms) {
-  const auto s = logi(
-      "schedule:\n"
-      "  - at: 5s\n"
-      "    faults: {rules: [{kind: reset, at: 5s}, {kind: refuse, at: 5s, for: 5500ms}]}\n"
-      "expect:\n"
-      "  - label: reconnect attempts at 6 s, 8 s and 11 s\n"
-      "    client: connecting\n"
-      "    times: [6s, 8s, 11s]\n"
-      "    tolerance: 250ms\n");
+  const auto s = logi(R"(schedule:
+  - at: 5s
+    faults: {rules: [{kind: reset, at: 5s}, {kind: refuse, at: 5s, for: 5500ms}]}
+expect:
+  - label: reconnect attempts at 6 s, 8 s and 11 s
+    client: connecting
+    times: [6s, 8s, 11s]
+    tolerance: 250ms
+)");
   ASSERT_EQ(s.expectations.size(), 1u);
   const auto& e = s.expectations[0];
   EXPECT_EQ(e.what, (Matcher{Source::client,
@@ -126,10 +65,10 @@ TEST(ScenarioYamlReleaseChecks, ReconnectAttemptsAt6s8s11sEachWithin250ms) {
 }
 
 TEST(ScenarioYamlReleaseChecks, ExactlyOneStRunReceived) {
-  const auto s = logi(
-      "expect:\n"
-      "  - received: \"ST:RUN\"\n"
-      "    count: 1\n");
+  const auto s = logi(R"(expect:
+  - received: "ST:RUN"
+    count: 1
+)");
   const auto& e = s.expectations.at(0);
   EXPECT_EQ(e.what, car_received("ST:RUN"));
   EXPECT_EQ(e.quantifier, Quantifier::exactly);
@@ -139,13 +78,13 @@ TEST(ScenarioYamlReleaseChecks, ExactlyOneStRunReceived) {
 }
 
 TEST(ScenarioYamlReleaseChecks, Station2Within90sAndStopped) {
-  const auto s = logi(
-      "expect:\n"
-      "  - sim: {station: 2}\n"
-      "    within: 90s\n"
-      "  - sim: at_rest\n"
-      "    after: {sim: {station: 2}}\n"
-      "    within: 2s\n");
+  const auto s = logi(R"(expect:
+  - sim: {station: 2}
+    within: 90s
+  - sim: at_rest
+    after: {sim: {station: 2}}
+    within: 2s
+)");
   ASSERT_EQ(s.expectations.size(), 2u);
   const Matcher station{
       Source::sim, "station", {{"station", Op::equals, 2}}, "car reached station 2"};
@@ -156,10 +95,10 @@ TEST(ScenarioYamlReleaseChecks, Station2Within90sAndStopped) {
 }
 
 TEST(ScenarioYamlReleaseChecks, ClientNeverSentABadChecksum) {
-  const auto s = logi(
-      "expect:\n"
-      "  - never: true\n"
-      "    wire: {sent_by_client: \"*\", valid: false, error: checksum}\n");
+  const auto s = logi(R"(expect:
+  - never: true
+    wire: {sent_by_client: "*", valid: false, error: checksum}
+)");
   const auto& e = s.expectations.at(0);
   EXPECT_EQ(e.quantifier, Quantifier::never);
   EXPECT_EQ(e.what, (Matcher{Source::wire,
@@ -173,11 +112,11 @@ TEST(ScenarioYamlReleaseChecks, ClientNeverSentABadChecksum) {
 }
 
 TEST(ScenarioYamlReleaseChecks, AtRestWithin1sOfTheEmergencyStop) {
-  const auto s = logi(
-      "expect:\n"
-      "  - sim: at_rest\n"
-      "    within: 1s\n"
-      "    after: {step: estop, at: start}\n");
+  const auto s = logi(R"(expect:
+  - sim: at_rest
+    within: 1s
+    after: {step: estop, at: start}
+)");
   const auto& e = s.expectations.at(0);
   EXPECT_EQ(e.what.source, Source::sim);
   EXPECT_EQ(e.what.kind, "at_rest");
@@ -285,33 +224,45 @@ TEST(ScenarioYaml, ReferenceClientSettingsAreCheckedByTheCarsClientLibrary) {
                     (car == "arduino" ? "PING" : "connect") +
                     "]\nclient: {reference: {settings: " + settings + "}}\n");
   };
-  EXPECT_EQ(error("logi", "{max_retrys: 1}"),
-            "t.yaml:4:33: 'client: reference: settings' (LOGI): unknown key 'max_retrys' "
-            "(allowed: feedback_timeout, max_retries, reconnect_delays, stale_after, keepalive, "
-            "keepalive_period); did you mean 'max_retries'?");
-  EXPECT_EQ(error("logi", "{max_retries: 11}"),
-            "t.yaml:4:46: 'client: reference: settings': 'max_retries' must be a whole number "
-            "0..10, got '11'");
-  EXPECT_EQ(error("logi", "{feedback_timeout: 800}"),
-            "t.yaml:4:51: 'client: reference: settings': 'feedback_timeout' must be a duration "
-            "above 0 with a unit (800ms, 2s), got '800'");
-  EXPECT_EQ(error("logi", "{reconnect_delays: []}"),
-            "t.yaml:4:51: 'client: reference: settings': 'reconnect_delays' must be a list of "
-            "durations above 0, like [1s, 2s, 3s], got '[]'");
-  EXPECT_EQ(error("wr8", "{auth: SHORT}"),
-            "t.yaml:4:39: 'client: reference: settings': 'auth' must be a text of exactly 10 "
-            "printable characters, got 'SHORT'");
-  EXPECT_EQ(error("arduino", "{keepalive: true}"),
-            "t.yaml:4:33: 'client: reference: settings' (Arduino): unknown key 'keepalive' "
-            "(allowed: base_timeout, max_retries, max_bad_cs_resends, health_check_interval, "
-            "reconnect_base_delay, max_reconnect_attempts, reconnect_ping_retries)");
-  // Zero is "never" where the library says so, and refused elsewhere.
-  EXPECT_EQ(error("arduino", "{health_check_interval: 0s}"), "");
-  EXPECT_EQ(error("leka", "{info_timeout: 0s}"),
-            "t.yaml:4:47: 'client: reference: settings': 'info_timeout' must be a duration above "
-            "0 with a unit (800ms, 2s), got '0s'");
-  EXPECT_EQ(error("leka", "max_retries"),
-            "t.yaml:4:32: 'client: reference: settings' must be a map like {max_retries: 0}");
+  /// A car, the settings its reference client is given, and the error.
+  struct SettingsCase {
+    std::string car;
+    std::string settings;
+    std::string error;
+  };
+  const std::vector<SettingsCase> cases = {
+      {"logi", "{max_retrys: 1}",
+       "t.yaml:4:33: 'client: reference: settings' (LOGI): unknown key 'max_retrys' "
+       "(allowed: feedback_timeout, max_retries, reconnect_delays, stale_after, keepalive, "
+       "keepalive_period); did you mean 'max_retries'?"},
+      {"logi", "{max_retries: 11}",
+       "t.yaml:4:46: 'client: reference: settings': 'max_retries' must be a whole number "
+       "0..10, got '11'"},
+      {"logi", "{feedback_timeout: 800}",
+       "t.yaml:4:51: 'client: reference: settings': 'feedback_timeout' must be a duration "
+       "above 0 with a unit (800ms, 2s), got '800'"},
+      {"logi", "{reconnect_delays: []}",
+       "t.yaml:4:51: 'client: reference: settings': 'reconnect_delays' must be a list of "
+       "durations above 0, like [1s, 2s, 3s], got '[]'"},
+      {"wr8", "{auth: SHORT}",
+       "t.yaml:4:39: 'client: reference: settings': 'auth' must be a text of exactly 10 "
+       "printable characters, got 'SHORT'"},
+      {"arduino", "{keepalive: true}",
+       "t.yaml:4:33: 'client: reference: settings' (Arduino): unknown key 'keepalive' "
+       "(allowed: base_timeout, max_retries, max_bad_cs_resends, health_check_interval, "
+       "reconnect_base_delay, max_reconnect_attempts, reconnect_ping_retries)"},
+      // Zero is "never" where the library says so, and refused elsewhere.
+      {"arduino", "{health_check_interval: 0s}", ""},
+      {"leka", "{info_timeout: 0s}",
+       "t.yaml:4:47: 'client: reference: settings': 'info_timeout' must be a duration above "
+       "0 with a unit (800ms, 2s), got '0s'"},
+      {"leka", "max_retries",
+       "t.yaml:4:32: 'client: reference: settings' must be a map like {max_retries: 0}"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.car + ": " + c.settings);
+    EXPECT_EQ(error(c.car, c.settings), c.error);
+  }
 }
 
 TEST(ScenarioYaml, FilesAreFoundRelativeToTheScenario) {
@@ -381,8 +332,9 @@ TEST(ScenarioYaml, AFileThatCannotBeReadIsAnErrorWithoutPosition) {
     FAIL() << "loaded";
   } catch (const config::ConfigError& e) {
     EXPECT_EQ(e.line(), 0);
-    EXPECT_EQ(std::string(e.what()),
-              kData + "/no-such-scenario.yaml: cannot read the scenario file: No such file or directory");
+    EXPECT_EQ(
+        std::string(e.what()),
+        kData + "/no-such-scenario.yaml: cannot read the scenario file: No such file or directory");
   }
 }
 
@@ -514,14 +466,16 @@ TEST(ScenarioYamlSteps, AnyStepCanBeExpectedToFailWithAReasonItMustGive) {
   EXPECT_TRUE(s.schedule[0].step.expect_failure);
 
   const std::string head = "name: t\ncar: logi\nsteps:\n  - ";
-  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: fial}\n"),
-            "t.yaml:4:31: step 1: 'expect' must be fail or {fail: \"words the reason contains\"}, "
-            "got 'fial'; did you mean 'fail'?");
-  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: {fails: x}}\n"),
-            "t.yaml:4:32: step 1: 'expect': unknown key 'fails' (allowed: fail); did you mean "
-            "'fail'?");
-  EXPECT_EQ(error_of(head + "{do: \"press FWD\", expect: {fail: [a, b]}}\n"),
-            "t.yaml:4:38: step 1: 'expect': 'fail' must be a text or a number, not a list");
+  expect_errors({
+      {head + "{do: \"press FWD\", expect: fial}\n",
+       "t.yaml:4:31: step 1: 'expect' must be fail or {fail: \"words the reason contains\"}, "
+       "got 'fial'; did you mean 'fail'?"},
+      {head + "{do: \"press FWD\", expect: {fails: x}}\n",
+       "t.yaml:4:32: step 1: 'expect': unknown key 'fails' (allowed: fail); did you mean "
+       "'fail'?"},
+      {head + "{do: \"press FWD\", expect: {fail: [a, b]}}\n",
+       "t.yaml:4:38: step 1: 'expect': 'fail' must be a text or a number, not a list"},
+  });
 }
 
 TEST(ScenarioYamlSteps, ScheduleAtATimeOrOnAnEvent) {
@@ -551,237 +505,6 @@ TEST(ScenarioYamlSteps, ScheduleAtATimeOrOnAnEvent) {
   EXPECT_EQ(s.schedule[2].step, step_of(19, "estop", ActionStep{"estop"}));
   EXPECT_EQ(s.schedule[3].when.occurrence, -1);
   EXPECT_EQ(s.schedule[3].when.event->kind, "stale");
-}
-
-// ------------------------------------------------------------------ matchers
-
-Matcher matcher_of(const std::string& expectation) {
-  return logi("expect:\n  - " + expectation + "\n").expectations.at(0).what;
-}
-
-TEST(ScenarioYamlMatchers, WireDirectionsAndStages) {
-  EXPECT_EQ(matcher_of("{wire: {received: \"MV:STOP\"}}"), car_received("MV:STOP"));
-  const auto sent = matcher_of("{wire: {sent_by_client: SP}}");
-  EXPECT_EQ(sent.tests, (std::vector<FieldTest>{{"dir", Op::equals, "to_car"},
-                                                {"stage", Op::equals, "sent"},
-                                                {"frame", Op::kind_prefix, "SP"}}));
-  const auto car_sent = matcher_of("{sent_by_car: STAT}");
-  EXPECT_EQ(car_sent.tests, (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
-                                                    {"stage", Op::equals, "sent"},
-                                                    {"frame", Op::kind_prefix, "STAT"}}));
-  const auto got = matcher_of("{received_by_client: \"FB:MV\", valid: true}");
-  EXPECT_EQ(got.tests, (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
-                                               {"stage", Op::equals, "delivered"},
-                                               {"frame", Op::kind_prefix, "FB:MV"},
-                                               {"valid", Op::equals, true}}));
-  EXPECT_EQ(matcher_of("{wire: close}"), (Matcher{Source::wire, "close", {}, "link closed"}));
-}
-
-TEST(ScenarioYamlMatchers, FrameContentTextHexMessageAndFields) {
-  const auto sp = matcher_of("{received: SP, text: {contains: \"SP:050\"}}");
-  EXPECT_EQ(sp.tests.back(), (FieldTest{"text", Op::contains, "SP:050"}));
-  EXPECT_EQ(sp.text, "car received SP with text containing 'SP:050'");
-  EXPECT_EQ(matcher_of("{received: SP, text: \"LOGI:SP:050:D7#\"}").tests.back(),
-            (FieldTest{"text", Op::equals, "LOGI:SP:050:D7#"}));
-  // Hex in any spacing and case is written as the timeline writes bytes.
-  EXPECT_EQ(matcher_of("{sent_by_car: STAT, hex: \"4c4f 47\"}").tests.back(),
-            (FieldTest{"hex", Op::equals, "4C 4F 47"}));
-  EXPECT_EQ(matcher_of("{sent_by_car: STAT, hex: {contains: 4c4f}}").tests.back(),
-            (FieldTest{"hex", Op::contains, "4C 4F"}));
-  const auto nack = matcher_of("{received_by_client: \"FB:MV\", message: rejected}");
-  EXPECT_EQ(nack.tests.back(), (FieldTest{"message", Op::contains, "rejected"}));
-  EXPECT_EQ(nack.text, "client received FB:MV with message containing 'rejected'");
-
-  const auto stat = matcher_of(
-      "{received_by_client: STAT, fields: {speed_percent: 50, mode: MAN, track: 0110, "
-      "distance_cm: {at_least: 10, below: 300}, manual: {not: FWD}, rpm: {contains: \"0:0\"}}}");
-  EXPECT_EQ(stat.tests, (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
-                                                {"stage", Op::equals, "delivered"},
-                                                {"frame", Op::kind_prefix, "STAT"},
-                                                {"fields.speed_percent", Op::equals, 50},
-                                                {"fields.mode", Op::equals, "MAN"},
-                                                {"fields.track", Op::equals, "0110"},
-                                                {"fields.distance_cm", Op::greater_equal, 10.0},
-                                                {"fields.distance_cm", Op::less, 300.0},
-                                                {"fields.manual", Op::not_equals, "FWD"},
-                                                {"fields.rpm", Op::contains, "0:0"}}));
-  EXPECT_EQ(stat.text,
-            "client received STAT with speed_percent = 50, mode = MAN, track = 0110, distance_cm "
-            ">= 10 < 300, manual not FWD, rpm containing '0:0'");
-  // The same keys in every place a matcher goes.
-  const auto s = logi(
-      "schedule:\n"
-      "  - when: {received: SP, fields: {percent: 50}}\n"
-      "    car: fault\n"
-      "expect:\n"
-      "  - never: {received: SP, text: {contains: \"SP:100\"}}\n"
-      "  - wire: {received: MD, message: MAN}\n"
-      "    after: {received: SP, hex: {contains: 4C}}\n");
-  EXPECT_EQ(s.schedule[0].when.event->tests.back(), (FieldTest{"fields.percent", Op::equals, 50}));
-  EXPECT_EQ(s.expectations[0].quantifier, Quantifier::never);
-  EXPECT_EQ(s.expectations[1].window.from.event->tests.back(),
-            (FieldTest{"hex", Op::contains, "4C"}));
-}
-
-TEST(ScenarioYamlMatchers, InvalidFramesOfAKindIncludeThoseTheDecoderNamedOnlyInPart) {
-  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\", valid: false}").tests,
-            (std::vector<FieldTest>{{"dir", Op::equals, "to_client"},
-                                    {"stage", Op::equals, "delivered"},
-                                    {"frame", Op::kind_either_prefix, "FB:SP"},
-                                    {"valid", Op::equals, false}}));
-  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\", valid: true}").tests[2],
-            (FieldTest{"frame", Op::kind_prefix, "FB:SP"}));
-  EXPECT_EQ(matcher_of("{received_by_client: \"FB:SP\"}").tests[2],
-            (FieldTest{"frame", Op::kind_prefix, "FB:SP"}));
-}
-
-TEST(ScenarioYamlMatchers, FrameContentMistakesAreReportedWhereTheyAre) {
-  const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - ";
-  EXPECT_EQ(error_of(head + "{received: SP, text: {contans: x}}\n"),
-            "t.yaml:5:27: expectation 1: 'text': unknown key 'contans' (allowed: contains); did "
-            "you mean 'contains'?");
-  EXPECT_EQ(error_of(head + "{received: SP, hex: \"4C4\"}\n"),
-            "t.yaml:5:25: expectation 1: 'hex' must be whole bytes (two hex digits each)");
-  EXPECT_EQ(error_of(head + "{received: SP, hex: \"LOGI\"}\n"),
-            "t.yaml:5:25: expectation 1: 'hex' must be hex digits like \"06 01 FF\", got 'LOGI'");
-  EXPECT_EQ(error_of(head + "{received: SP, fields: {precent: 50}}\n"),
-            "t.yaml:5:29: expectation 1: 'fields': LOGI frames have no field 'precent' (they have "
-            "percent, station, speed_percent, running, mode, manual, distance_cm, track, "
-            "deviation, obstacle, rpm); did you mean 'percent'?");
-  EXPECT_EQ(error_of(head + "{received: SP, fields: {percent: {abve: 50}}}\n"),
-            "t.yaml:5:39: expectation 1: 'fields': 'percent': unknown key 'abve' (allowed: not, "
-            "contains, below, above, at_least, at_most); did you mean 'above'?");
-  EXPECT_EQ(error_of(head + "{received: SP, fields: {percent: {above: fast}}}\n"),
-            "t.yaml:5:46: expectation 1: 'fields': 'percent': 'above' must be a number, got "
-            "'fast'");
-  EXPECT_EQ(error_of(head + "{received: SP, fields: percent}\n"),
-            "t.yaml:5:28: expectation 1: 'fields' must be a map of field names to values, like "
-            "{percent: 50}");
-  EXPECT_EQ(error_of(head + "{client: connected, text: x}\n"),
-            "t.yaml:5:31: expectation 1: 'text' goes with a wire frame key");
-  // A name far from every known one is a firmware's own key, and is let through.
-  EXPECT_EQ(error_of(head + "{received_by_client: STAT, fields: {BAT: 87}}\n"), "");
-}
-
-TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
-  EXPECT_EQ(
-      matcher_of("{client: parse_error}"),
-      (Matcher{Source::client, "parse_error", {}, "client reported a frame it could not parse"}));
-  EXPECT_EQ(matcher_of("{client: {parse_error: bad_checksum}}"),
-            (Matcher{Source::client,
-                     "parse_error",
-                     {{"text", Op::contains, "bad_checksum"}},
-                     "client could not parse a frame: 'bad_checksum'"}));
-  EXPECT_EQ(matcher_of("{client: {movement: false, reason: not connected}}"),
-            (Matcher{Source::client,
-                     "movement",
-                     {{"enabled", Op::equals, false}, {"reason", Op::contains, "not connected"}},
-                     "client disabled movement because of 'not connected'"}));
-  const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - client: ";
-  EXPECT_NE(error_of(head + "{movement: maybe}\n"), "");
-  EXPECT_EQ(error_of(head + "{parse_error: x, state: y}\n"),
-            "t.yaml:5:37: expectation 1: 'client': 'state' does not go with 'parse_error'");
-}
-
-TEST(ScenarioYamlMatchers, ClientEvents) {
-  EXPECT_EQ(matcher_of("{client: stale}"),
-            (Matcher{Source::client, "stale", {}, "client warned of stale telemetry"}));
-  EXPECT_EQ(matcher_of("{client: fresh}").kind, "fresh");
-  EXPECT_EQ(matcher_of("{client: {login: false, reason: refused}}"),
-            (Matcher{Source::client,
-                     "login",
-                     {{"ok", Op::equals, false}, {"reason", Op::contains, "refused"}},
-                     "client login refused because of 'refused'"}));
-  EXPECT_EQ(matcher_of("{client: {notice: \"Not in manual mode\"}}"),
-            (Matcher{Source::client,
-                     "notice",
-                     {{"text", Op::contains, "Not in manual mode"}},
-                     "client notice containing 'Not in manual mode'"}));
-  EXPECT_EQ(matcher_of("{client: {command: SP, state: rejected}}").tests,
-            (std::vector<FieldTest>{{"command", Op::kind_prefix, "SP"},
-                                    {"state", Op::equals, "rejected"}}));
-  EXPECT_EQ(matcher_of("{client: {exit: 0}}"),
-            (Matcher{Source::client, "exit", {{"code", Op::equals, 0}}, "client exited with 0"}));
-  EXPECT_EQ(matcher_of("{client: {output: ok}}").tests,
-            (std::vector<FieldTest>{{"line", Op::contains, "ok"}}));
-  EXPECT_EQ(matcher_of("{client: {action: \"press FWD\", ok: false}}"),
-            (Matcher{Source::client,
-                     "action",
-                     {{"text", Op::equals, "press FWD"}, {"ok", Op::equals, false}},
-                     "action 'press FWD' failed"}));
-  EXPECT_EQ(matcher_of("{client: disconnected}").tests,
-            (std::vector<FieldTest>{{"state", Op::equals, "disconnected"}}));
-}
-
-TEST(ScenarioYamlMatchers, SimulationEvents) {
-  EXPECT_EQ(matcher_of("{sim: moving}").kind, "moving");
-  EXPECT_EQ(matcher_of("{sim: collision}").kind, "collision");
-  EXPECT_EQ(
-      matcher_of("{sim: {speed_below: 0.01}}"),
-      (Matcher{Source::sim, "sample", {{"speed_mps", Op::less, 0.01}}, "speed below 0.01 m/s"}));
-  EXPECT_EQ(matcher_of("{sim: {near: [1.5, 0.4], radius: 0.2}}").tests,
-            (std::vector<FieldTest>{{"x_m", Op::greater_equal, 1.3},
-                                    {"x_m", Op::less_equal, 1.7},
-                                    {"y_m", Op::greater_equal, 0.4 - 0.2},
-                                    {"y_m", Op::less_equal, 0.4 + 0.2}}));
-}
-
-TEST(ScenarioYamlMatchers, StepsByTheirTextOrItsFirstWords) {
-  EXPECT_EQ(matcher_of("{step: release}"), step_ended("release"));
-  // "speed" starts exactly one step: "speed 50".
-  EXPECT_EQ(matcher_of("{step: speed}"), step_ended("speed 50"));
-  EXPECT_EQ(matcher_of("{step: {text: run, at: start}}").kind, "start");
-}
-
-TEST(ScenarioYamlMatchers, FaultAndCarEvents) {
-  EXPECT_EQ(matcher_of("{fault: drop}"), (Matcher{Source::fault, "drop", {}, "fault drop"}));
-  EXPECT_EQ(matcher_of("{car: fault_state}").tests,
-            (std::vector<FieldTest>{{"on", Op::equals, true}}));
-  EXPECT_EQ(matcher_of("{car: {behaviour: no-moves}}").tests,
-            (std::vector<FieldTest>{{"name", Op::equals, "no-moves"}}));
-}
-
-// ------------------------------------------------- windows and quantifiers
-
-Expectation expectation_of(const std::string& body) {
-  return logi("expect:\n  - " + body + "\n").expectations.at(0);
-}
-
-TEST(ScenarioYamlWindows, FromTheStartAtATimeBetweenAndAfter) {
-  EXPECT_EQ(expectation_of("{sim: at_rest, within: 3s}").window, (Window{Anchor{}, seconds(3)}));
-  EXPECT_EQ(expectation_of("{sim: at_rest, at: 5s}").window,
-            (Window{Anchor{std::nullopt, 1, seconds(5)}, Duration{0}}));
-  EXPECT_EQ(expectation_of("{sim: at_rest, at: 5s, within: 1s}").window,
-            (Window{Anchor{std::nullopt, 1, seconds(5)}, seconds(1)}));
-  EXPECT_EQ(expectation_of("{sim: at_rest, between: [5s, 12s]}").window,
-            (Window{Anchor{std::nullopt, 1, seconds(5)}, seconds(7)}));
-  EXPECT_EQ(expectation_of("{sim: at_rest, after: 4s}").window,
-            (Window{Anchor{std::nullopt, 1, seconds(4)}, std::nullopt}));
-  EXPECT_EQ(expectation_of("{sim: at_rest, after: release}").window,
-            (Window{Anchor{step_ended("release"), 1, Duration{0}}, std::nullopt}));
-  EXPECT_EQ(
-      expectation_of("{sim: at_rest, after: {step: release, at: start}}").window.from.event->kind,
-      "start");
-  EXPECT_EQ(
-      expectation_of("{sim: at_rest, after: {received: \"MV:STOP\", occurrence: 2, offset: 1s}}")
-          .window.from,
-      (Anchor{car_received("MV:STOP"), 2, seconds(1)}));
-}
-
-TEST(ScenarioYamlQuantifiers, EveryQuantifier) {
-  EXPECT_EQ(expectation_of("{received: SP, at_least: 2}").quantifier, Quantifier::at_least);
-  EXPECT_EQ(expectation_of("{received: SP, at_least: 2}").count, 2u);
-  EXPECT_EQ(expectation_of("{received: SP, at_most: 3}").quantifier, Quantifier::at_most);
-  EXPECT_EQ(expectation_of("{received: SP, never: true}").quantifier, Quantifier::never);
-  EXPECT_EQ(expectation_of("{never: {received: SP}}").what, car_received("SP"));
-  const auto only =
-      expectation_of("{client: connecting, times: [1s, 3s], tolerance: 100ms, only: true}");
-  EXPECT_EQ(only.quantifier, Quantifier::at_times);
-  EXPECT_TRUE(only.only);
-  const auto always = expectation_of("{always: {sim: {speed_below: 0.5}}, after: release}");
-  EXPECT_EQ(always.quantifier, Quantifier::always);
-  EXPECT_EQ(always.what.kind, "sample");
-  EXPECT_EQ(always.label, "always: speed below 0.5 m/s after step 'release' ended");
 }
 
 // ----------------------------------------------------------------- variables
@@ -868,74 +591,75 @@ TEST(ScenarioYamlProfiles, AWr8ProgramProfileChecksActionsAndSettingsByItsOwnWor
 // -------------------------------------------------------------------- errors
 
 TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
-  // Unknown key, with the allowed ones and the likely one.
-  EXPECT_EQ(error_of("name: t\ncar: logi\nstpes: [connect]\n"),
-            "t.yaml:3:1: the scenario: unknown key 'stpes' (allowed: name, description, tags, "
-            "car, profile, reply_latency, world, seed, timeout, settle, variables, faults, client, "
-            "setup, steps, teardown, schedule, expect); did you mean 'steps'?");
-  EXPECT_EQ(error_of("name: t\ncar: logi\n"), "t.yaml:1:1: the scenario: 'steps' is missing");
-  EXPECT_EQ(error_of("name: t\ncar: tesla\nsteps: [connect]\n"),
-            "t.yaml:2:6: unknown car 'tesla' (expected logi, wr8, arduino or leka)");
-  EXPECT_EQ(error_of("name: t\ncar: logi\ntimeout: 60\nsteps: [connect]\n"),
-            "t.yaml:3:10: 'timeout' must be a duration with a unit (500ms, 2s, 1.5s), got '60'");
-  EXPECT_EQ(error_of("name: t\ncar: logi\ntags: logi\nsteps: [connect]\n"),
-            "t.yaml:3:7: 'tags' must be a list of words, like [logi, safety]");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps:\n  - speed 50\n  - pres FWD\n"),
-            "t.yaml:5:5: step 2: LOGI action 'pres FWD': unknown action 'pres' (expected one of "
-            "connect, disconnect, speed, mode, press, release, station, run, stop, estop, wait, "
-            "confirm)");
-  // The parser's column inside a quoted string.
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps:\n  - do: \"speed 500\"\n"),
-            "t.yaml:4:16: step 1: LOGI action 'speed 500': expected a speed 0..100, got '500'");
-  EXPECT_EQ(
-      error_of("name: t\ncar: logi\nsteps:\n  - wait: 5\n"),
-      "t.yaml:4:11: step 1: 'wait' must be a duration with a unit (500ms, 2s, 1.5s), got '5'");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps:\n  - {wait: 1s, car: fault}\n"),
-            "t.yaml:4:21: step 1: a step does one thing: 'wait' and 'car' are two steps");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps:\n  - car: {mute_telemetry: soon}\n"),
-            "t.yaml:4:27: step 1: car behaviour (mute-telemetry): 'for' must be a duration with a "
-            "unit, like 250ms or 1.5s (units: ns, us, ms, s)");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps:\n  - car: {rejct: MV}\n"),
-            "t.yaml:4:11: step 1: unknown key 'rejct' (allowed: reject, ignore, "
-            "mute_telemetry, send, send_hex, fault, clear_fault, close, at, after, after_count, "
-            "name, do); did you mean 'reject'?");
-  EXPECT_EQ(
-      error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, within: 1s, "
-               "after: relase}\n"),
-      "t.yaml:5:39: expectation 1: 'after': no step reads 'relase' (steps: connect)");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect, release]\nexpect:\n  - {received: SP, "
-                     "after: {step: relase}}\n"),
-            "t.yaml:5:34: expectation 1: 'after': 'step': no step reads 'relase' (steps: connect, "
-            "release); did you mean 'release'?");
-  EXPECT_EQ(
-      error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {client: conected}\n"),
-      "t.yaml:5:14: expectation 1: 'client': unknown client state 'conected' (expected "
-      "connected, disconnected, connecting, authenticating, reconnecting, degraded, down, stale, "
-      "fresh, parse_error); did you mean 'connected'?");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, count: 1, "
-                     "never: true}\n"),
-            "t.yaml:5:27: expectation 1: 'never' and 'count' do not go together");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {within: 1s}\n"),
-            "t.yaml:5:5: expectation 1: nothing to match: give one of wire, client, sim, step, "
-            "fault, car (or received, sent_by_client, sent_by_car, received_by_client)");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, "
-                     "tolerance: 1s}\n"),
-            "t.yaml:5:31: expectation 1: 'tolerance' goes with 'times'");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nclient: {exec: \"c {hots}\"}\n"),
-            "t.yaml:4:19: unknown placeholder '{hots}' (known: {host}, {port}, {endpoint}, {pty}, "
-            "{actions}, {scenario}); did you mean '{host}'?");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect]\nschedule:\n  - car: fault\n"),
-            "t.yaml:5:5: schedule 1: 'at' (a run time like 5s) or 'when' (a matcher) is missing");
-  EXPECT_EQ(error_of("name: t\ncar: logi\nname: u\nsteps: [connect]\n"),
-            "t.yaml:3:1: the scenario: key 'name' is given twice");
+  expect_errors({
+      // Unknown key, with the allowed ones and the likely one.
+      {"name: t\ncar: logi\nstpes: [connect]\n",
+       "t.yaml:3:1: the scenario: unknown key 'stpes' (allowed: name, description, tags, "
+       "car, profile, reply_latency, world, seed, timeout, settle, variables, faults, client, "
+       "setup, steps, teardown, schedule, expect); did you mean 'steps'?"},
+      {"name: t\ncar: logi\n", "t.yaml:1:1: the scenario: 'steps' is missing"},
+      {"name: t\ncar: tesla\nsteps: [connect]\n",
+       "t.yaml:2:6: unknown car 'tesla' (expected logi, wr8, arduino or leka)"},
+      {"name: t\ncar: logi\ntimeout: 60\nsteps: [connect]\n",
+       "t.yaml:3:10: 'timeout' must be a duration with a unit (500ms, 2s, 1.5s), got '60'"},
+      {"name: t\ncar: logi\ntags: logi\nsteps: [connect]\n",
+       "t.yaml:3:7: 'tags' must be a list of words, like [logi, safety]"},
+      {"name: t\ncar: logi\nsteps:\n  - speed 50\n  - pres FWD\n",
+       "t.yaml:5:5: step 2: LOGI action 'pres FWD': unknown action 'pres' (expected one of "
+       "connect, disconnect, speed, mode, press, release, station, run, stop, estop, wait, "
+       "confirm)"},
+      // The parser's column inside a quoted string.
+      {"name: t\ncar: logi\nsteps:\n  - do: \"speed 500\"\n",
+       "t.yaml:4:16: step 1: LOGI action 'speed 500': expected a speed 0..100, got '500'"},
+      {"name: t\ncar: logi\nsteps:\n  - wait: 5\n",
+       "t.yaml:4:11: step 1: 'wait' must be a duration with a unit (500ms, 2s, 1.5s), got '5'"},
+      {"name: t\ncar: logi\nsteps:\n  - {wait: 1s, car: fault}\n",
+       "t.yaml:4:21: step 1: a step does one thing: 'wait' and 'car' are two steps"},
+      {"name: t\ncar: logi\nsteps:\n  - car: {mute_telemetry: soon}\n",
+       "t.yaml:4:27: step 1: car behaviour (mute-telemetry): 'for' must be a duration with a "
+       "unit, like 250ms or 1.5s (units: ns, us, ms, s)"},
+      {"name: t\ncar: logi\nsteps:\n  - car: {rejct: MV}\n",
+       "t.yaml:4:11: step 1: unknown key 'rejct' (allowed: reject, ignore, "
+       "mute_telemetry, send, send_hex, fault, clear_fault, close, at, after, after_count, "
+       "name, do); did you mean 'reject'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, within: 1s, "
+       "after: relase}\n",
+       "t.yaml:5:39: expectation 1: 'after': no step reads 'relase' (steps: connect)"},
+      {"name: t\ncar: logi\nsteps: [connect, release]\nexpect:\n  - {received: SP, "
+       "after: {step: relase}}\n",
+       "t.yaml:5:34: expectation 1: 'after': 'step': no step reads 'relase' (steps: connect, "
+       "release); did you mean 'release'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {client: conected}\n",
+       "t.yaml:5:14: expectation 1: 'client': unknown client state 'conected' (expected "
+       "connected, disconnected, connecting, authenticating, reconnecting, degraded, down, stale, "
+       "fresh, parse_error); did you mean 'connected'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, count: 1, "
+       "never: true}\n",
+       "t.yaml:5:27: expectation 1: 'never' and 'count' do not go together"},
+      {"name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {within: 1s}\n",
+       "t.yaml:5:5: expectation 1: nothing to match: give one of wire, client, sim, step, "
+       "fault, car (or received, sent_by_client, sent_by_car, received_by_client)"},
+      {"name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - {received: SP, "
+       "tolerance: 1s}\n",
+       "t.yaml:5:31: expectation 1: 'tolerance' goes with 'times'"},
+      {"name: t\ncar: logi\nsteps: [connect]\nclient: {exec: \"c {hots}\"}\n",
+       "t.yaml:4:19: unknown placeholder '{hots}' (known: {host}, {port}, {endpoint}, {pty}, "
+       "{actions}, {scenario}); did you mean '{host}'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nschedule:\n  - car: fault\n",
+       "t.yaml:5:5: schedule 1: 'at' (a run time like 5s) or 'when' (a matcher) is missing"},
+      {"name: t\ncar: logi\nname: u\nsteps: [connect]\n",
+       "t.yaml:3:1: the scenario: key 'name' is given twice"},
+  });
 }
 
 TEST(ScenarioYamlErrors, YamlSyntaxErrorsKeepTheParsersPosition) {
-  EXPECT_EQ(error_of("name: t\ncar: logi\nsteps: [connect\n"),
-            "t.yaml:4:1: not valid YAML: end of sequence flow not found");
-  EXPECT_EQ(error_of("- just\n- a list\n"),
-            "t.yaml:1:1: a scenario is a map with at least 'name', 'car' and 'steps' (see "
-            "docs/scenarios.md)");
+  expect_errors({
+      {"name: t\ncar: logi\nsteps: [connect\n",
+       "t.yaml:4:1: not valid YAML: end of sequence flow not found"},
+      {"- just\n- a list\n",
+       "t.yaml:1:1: a scenario is a map with at least 'name', 'car' and 'steps' (see "
+       "docs/scenarios.md)"},
+  });
 }
 
 // ----------------------------------------------------------- shipped files

@@ -119,6 +119,23 @@ void expect_failure(const std::string& yaml, int line, int column, const std::st
   EXPECT_THAT(f.what, HasSubstr(text));
 }
 
+/// A world text with one mistake: a part of the message reading it gives,
+/// and where that points.
+struct Mistake {
+  std::string message_part;
+  int line;
+  int column;
+  std::string yaml;
+};
+
+/// expect_failure for each mistake, each traced by its text.
+void expect_failures(const std::vector<Mistake>& mistakes) {
+  for (const auto& m : mistakes) {
+    SCOPED_TRACE(m.yaml);
+    expect_failure(m.yaml, m.line, m.column, m.message_part);
+  }
+}
+
 // A valid arena for the error tests to add one mistake to. Lines 1-2.
 const std::string kBase =
     "size_m: [4, 3]\n"
@@ -377,25 +394,23 @@ TEST(ArenaYamlErrors, TopLevelMustBeAMap) {
 }
 
 TEST(ArenaYamlErrors, UnknownKeysAreNamedWithTheAllowedOnes) {
-  expect_failure(kBase + "wall: false\n", 3, 1,
-                 "wall: unknown key 'wall' (allowed: name, obstacles, size_m, "
-                 "start, tags, tapes, wall_thickness_m, walls)");
-
-  expect_failure(kBase +
-                     "obstacles:\n"
-                     "  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
-                     "  - circle: {x_m: 1, y_m: 1, raduis_m: 0.1}\n",
-                 5, 30,
-                 "obstacles[1].circle.raduis_m: unknown key 'raduis_m' (allowed: "
-                 "name, radius_m, x_m, y_m)");
-
-  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    colour: red\n", 5, 5,
-                 "tapes[0].colour: unknown key 'colour' (allowed: closed, name, "
-                 "points_m, width_m)");
-
-  expect_failure("size_m: [4, 3]\nstart: {x_m: 1, y_m: 1, heading_rad: 1}\n", 2, 25,
-                 "start.heading_rad: unknown key 'heading_rad' (allowed: "
-                 "heading_deg, x_m, y_m)");
+  expect_failures({
+      {"wall: unknown key 'wall' (allowed: name, obstacles, size_m, "
+       "start, tags, tapes, wall_thickness_m, walls)",
+       3, 1, kBase + "wall: false\n"},
+      {"obstacles[1].circle.raduis_m: unknown key 'raduis_m' (allowed: "
+       "name, radius_m, x_m, y_m)",
+       5, 30,
+       kBase + "obstacles:\n"
+               "  - circle: {x_m: 1, y_m: 1, radius_m: 0.1}\n"
+               "  - circle: {x_m: 1, y_m: 1, raduis_m: 0.1}\n"},
+      {"tapes[0].colour: unknown key 'colour' (allowed: closed, name, "
+       "points_m, width_m)",
+       5, 5, kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    colour: red\n"},
+      {"start.heading_rad: unknown key 'heading_rad' (allowed: "
+       "heading_deg, x_m, y_m)",
+       2, 25, "size_m: [4, 3]\nstart: {x_m: 1, y_m: 1, heading_rad: 1}\n"},
+  });
 }
 
 TEST(ArenaYamlErrors, KeyGivenTwice) {
@@ -433,19 +448,17 @@ TEST(ArenaYamlErrors, WrongTypes) {
                                   std::string(value) + "'"));
   }
 
-  expect_failure(kBase + "walls: yes\n", 3, 8, "walls: expected true or false, got 'yes'");
-
-  expect_failure(kBase + "obstacles:\n  box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n", 4, 3,
-                 "obstacles: expected a list, got a map");
-
-  expect_failure(kBase + "tags:\n  - {id: [1], x_m: 1, y_m: 1}\n", 4, 10,
-                 "tags[0].id: expected the tag's id as text");
-
-  expect_failure("size_m: 4\nstart: {x_m: 1, y_m: 1}\n", 1, 9,
-                 "size_m: expected [width, height] in metres, got '4'");
-
-  expect_failure("size_m: [4, 3]\nstart: 1\n", 2, 8,
-                 "start: expected a map with keys heading_deg, x_m, y_m, got '1'");
+  expect_failures({
+      {"walls: expected true or false, got 'yes'", 3, 8, kBase + "walls: yes\n"},
+      {"obstacles: expected a list, got a map", 4, 3,
+       kBase + "obstacles:\n  box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n"},
+      {"tags[0].id: expected the tag's id as text", 4, 10,
+       kBase + "tags:\n  - {id: [1], x_m: 1, y_m: 1}\n"},
+      {"size_m: expected [width, height] in metres, got '4'", 1, 9,
+       "size_m: 4\nstart: {x_m: 1, y_m: 1}\n"},
+      {"start: expected a map with keys heading_deg, x_m, y_m, got '1'", 2, 8,
+       "size_m: [4, 3]\nstart: 1\n"},
+  });
 }
 
 TEST(ArenaYamlErrors, SizesMustBePositive) {
@@ -467,69 +480,48 @@ TEST(ArenaYamlErrors, SizesMustBePositive) {
   EXPECT_EQ(f.line, 12);
   EXPECT_EQ(f.column, 17);
 
-  struct Case {
-    std::string yaml;
-    int line;
-    int column;
-    std::string field;
-  };
-  const Case cases[] = {
-      {"size_m: [4, 0]\nstart: {x_m: 0, y_m: 0}\n", 1, 13, "size_m[1]: expected a positive"},
-      {"size_m: [-4, 3]\nstart: {x_m: 0, y_m: 0}\n", 1, 10, "size_m[0]: expected a positive"},
-      {kBase + "wall_thickness_m: -0.1\n", 3, 19,
-       "wall_thickness_m: expected a number of metres >= 0"},
-      {kBase + "obstacles:\n  - box: {x_m: 1, y_m: 1, width_m: 0, height_m: 1}\n", 4, 36,
-       "obstacles[0].box.width_m: expected a positive"},
-      {kBase + "obstacles:\n  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: -1}\n", 4, 49,
-       "obstacles[0].box.height_m: expected a positive"},
-      {kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    width_m: 0\n", 5, 14,
-       "tapes[0].width_m: expected a positive"},
-      {kBase + "tags:\n  - {id: A, x_m: 1, y_m: 1, radius_m: 0}\n", 4, 39,
-       "tags[0].radius_m: expected a positive"},
-  };
-  for (const auto& c : cases) {
-    SCOPED_TRACE(c.yaml);
-    const Failure g = failure_of(c.yaml);
-    EXPECT_EQ(g.line, c.line);
-    EXPECT_EQ(g.column, c.column);
-    EXPECT_THAT(g.what, HasSubstr(c.field));
-  }
+  expect_failures({
+      {"size_m[1]: expected a positive", 1, 13, "size_m: [4, 0]\nstart: {x_m: 0, y_m: 0}\n"},
+      {"size_m[0]: expected a positive", 1, 10, "size_m: [-4, 3]\nstart: {x_m: 0, y_m: 0}\n"},
+      {"wall_thickness_m: expected a number of metres >= 0", 3, 19,
+       kBase + "wall_thickness_m: -0.1\n"},
+      {"obstacles[0].box.width_m: expected a positive", 4, 36,
+       kBase + "obstacles:\n  - box: {x_m: 1, y_m: 1, width_m: 0, height_m: 1}\n"},
+      {"obstacles[0].box.height_m: expected a positive", 4, 49,
+       kBase + "obstacles:\n  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: -1}\n"},
+      {"tapes[0].width_m: expected a positive", 5, 14,
+       kBase + "tapes:\n  - points_m: [[1, 1], [2, 1]]\n    width_m: 0\n"},
+      {"tags[0].radius_m: expected a positive", 4, 39,
+       kBase + "tags:\n  - {id: A, x_m: 1, y_m: 1, radius_m: 0}\n"},
+  });
 }
 
 TEST(ArenaYamlErrors, ObstacleIsExactlyOneOfBoxOrCircle) {
-  expect_failure(kBase +
-                     "obstacles:\n"
-                     "  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n"
-                     "    circle: {x_m: 1, y_m: 1, radius_m: 1}\n",
-                 4, 5, "obstacles[0]: expected exactly one of 'box' or 'circle', got both");
-
-  expect_failure(kBase + "obstacles:\n  - {}\n", 4, 5,
-                 "obstacles[0]: expected exactly one of 'box' or 'circle', got neither");
-
-  expect_failure(kBase + "obstacles:\n  - cylinder: {x_m: 1, y_m: 1}\n", 4, 5,
-                 "obstacles[0].cylinder: unknown key 'cylinder' (allowed: box, "
-                 "circle)");
-
-  expect_failure(kBase + "obstacles:\n  - circle\n", 4, 5,
-                 "obstacles[0]: expected a map with keys box, circle, got 'circle'");
+  expect_failures({
+      {"obstacles[0]: expected exactly one of 'box' or 'circle', got both", 4, 5,
+       kBase + "obstacles:\n"
+               "  - box: {x_m: 1, y_m: 1, width_m: 1, height_m: 1}\n"
+               "    circle: {x_m: 1, y_m: 1, radius_m: 1}\n"},
+      {"obstacles[0]: expected exactly one of 'box' or 'circle', got neither", 4, 5,
+       kBase + "obstacles:\n  - {}\n"},
+      {"obstacles[0].cylinder: unknown key 'cylinder' (allowed: box, circle)", 4, 5,
+       kBase + "obstacles:\n  - cylinder: {x_m: 1, y_m: 1}\n"},
+      {"obstacles[0]: expected a map with keys box, circle, got 'circle'", 4, 5,
+       kBase + "obstacles:\n  - circle\n"},
+  });
 }
 
 TEST(ArenaYamlErrors, TapePointsMustBePairs) {
-  Failure f = failure_of(kBase + "tapes:\n  - points_m: [[1, 1], [2, 1, 0], [3, 1]]\n");
-  EXPECT_EQ(f.line, 4);
-  EXPECT_EQ(f.column, 24);
-  EXPECT_THAT(
-      f.what,
-      HasSubstr("tapes[0].points_m[1]: expected an [x, y] pair of metres, got a list of 3"));
-
-  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], 2]\n", 4, 24,
-                 "tapes[0].points_m[1]: expected an [x, y] pair of metres, got '2'");
-
-  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1], [2, y]]\n", 4, 28,
-                 "tapes[0].points_m[1][1]: expected a number of metres, got 'y'");
-
-  expect_failure(kBase + "tapes:\n  - points_m: {x: 1}\n", 4, 15,
-                 "tapes[0].points_m: expected a list of [x, y] points");
+  expect_failures({
+      {"tapes[0].points_m[1]: expected an [x, y] pair of metres, got a list of 3", 4, 24,
+       kBase + "tapes:\n  - points_m: [[1, 1], [2, 1, 0], [3, 1]]\n"},
+      {"tapes[0].points_m[1]: expected an [x, y] pair of metres, got '2'", 4, 24,
+       kBase + "tapes:\n  - points_m: [[1, 1], 2]\n"},
+      {"tapes[0].points_m[1][1]: expected a number of metres, got 'y'", 4, 28,
+       kBase + "tapes:\n  - points_m: [[1, 1], [2, y]]\n"},
+      {"tapes[0].points_m: expected a list of [x, y] points", 4, 15,
+       kBase + "tapes:\n  - points_m: {x: 1}\n"},
+  });
 }
 
 // The checks of validate() run after reading and point at the part they name.
@@ -544,11 +536,12 @@ TEST(ArenaYamlErrors, PointOutsideTheArena) {
 }
 
 TEST(ArenaYamlErrors, TooFewTapePoints) {
-  expect_failure(kBase + "tapes:\n  - points_m: [[1, 1]]\n", 4, 15,
-                 "tapes[0].points_m: needs at least 2 points");
-
-  expect_failure(kBase + "tapes:\n  - closed: true\n    points_m: [[1, 1], [2, 2]]\n", 5, 15,
-                 "tapes[0].points_m: a closed tape needs 3 points");
+  expect_failures({
+      {"tapes[0].points_m: needs at least 2 points", 4, 15,
+       kBase + "tapes:\n  - points_m: [[1, 1]]\n"},
+      {"tapes[0].points_m: a closed tape needs 3 points", 5, 15,
+       kBase + "tapes:\n  - closed: true\n    points_m: [[1, 1], [2, 2]]\n"},
+  });
 }
 
 TEST(ArenaYamlErrors, DuplicateTagIdAtTheSecondId) {

@@ -10,8 +10,10 @@
 #include <limits>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -115,6 +117,15 @@ class Browser {
   std::string screenshot_png() {
     const json shot = call("GET", path("/screenshot"), nullptr);
     return shot.is_string() ? base64_decode(shot.get<std::string>()) : std::string();
+  }
+  /// Takes a screenshot, expects a real PNG, and writes it to `file` (for a
+  /// person to look at the page CI saw).
+  void save_screenshot(const char* file) {
+    const std::string png = screenshot_png();
+    ASSERT_GT(png.size(), 1000U);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    std::ofstream(file, std::ios::binary) << png;
+    std::printf("screenshot: %s\n", file);
   }
 
  private:

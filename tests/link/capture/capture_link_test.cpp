@@ -113,21 +113,14 @@ TEST_F(CaptureLinkTest, WireLogShowsSentFaultAndDeliveredPiecesAtVirtualTimes) {
 }
 
 TEST_F(CaptureLinkTest, PcapHoldsTheDeliveredPiecesAtWallTimePlusVirtualTime) {
-  if (std::system("command -v tshark >/dev/null 2>&1") != 0) {
+  if (!test::tshark_installed()) {
     GTEST_SKIP() << "tshark is not installed (ci/install-deps.sh installs it)";
   }
   run_exchange();
-  const std::string command = "tshark -n -r '" + pcap_file.path().string() +
-                              "' -Y 'tcp.len > 0' -T fields -e frame.time_epoch -e "
-                              "tcp.srcport -e tcp.len 2>/dev/null";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string out;
-  char buf[1024];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe))
-    out.append(buf, n);
-  ASSERT_EQ(::pclose(pipe), 0);
-  EXPECT_EQ(out,
+  const auto out = test::tshark_output(
+      pcap_file.path(), "-Y 'tcp.len > 0' -T fields -e frame.time_epoch -e tcp.srcport -e tcp.len");
+  ASSERT_TRUE(out);
+  EXPECT_EQ(*out,
             "1700000000.010000000\t40000\t5\n"
             "1700000000.011000000\t40000\t5\n"
             "1700000000.012000000\t40000\t5\n"
@@ -135,7 +128,7 @@ TEST_F(CaptureLinkTest, PcapHoldsTheDeliveredPiecesAtWallTimePlusVirtualTime) {
 }
 
 TEST(CaptureLinkSvgui, APcapOfTheRealWr8ProgramsDecodesByTheLengthByteWhateverTheSegments) {
-  if (std::system("command -v tshark >/dev/null 2>&1") != 0) {
+  if (!test::tshark_installed()) {
     GTEST_SKIP() << "tshark is not installed (ci/install-deps.sh installs it)";
   }
   namespace svgui = protocol::wr8::svgui;
@@ -171,18 +164,12 @@ TEST(CaptureLinkSvgui, APcapOfTheRealWr8ProgramsDecodesByTheLengthByteWhateverTh
 
   // tshark gives the payload of each segment; joined, the length byte cuts
   // them back into the two packets.
-  const std::string command = "tshark -n -r '" + pcap_file.path().string() +
-                              "' -Y 'tcp.len > 0' -T fields -e tcp.payload 2>/dev/null";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string out;
-  char buf[1024];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe))
-    out.append(buf, n);
-  ASSERT_EQ(::pclose(pipe), 0);
+  const auto out =
+      test::tshark_output(pcap_file.path(), "-Y 'tcp.len > 0' -T fields -e tcp.payload");
+  ASSERT_TRUE(out);
   std::string hex;
   int segments = 0;
-  for (const char c : out) {
+  for (const char c : *out) {
     if (c == '\n') {
       ++segments;
     } else if (c != ':') {

@@ -19,9 +19,7 @@ using test::ScratchFile;
 
 using test::kWallUs;
 
-bool tshark_installed() {
-  return std::system("command -v tshark >/dev/null 2>&1") == 0;
-}
+using test::tshark_installed;
 
 #define REQUIRE_TSHARK()                                                                     \
   if (!tshark_installed()) {                                                                 \
@@ -30,23 +28,11 @@ bool tshark_installed() {
   }
 
 /// Runs tshark on the file and returns one row per packet, fields split on
-/// tabs. Fails the test when tshark exits non-zero.
+/// tabs. Fails the test (no rows) when tshark exits non-zero.
 std::vector<std::vector<std::string>> tshark(const std::filesystem::path& file,
                                              const std::string& args) {
-  const std::string command = "tshark -n -r '" + file.string() + "' " + args + " 2>/dev/null";
   std::vector<std::vector<std::string>> rows;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    ADD_FAILURE() << "cannot run " << command;
-    return rows;
-  }
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe))
-    out.append(buf, n);
-  const int status = ::pclose(pipe);
-  EXPECT_EQ(status, 0) << command;
-  std::istringstream lines(out);
+  std::istringstream lines(test::tshark_output(file, args).value_or(""));
   std::string line;
   while (std::getline(lines, line)) {
     std::vector<std::string> fields;

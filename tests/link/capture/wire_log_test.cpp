@@ -38,19 +38,39 @@ struct LogFixture : ::testing::Test {
 
 using WireLogTest = LogFixture;
 
+/// Expects `record` to hold each (key, value) of `fields`.
+void expect_fields(const nlohmann::json& record,
+                   const std::vector<std::pair<std::string, nlohmann::json>>& fields) {
+  for (const auto& [key, value] : fields) {
+    SCOPED_TRACE(key);
+    EXPECT_EQ(record[key], value);
+  }
+}
+
+/// Expects `record` to hold exactly one decoded frame, of `kind` and valid
+/// as `valid`; false (for an ASSERT_TRUE) when it holds another number.
+bool has_one_frame(const nlohmann::json& record, const std::string& kind, bool valid) {
+  const auto& frames = record["frames"];
+  EXPECT_EQ(frames.size(), 1u) << record.dump();
+  if (frames.size() != 1u) return false;
+  EXPECT_EQ(frames[0]["kind"], kind);
+  EXPECT_EQ(frames[0]["valid"], valid);
+  return true;
+}
+
 TEST_F(WireLogTest, OpenRecordCarriesTimesSidesAndProtocol) {
   auto log = make();
   log->on_open(milliseconds(5), "tcp 127.0.0.1:9000 <- 127.0.0.1:53422", "mem car0");
   const auto r = records();
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_EQ(r[0]["event"], "open");
-  EXPECT_EQ(r[0]["link"], "car0");
-  EXPECT_EQ(r[0]["t_ms"], 5.0);
-  EXPECT_EQ(r[0]["wall_us"], kLogWallUs);
-  EXPECT_EQ(r[0]["client"], "tcp 127.0.0.1:9000 <- 127.0.0.1:53422");
-  EXPECT_EQ(r[0]["car"], "mem car0");
-  EXPECT_EQ(r[0]["protocol"], "logi");
-  EXPECT_EQ(r[0]["profile"], "guide");
+  expect_fields(r[0], {{"event", "open"},
+                       {"link", "car0"},
+                       {"t_ms", 5.0},
+                       {"wall_us", kLogWallUs},
+                       {"client", "tcp 127.0.0.1:9000 <- 127.0.0.1:53422"},
+                       {"car", "mem car0"},
+                       {"protocol", "logi"},
+                       {"profile", "guide"}});
   // A person reading the file sees which link, what and when first.
   EXPECT_EQ(file.contents().rfind(R"({"link":"car0","event":"open","t_ms":5.0,"wall_us":)", 0), 0u)
       << file.contents();
@@ -113,18 +133,14 @@ TEST_F(WireLogTest, LogiFrameSplitAcrossTwoDeliveriesIsDecodedWhenItCompletes) {
   ASSERT_EQ(r.size(), 3u);
 
   // What the client wrote was one whole frame.
-  ASSERT_EQ(r[0]["frames"].size(), 1u);
-  EXPECT_EQ(r[0]["frames"][0]["kind"], "SP");
-  EXPECT_EQ(r[0]["frames"][0]["valid"], true);
+  ASSERT_TRUE(has_one_frame(r[0], "SP", true));
   EXPECT_EQ(r[0]["held"], 0);
 
   // The car got it in two pieces: no frame yet, then the frame, with the
   // start of the next one held.
   EXPECT_EQ(r[1]["frames"].size(), 0u);
   EXPECT_EQ(r[1]["held"], 9);
-  ASSERT_EQ(r[2]["frames"].size(), 1u);
-  EXPECT_EQ(r[2]["frames"][0]["kind"], "SP");
-  EXPECT_EQ(r[2]["frames"][0]["valid"], true);
+  ASSERT_TRUE(has_one_frame(r[2], "SP", true));
   EXPECT_FALSE(r[2]["frames"][0]["text"].get<std::string>().empty());
   EXPECT_EQ(r[2]["held"], 5);
 }
@@ -140,9 +156,7 @@ TEST_F(WireLogTest, DirectionsAndSentVersusDeliveredAreSplitSeparately) {
   log->on_delivered(milliseconds(2), Direction::to_client, to_bytes("SP:1:35#"));
   const auto r = records();
   ASSERT_EQ(r.size(), 5u);
-  ASSERT_EQ(r[3]["frames"].size(), 1u);
-  EXPECT_EQ(r[3]["frames"][0]["valid"], true);
-  EXPECT_EQ(r[3]["frames"][0]["kind"], "SP");
+  ASSERT_TRUE(has_one_frame(r[3], "SP", true));
   ASSERT_EQ(r[4]["frames"].size(), 1u);
   EXPECT_EQ(r[4]["frames"][0]["valid"], true);
   EXPECT_EQ(r[4]["frames"][0]["kind"].get<std::string>().rfind("FB", 0), 0u) << r[4].dump();
@@ -170,17 +184,15 @@ TEST_F(WireLogTest, FaultRecordShowsRuleAndBytesBeforeAndAfter) {
   log->on_fault(e);
   const auto r = records();
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_EQ(r[0]["event"], "fault");
-  EXPECT_EQ(r[0]["t_ms"], 2.5);
-  EXPECT_EQ(r[0]["wall_us"], kLogWallUs);
-  EXPECT_EQ(r[0]["dir"], "to_client");
-  EXPECT_EQ(r[0]["kind"], "corrupt");
-  EXPECT_EQ(r[0]["rule"], "flip-checksum");
-  EXPECT_EQ(r[0]["detail"], "checksum field flipped");
-  EXPECT_EQ(r[0]["before"]["bytes"], 16);
-  EXPECT_EQ(r[0]["before"]["text"], "LOGI:FB:SP:1:35#");
-  EXPECT_EQ(r[0]["after"]["bytes"], 3);
-  EXPECT_EQ(r[0]["after"]["hex"], "4C 4F 00");
+  expect_fields(r[0], {{"event", "fault"},
+                       {"t_ms", 2.5},
+                       {"wall_us", kLogWallUs},
+                       {"dir", "to_client"},
+                       {"kind", "corrupt"},
+                       {"rule", "flip-checksum"},
+                       {"detail", "checksum field flipped"}});
+  expect_fields(r[0]["before"], {{"bytes", 16}, {"text", "LOGI:FB:SP:1:35#"}});
+  expect_fields(r[0]["after"], {{"bytes", 3}, {"hex", "4C 4F 00"}});
 }
 
 TEST_F(WireLogTest, DropFaultHasEmptyAfter) {
@@ -201,12 +213,12 @@ TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
   log->on_close(milliseconds(3), {LinkClose::By::car, CloseMode::graceful, "car closed"});
   const auto r = records();
   ASSERT_EQ(r.size(), 2u);
-  EXPECT_EQ(r[1]["event"], "close");
-  EXPECT_EQ(r[1]["reason"], "car closed");
-  EXPECT_EQ(r[1]["by"], "car");
-  EXPECT_EQ(r[1]["mode"], "graceful");
-  EXPECT_EQ(r[1]["t_ms"], 3.0);
-  EXPECT_EQ(r[1]["wall_us"], kLogWallUs + 7);
+  expect_fields(r[1], {{"event", "close"},
+                       {"reason", "car closed"},
+                       {"by", "car"},
+                       {"mode", "graceful"},
+                       {"t_ms", 3.0},
+                       {"wall_us", kLogWallUs + 7}});
   ASSERT_EQ(r[1]["unfinished"].size(), 1u);
   EXPECT_EQ(r[1]["unfinished"][0]["event"], "delivered");
   EXPECT_EQ(r[1]["unfinished"][0]["dir"], "to_client");

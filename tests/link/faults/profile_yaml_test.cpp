@@ -152,31 +152,35 @@ TEST(FaultProfileYaml, UnknownKeysAreErrorsSoTyposCannotDisableAFault) {
 }
 
 TEST(FaultProfileYaml, EachProblemIsReported) {
-  EXPECT_THAT(error_of("- kind: dorp\n"), HasSubstr("1:9: rule 1: unknown kind 'dorp'"));
-  EXPECT_THAT(error_of("- drop\n"), HasSubstr("rule 1: must be a map"));
-  EXPECT_THAT(error_of("- name: x\n"), HasSubstr("'kind' is missing"));
-  EXPECT_THAT(error_of("- kind: drop\n  probability: 1.5\n"),
-              HasSubstr("2:16: rule 1 (drop): 'probability' must be"));
-  EXPECT_THAT(error_of("- kind: drop\n  direction: up\n"),
-              HasSubstr("'direction' must be to_car, to_client or both"));
-  EXPECT_THAT(error_of("- kind: drop\n  first: 0\n"),
-              HasSubstr("'first' must be a whole number >= 1"));
-  EXPECT_THAT(error_of("- kind: drop\n  count: 3\n"), HasSubstr("'count' goes with 'unit: bytes'"));
-  EXPECT_THAT(error_of("- kind: stall\n  for: 1s\n"), HasSubstr("needs 'at' or a frame trigger"));
-  EXPECT_THAT(error_of("- kind: stall\n  at: 1s\n"), HasSubstr("'for' is missing"));
-  EXPECT_THAT(error_of("- kind: coalesce\n"),
-              HasSubstr("needs 'count' (frames) or 'window' (time)"));
-  EXPECT_THAT(error_of("- kind: coalesce\n  count: 1\n"),
-              HasSubstr("'count' must be a whole number >= 2"));
-  EXPECT_THAT(error_of("- kind: corrupt\n  target: field\n"),
-              HasSubstr("target 'field' needs 'field: NAME'"));
-  EXPECT_THAT(error_of("- kind: garbage\n  hex: zz\n"), HasSubstr("'hex' must be bytes in hex"));
-  EXPECT_THAT(error_of("- kind: delay\n  jitter: 5ms\n"), HasSubstr("'delay' is missing"));
-  EXPECT_THAT(error_of("- kind: drop\n  at: 1s\n"), HasSubstr("unknown key 'at'"));
-  EXPECT_THAT(error_of("- kind: drop\n  from: 2s\n  to: 1s\n"),
-              HasSubstr("'to' must be after 'from'"));
-  EXPECT_THAT(error_of("- kind: drop\n  first: 1\n  first: 2\n"), HasSubstr("given twice"));
-  EXPECT_THAT(error_of("- kind: [drop\n"), HasSubstr("not valid YAML"));
+  /// A mistaken profile and a part of the error it must raise.
+  struct Case {
+    std::string yaml;
+    std::string error_part;
+  };
+  const std::vector<Case> cases = {
+      {"- kind: dorp\n", "1:9: rule 1: unknown kind 'dorp'"},
+      {"- drop\n", "rule 1: must be a map"},
+      {"- name: x\n", "'kind' is missing"},
+      {"- kind: drop\n  probability: 1.5\n", "2:16: rule 1 (drop): 'probability' must be"},
+      {"- kind: drop\n  direction: up\n", "'direction' must be to_car, to_client or both"},
+      {"- kind: drop\n  first: 0\n", "'first' must be a whole number >= 1"},
+      {"- kind: drop\n  count: 3\n", "'count' goes with 'unit: bytes'"},
+      {"- kind: stall\n  for: 1s\n", "needs 'at' or a frame trigger"},
+      {"- kind: stall\n  at: 1s\n", "'for' is missing"},
+      {"- kind: coalesce\n", "needs 'count' (frames) or 'window' (time)"},
+      {"- kind: coalesce\n  count: 1\n", "'count' must be a whole number >= 2"},
+      {"- kind: corrupt\n  target: field\n", "target 'field' needs 'field: NAME'"},
+      {"- kind: garbage\n  hex: zz\n", "'hex' must be bytes in hex"},
+      {"- kind: delay\n  jitter: 5ms\n", "'delay' is missing"},
+      {"- kind: drop\n  at: 1s\n", "unknown key 'at'"},
+      {"- kind: drop\n  from: 2s\n  to: 1s\n", "'to' must be after 'from'"},
+      {"- kind: drop\n  first: 1\n  first: 2\n", "given twice"},
+      {"- kind: [drop\n", "not valid YAML"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.yaml);
+    EXPECT_THAT(error_of(c.yaml), HasSubstr(c.error_part));
+  }
 }
 
 TEST(FaultProfileYaml, MissingFileSaysSo) {
@@ -184,7 +188,8 @@ TEST(FaultProfileYaml, MissingFileSaysSo) {
     load_fault_profile("/nonexistent/faults.yaml");
     FAIL();
   } catch (const config::ConfigError& e) {
-    EXPECT_STREQ(e.what(), "/nonexistent/faults.yaml: cannot read the file: No such file or directory");
+    EXPECT_STREQ(e.what(),
+                 "/nonexistent/faults.yaml: cannot read the file: No such file or directory");
     EXPECT_EQ(e.line(), 0);
   }
 }

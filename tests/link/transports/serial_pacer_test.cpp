@@ -15,6 +15,14 @@ struct Arrival {
   std::size_t bytes;
 };
 
+/// The bytes 0, 1, 2, ... (mod 256), `n` of them.
+Bytes counting(std::size_t n) {
+  Bytes b(n);
+  for (std::size_t i = 0; i < n; ++i)
+    b[i] = static_cast<std::uint8_t>(i);
+  return b;
+}
+
 struct Paced {
   explicit Paced(unsigned baud, Duration min_tick = milliseconds(1))
       : pacer(
@@ -27,18 +35,20 @@ struct Paced {
 
   Time last_arrival() const { return arrivals.empty() ? Time{-1} : arrivals.back().at; }
 
+  /// Writes `first` bytes at time 0 and `second` bytes at `then`, and runs
+  /// until the line is idle.
+  void push_twice(std::size_t first, Time then, std::size_t second) {
+    pacer.push(counting(first));
+    ex.run_until(then);
+    pacer.push(counting(second));
+    ex.run_until_idle();
+  }
+
   VirtualExecutor ex;
   std::vector<Arrival> arrivals;
   Bytes data;
   SerialPacer pacer;
 };
-
-Bytes counting(std::size_t n) {
-  Bytes b(n);
-  for (std::size_t i = 0; i < n; ++i)
-    b[i] = static_cast<std::uint8_t>(i);
-  return b;
-}
 
 TEST(SerialPacer, ByteTimeIsTenBitsAtTheBaud) {
   EXPECT_EQ(SerialPacer::byte_time(9600), nanoseconds(1'041'666));
@@ -69,10 +79,7 @@ TEST(SerialPacer, NoByteArrivesBeforeItsLastBitIsSent) {
 
 TEST(SerialPacer, WritesDuringABurstQueueBehindIt) {
   Paced p(9600);
-  p.pacer.push(counting(10));
-  p.ex.run_until(milliseconds(5));
-  p.pacer.push(counting(10));
-  p.ex.run_until_idle();
+  p.push_twice(10, milliseconds(5), 10);
   // 20 bytes back to back: 20 * 10 / 9600 s = 20.8333.. ms, rounded up.
   EXPECT_EQ(p.last_arrival(), nanoseconds(20'833'334));
   EXPECT_EQ(p.data.size(), 20u);
@@ -80,10 +87,7 @@ TEST(SerialPacer, WritesDuringABurstQueueBehindIt) {
 
 TEST(SerialPacer, AnIdleLineStartsANewBurstWhenBytesArrive) {
   Paced p(9600);
-  p.pacer.push(counting(1));
-  p.ex.run_until(milliseconds(10));
-  p.pacer.push(counting(1));
-  p.ex.run_until_idle();
+  p.push_twice(1, milliseconds(10), 1);
   ASSERT_EQ(p.arrivals.size(), 2u);
   EXPECT_EQ(p.arrivals[1].at, milliseconds(10) + nanoseconds(1'041'667));
 }

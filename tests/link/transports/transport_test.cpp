@@ -10,6 +10,23 @@
 namespace hil::link {
 namespace {
 
+/// A listener on `uri` that keeps the connection it accepts and what
+/// arrives on it.
+struct Receiver {
+  Receiver(TransportContext& context, const std::string& uri)
+      : listener(listen(context, parse_endpoint(uri))) {
+    listener->start([this](BytePipePtr p) {
+      server = p;
+      p->start({[this](ByteView b) { got.insert(got.end(), b.begin(), b.end()); }, {}});
+    });
+  }
+  std::string text() const { return {got.begin(), got.end()}; }
+
+  std::unique_ptr<Listener> listener;
+  Bytes got;
+  BytePipePtr server;
+};
+
 TEST(Transport, RealTimeSchemesNeedTheRealTimeDriver) {
   VirtualExecutor ex;
   TransportContext context{ex};
@@ -27,13 +44,7 @@ TEST(Transport, RealTimeSchemesNeedTheRealTimeDriver) {
 TEST(Transport, MemWorksWithoutANetworkGiven) {
   VirtualExecutor ex;
   TransportContext context{ex};
-  auto listener = listen(context, parse_endpoint("mem://car0"));
-  Bytes got;
-  BytePipePtr server;
-  listener->start([&](BytePipePtr p) {
-    server = p;
-    p->start({[&got](ByteView b) { got.insert(got.end(), b.begin(), b.end()); }, {}});
-  });
+  Receiver car(context, "mem://car0");
   BytePipePtr client;
   connect(context, parse_endpoint("mem://car0"), [&](std::error_code ec, BytePipePtr p) {
     ASSERT_FALSE(ec);
@@ -41,28 +52,22 @@ TEST(Transport, MemWorksWithoutANetworkGiven) {
     p->write(protocol::to_bytes("hi"));
   });
   ex.run_until_idle();
-  EXPECT_EQ(std::string(got.begin(), got.end()), "hi");
+  EXPECT_EQ(car.text(), "hi");
 }
 
 TEST(Transport, TcpByUri) {
   asio::io_context io;
   AsioExecutor ex(io);
   TransportContext context{ex, &io};
-  auto listener = listen(context, parse_endpoint("tcp://127.0.0.1:0"));
-  Bytes got;
-  BytePipePtr server;
-  listener->start([&](BytePipePtr p) {
-    server = p;
-    p->start({[&got](ByteView b) { got.insert(got.end(), b.begin(), b.end()); }, {}});
-  });
+  Receiver car(context, "tcp://127.0.0.1:0");
   BytePipePtr client;
-  connect(context, parse_endpoint(listener->address()), [&](std::error_code ec, BytePipePtr p) {
+  connect(context, parse_endpoint(car.listener->address()), [&](std::error_code ec, BytePipePtr p) {
     ASSERT_FALSE(ec) << ec.message();
     client = p;
     p->write(protocol::to_bytes("over tcp"));
   });
-  ASSERT_TRUE(test::run_until(io, [&] { return got.size() == 8; }));
-  EXPECT_EQ(std::string(got.begin(), got.end()), "over tcp");
+  ASSERT_TRUE(test::run_until(io, [&] { return car.got.size() == 8; }));
+  EXPECT_EQ(car.text(), "over tcp");
 }
 
 TEST(Transport, PtyByUriCarriesItsOptions) {
