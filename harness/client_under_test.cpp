@@ -105,7 +105,7 @@ void ClientUnderTest::end_program(const Drive& drive) {
       "the client ignored SIGTERM for " + run_seconds_text(kTermGrace) + ": sent SIGKILL"};
   for (const bool hard : {false, true}) {
     if (finished()) return;
-    timeline_.add(Source::client, "notice", {{"text", notices[hard ? 1 : 0]}});
+    timeline_.add(ClientKind::notice, {{"text", notices[hard ? 1 : 0]}});
     session_->terminate(hard);
     drive(finished, executor_.now() + kTermGrace);
   }

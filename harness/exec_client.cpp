@@ -77,38 +77,38 @@ std::optional<ClientLine> event_line(std::string_view rest) {
                         "degraded", "down"}) ||
         !more.empty())
       return std::nullopt;
-    line.record_kind = "connection";
+    line.record_kind = ClientKind::connection;
     line.record_data["state"] = std::string(state);
     return line;
   }
   if ((what == "stale" || what == "fresh") && args.empty()) {
-    line.record_kind = std::string(what);
+    line.record_kind = *parse_record_kind(Source::client, what);
     return line;
   }
   if (what == "command") {
     const auto [command, after] = first_word(args);
     const auto [state, more] = first_word(after);
     if (command.empty() || state.empty() || !more.empty()) return std::nullopt;
-    line.record_kind = "command";
+    line.record_kind = ClientKind::command;
     line.record_data["command"] = std::string(command);
     line.record_data["state"] = std::string(state);
     return line;
   }
   if ((what == "notice" || what == "parse_error") && !args.empty()) {
-    line.record_kind = std::string(what);
+    line.record_kind = *parse_record_kind(Source::client, what);
     line.record_data["text"] = std::string(args);
     return line;
   }
   // `movement enabled|disabled REASON`, `login ok|failed [REASON]`.
   const auto [word, reason] = first_word(args);
   if (what == "movement" && one_of(word, {"enabled", "disabled"})) {
-    line.record_kind = "movement";
+    line.record_kind = ClientKind::movement;
     line.record_data["enabled"] = word == "enabled";
     line.record_data["reason"] = std::string(reason);
     return line;
   }
   if (what == "login" && one_of(word, {"ok", "failed"})) {
-    line.record_kind = "login";
+    line.record_kind = ClientKind::login;
     line.record_data["ok"] = word == "ok";
     if (!reason.empty()) line.record_data["reason"] = std::string(reason);
     return line;
@@ -274,11 +274,11 @@ class ExecSession final : public ReferenceSession {
     stdout_.assign(out[0]);
     stderr_.assign(err[0]);
     stdin_.non_blocking(true);
-    timeline_.add(Source::client, "start",
+    timeline_.add(ClientKind::start,
                   {{"command", options_.command}, {"pid", static_cast<long long>(pid_)}});
   }
 
-  void record_spawn_error() { timeline_.add(Source::client, "notice", {{"text", spawn_error_}}); }
+  void record_spawn_error() { timeline_.add(ClientKind::notice, {{"text", spawn_error_}}); }
 
   void queue_write(std::string bytes) {
     writes_.push_back(std::move(bytes));
@@ -346,11 +346,11 @@ class ExecSession final : public ReferenceSession {
         return;
       }
       if (parsed.kind == ClientLine::Kind::event) {
-        timeline_.add(Source::client, parsed.record_kind, parsed.record_data);
+        timeline_.add(parsed.record_kind, parsed.record_data);
         return;
       }
     }
-    timeline_.add(Source::client, "output", {{"line", line}, {"stream", stream}});
+    timeline_.add(ClientKind::output, {{"line", line}, {"stream", stream}});
   }
 
   void on_result(const ClientLine& result, const std::string& line) {
@@ -360,7 +360,7 @@ class ExecSession final : public ReferenceSession {
       return;
     }
     if (pending_.empty()) {
-      timeline_.add(Source::client, "output",
+      timeline_.add(ClientKind::output,
                     {{"line", line}, {"stream", "stdout"}, {"unexpected_result", true}});
       return;
     }
@@ -397,7 +397,7 @@ class ExecSession final : public ReferenceSession {
     }
     if (closed_streams_ < 2 && executor_.now() - reaped_at_ < kPipeGrace) return;
     exit_ = status_;
-    timeline_.add(Source::client, "exit", *exit_);
+    timeline_.add(ClientKind::exit, *exit_);
     fail_pending(exit_text(*exit_) + " before answering");
   }
 

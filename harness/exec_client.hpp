@@ -38,10 +38,10 @@ std::string shell_quote(std::string_view text);
 struct ClientLine {
   enum class Kind : std::uint8_t { result, event, output };
   Kind kind = Kind::output;
-  bool ok = false;             ///< result: `ok` (true) or `fail`
-  std::string reason;          ///< result: text after "fail ...: " (or all of it)
-  std::string record_kind;     ///< event: the client record's kind
-  nlohmann::json record_data;  ///< event: its data
+  bool ok = false;                             ///< result: `ok` (true) or `fail`
+  std::string reason;                          ///< result: text after "fail ...: " (or all of it)
+  RecordKind record_kind{ClientKind::notice};  ///< event: the client record's kind
+  nlohmann::json record_data;                  ///< event: its data
 };
 /// Reads one line of the program's stdout (without its line break).
 ClientLine parse_client_line(std::string_view line);

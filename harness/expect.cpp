@@ -55,7 +55,7 @@ bool test_holds(const FieldTest& test, const Record& record) {
   Json kind_value;
   const Json* value = nullptr;
   if (test.field == "kind") {
-    kind_value = record.kind;
+    kind_value = std::string(record.kind.name());
     value = &kind_value;
   } else {
     value = field_of(record, test.field);
@@ -98,7 +98,7 @@ bool test_holds(const FieldTest& test, const Record& record) {
 }
 
 bool same_source_and_kind(const Matcher& matcher, const Record& record) {
-  return record.source == matcher.source && (matcher.kind.empty() || record.kind == matcher.kind);
+  return record.source() == matcher.source && (!matcher.kind || record.kind == *matcher.kind);
 }
 
 /// Tests that say which records a matcher is about rather than what they
@@ -125,7 +125,7 @@ std::string failed_fields_text(const Matcher& matcher, const Record& record) {
     if (test_holds(test, record)) continue;
     if (!text.empty()) text += ", ";
     if (test.field == "kind") {
-      text += "kind = " + Json(record.kind).dump();
+      text += "kind = " + Json(std::string(record.kind.name())).dump();
     } else if (const Json* value = field_of(record, test.field)) {
       text += test.field + " = " + value->dump();
     } else {
@@ -151,7 +151,7 @@ std::vector<Record> evidence_of(const Timeline& timeline, std::vector<std::size_
     return close(from) || close(to);
   };
   for (std::size_t i = 0; i < records.size() && chosen.size() < max_evidence; ++i) {
-    if (records[i].source != source || !near_edge(records[i].at)) continue;
+    if (records[i].source() != source || !near_edge(records[i].at)) continue;
     if (std::find(candidates.begin(), candidates.end(), i) != candidates.end() &&
         std::find(chosen.begin(), chosen.end(), i) == chosen.end())
       continue;

@@ -23,7 +23,7 @@ std::string times_text(const std::vector<Time>& times);
 std::string count_text(std::uint64_t count);
 
 /// "wire frame", "client record": a source and a record kind.
-std::string record_kind_text(Source source, const std::string& kind);
+std::string record_kind_text(Source source, const std::optional<RecordKind>& kind);
 
 /// The matcher in the scenario's words, or built from its fields when it
 /// has none ("wire frame where dir = \"to_car\"").

@@ -93,8 +93,8 @@ std::string count_text(std::uint64_t count) {
   return std::to_string(count) + " times";
 }
 
-std::string record_kind_text(Source source, const std::string& kind) {
-  return std::string(to_string(source)) + " " + (kind.empty() ? std::string("record") : kind);
+std::string record_kind_text(Source source, const std::optional<RecordKind>& kind) {
+  return std::string(to_string(source)) + " " + (kind ? std::string(kind->name()) : "record");
 }
 
 std::string matcher_text(const Matcher& matcher) {

@@ -9,7 +9,7 @@ namespace hil::harness {
 namespace {
 
 bool judges_exit(const Expectation& e) {
-  return e.what.source == Source::client && e.what.kind == "exit";
+  return e.what.source == Source::client && e.what.kind == ClientKind::exit;
 }
 
 Expectation clean_exit(const JudgedRun& run) {
@@ -17,8 +17,10 @@ Expectation clean_exit(const JudgedRun& run) {
   exit.label = "the client exited with code 0 after its input closed";
   exit.window.from.offset = run.session_end - Time(0);
   exit.window.within = run.run_end - run.session_end;
-  exit.what = Matcher{
-      Source::client, "exit", {FieldTest{"code", FieldTest::Op::equals, 0}}, "client exit 0"};
+  exit.what = Matcher{Source::client,
+                      ClientKind::exit,
+                      {FieldTest{"code", FieldTest::Op::equals, 0}},
+                      "client exit 0"};
   return exit;
 }
 

@@ -104,28 +104,26 @@ class LogiReference final : public ReferenceSession {
     std::visit(
         protocol::Overloaded{
             [&](const cl::ConnectionEvent& e) {
-              timeline_.add(Source::client, "connection", connection(e.state, e.attempt));
+              timeline_.add(ClientKind::connection, connection(e.state, e.attempt));
             },
             [&](const cl::CommandEvent& e) {
-              timeline_.add(Source::client, "command",
-                            {{"command", protocol::logi::kind_of(e.command)},
-                             {"text", protocol::logi::encode_text(e.command)},
-                             {"state", std::string(cl::to_string(e.state))},
-                             {"request", e.request},
-                             {"attempt", e.attempt}});
+              timeline_.add(ClientKind::command, {{"command", protocol::logi::kind_of(e.command)},
+                                                  {"text", protocol::logi::encode_text(e.command)},
+                                                  {"state", std::string(cl::to_string(e.state))},
+                                                  {"request", e.request},
+                                                  {"attempt", e.attempt}});
             },
             [&](const cl::StaleEvent& e) {
-              timeline_.add(Source::client, e.stale ? "stale" : "fresh");
+              timeline_.add(e.stale ? ClientKind::stale : ClientKind::fresh);
             },
             [&](const cl::NoticeEvent& e) {
-              timeline_.add(Source::client, "notice", {{"text", e.text}});
+              timeline_.add(ClientKind::notice, {{"text", e.text}});
             },
             [&](const cl::ParseErrorEvent& e) {
-              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
+              timeline_.add(ClientKind::parse_error, {{"text", decode_error_text(e.error)}});
             },
             [&](const cl::MovementEvent& e) {
-              timeline_.add(Source::client, "movement",
-                            {{"enabled", e.enabled}, {"reason", e.reason}});
+              timeline_.add(ClientKind::movement, {{"enabled", e.enabled}, {"reason", e.reason}});
             },
             [](const cl::StatusEvent&) {},    // the STAT frames are on the wire
             [](const cl::FeedbackEvent&) {},  // so are the FB frames
@@ -231,32 +229,32 @@ class Wr8Reference final : public ReferenceSession {
 
   void on_event(Time now, const typename Dialect::Event& event) {
     namespace cw = client::wr8;
-    std::visit(
-        protocol::Overloaded{
-            [&](const cw::ConnectionEvent& e) {
-              timeline_.add(Source::client, "connection", connection(e.state, e.attempt));
-            },
-            [&](const cw::LoginEvent&) {
-              timeline_.add(Source::client, "login", {{"ok", true}});
-            },
-            [&](const cw::LoginFailedEvent& e) {
-              timeline_.add(Source::client, "login", {{"ok", false}, {"reason", e.reason}});
-            },
-            [&](const cw::StaleEvent& e) {
-              timeline_.add(Source::client, e.stale ? "stale" : "fresh", Dialect::stale_fields(e));
-            },
-            [&](const cw::RequestEvent& e) {
-              timeline_.add(Source::client, "command",
-                            {{"command", Dialect::command(e)},
-                             {"state", std::string(cw::to_string(e.state))},
-                             {"request", e.coi}});
-            },
-            [&](const cw::ParseErrorEvent& e) {
-              timeline_.add(Source::client, "parse_error", {{"text", decode_error_text(e.error)}});
-            },
-            [](const auto&) {},  // DATA, MAP, settings read back: the wire shows them
-        },
-        event);
+    std::visit(protocol::Overloaded{
+                   [&](const cw::ConnectionEvent& e) {
+                     timeline_.add(ClientKind::connection, connection(e.state, e.attempt));
+                   },
+                   [&](const cw::LoginEvent&) {
+                     timeline_.add(ClientKind::login, {{"ok", true}});
+                   },
+                   [&](const cw::LoginFailedEvent& e) {
+                     timeline_.add(ClientKind::login, {{"ok", false}, {"reason", e.reason}});
+                   },
+                   [&](const cw::StaleEvent& e) {
+                     timeline_.add(e.stale ? ClientKind::stale : ClientKind::fresh,
+                                   Dialect::stale_fields(e));
+                   },
+                   [&](const cw::RequestEvent& e) {
+                     timeline_.add(ClientKind::command,
+                                   {{"command", Dialect::command(e)},
+                                    {"state", std::string(cw::to_string(e.state))},
+                                    {"request", e.coi}});
+                   },
+                   [&](const cw::ParseErrorEvent& e) {
+                     timeline_.add(ClientKind::parse_error, {{"text", decode_error_text(e.error)}});
+                   },
+                   [](const auto&) {},  // DATA, MAP, settings read back: the wire shows them
+               },
+               event);
     if (runner_) runner_->on_event(now, event);
   }
 
@@ -338,10 +336,10 @@ class ArduinoReference final : public ReferenceSession {
                    [&](const ca::LinkChanged& e) {
                      auto data = connection(e.to, 0, ca::link_name(e.to));
                      data["reason"] = e.reason;
-                     timeline_.add(Source::client, "connection", std::move(data));
+                     timeline_.add(ClientKind::connection, std::move(data));
                    },
                    [&](const ca::RequestDone& e) {
-                     timeline_.add(Source::client, "command",
+                     timeline_.add(ClientKind::command,
                                    {{"request", e.id},
                                     {"state", std::string(ca::to_string(e.result.code))},
                                     {"detail", ca::describe_result(e.result)}});
@@ -374,7 +372,7 @@ class LekaReference final : public ReferenceSession {
     // The port has no events of its own: look again whenever the wire opens
     // or closes, so the record comes at the moment it happened.
     listener_ = timeline_.listen([this](const Record& r) {
-      if (r.source == Source::wire && (r.kind == "open" || r.kind == "close"))
+      if (r.source() == Source::wire && (r.kind == WireKind::open || r.kind == WireKind::close))
         later(executor_, alive_, [this] { poll(); });
     });
   }
@@ -428,7 +426,7 @@ class LekaReference final : public ReferenceSession {
     if (state == state_) return;
     state_ = state;
     const bool open = state == client::ConnectionState::connected;
-    timeline_.add(Source::client, "connection", connection(state, 0, open ? "open" : "closed"));
+    timeline_.add(ClientKind::connection, connection(state, 0, open ? "open" : "closed"));
   }
 
  private:

@@ -66,7 +66,7 @@ double number(const nlohmann::json& data, const char* key) {
 
 std::string describe_wire(const Record& r) {
   const auto& d = r.data;
-  if (r.kind == "frame") {
+  if (r.kind == WireKind::frame) {
     const std::string dir = field(d, "dir");
     const std::string stage = field(d, "stage");
     std::string who;
@@ -87,14 +87,14 @@ std::string describe_wire(const Record& r) {
     }
     return out;
   }
-  if (r.kind == "open") {
+  if (r.kind == WireKind::open) {
     std::string out = "open";
     if (d.is_object())
       for (const auto& [key, value] : d.items())
         out += " " + key + "=" + field(d, key.c_str());
     return out;
   }
-  if (r.kind == "close") {
+  if (r.kind == WireKind::close) {
     std::string out = "close";
     if (const auto by = field(d, "by"); !by.empty()) out += " by " + by;
     if (const auto reason = field(d, "reason"); !reason.empty()) out += ": " + reason;
@@ -105,39 +105,39 @@ std::string describe_wire(const Record& r) {
 
 std::string describe_client(const Record& r) {
   const auto& d = r.data;
-  if (r.kind == "connection") return "connection " + field(d, "state");
-  if (r.kind == "command") {
+  if (r.kind == ClientKind::connection) return "connection " + field(d, "state");
+  if (r.kind == ClientKind::command) {
     std::string out = "command " + field(d, "command") + " " + field(d, "state");
     if (const auto request = field(d, "request"); !request.empty()) out += " (" + request + ")";
     return out;
   }
-  if (r.kind == "notice") return "notice: " + field(d, "text");
-  if (r.kind == "action") {
+  if (r.kind == ClientKind::notice) return "notice: " + field(d, "text");
+  if (r.kind == ClientKind::action) {
     std::string out = "action '" + field(d, "text") + "' ";
     if (flag(d, "ok", true)) return out + "ok";
     return out + "failed: " + field(d, "reason");
   }
-  if (r.kind == "output") return "output: " + printable(field(d, "line"));
-  if (r.kind == "exit") return "exit code " + field(d, "code");
+  if (r.kind == ClientKind::output) return "output: " + printable(field(d, "line"));
+  if (r.kind == ClientKind::exit) return "exit code " + field(d, "code");
   return {};
 }
 
 std::string describe_sim(const Record& r) {
   const auto& d = r.data;
-  if (r.kind == "sample") {
+  if (r.kind == SimKind::sample) {
     return "sample x=" + fixed(number(d, "x_m"), 3) + " m y=" + fixed(number(d, "y_m"), 3) +
            " m heading=" + fixed(number(d, "heading_deg"), 1) +
            " deg speed=" + fixed(number(d, "speed_mps"), 3) + " m/s";
   }
-  if (r.kind == "station") return "station " + field(d, "station");
-  if (r.kind == "collision") return "collision with " + field(d, "with");
+  if (r.kind == SimKind::station) return "station " + field(d, "station");
+  if (r.kind == SimKind::collision) return "collision with " + field(d, "with");
   return {};
 }
 
 std::string describe_step(const Record& r) {
   const auto& d = r.data;
-  if (r.kind == "start") return "start  " + field(d, "text");
-  if (r.kind == "end") {
+  if (r.kind == StepKind::start) return "start  " + field(d, "text");
+  if (r.kind == StepKind::end) {
     if (flag(d, "ok", true)) return "end    " + field(d, "text") + "  ok";
     return "end    " + field(d, "text") + "  FAILED: " + field(d, "reason");
   }
@@ -148,12 +148,12 @@ std::string describe_step(const Record& r) {
 
 std::string describe_record(const Record& r) {
   std::string text;
-  switch (r.source) {
+  switch (r.source()) {
     case Source::wire:
       text = describe_wire(r);
       break;
     case Source::fault: {
-      text = r.kind;
+      text = std::string(r.kind.name());
       if (const auto dir = field(r.data, "dir"); !dir.empty()) text += " " + dir;
       if (const auto detail = field(r.data, "detail"); !detail.empty()) text += ": " + detail;
       if (const auto rule = field(r.data, "rule"); !rule.empty()) text += " (rule " + rule + ")";
@@ -169,13 +169,13 @@ std::string describe_record(const Record& r) {
       text = describe_step(r);
       break;
     case Source::car:
-      if (r.kind == "behaviour") text = "behaviour " + field(r.data, "name");
-      if (r.kind == "fault_state") text = "fault state " + field(r.data, "on");
+      if (r.kind == CarEventKind::behaviour) text = "behaviour " + field(r.data, "name");
+      if (r.kind == CarEventKind::fault_state) text = "fault state " + field(r.data, "on");
       break;
   }
   if (!text.empty()) return text;
   // A kind this report does not know yet: show everything it carries.
-  text = r.kind;
+  text = std::string(r.kind.name());
   if (r.data.is_object() && !r.data.empty())
     text += " " + r.data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return text;
@@ -258,7 +258,7 @@ std::vector<Record> evidence_for_step(const StepOutcome& step, const Timeline& t
   std::vector<Record> earlier;
   std::vector<Record> later;
   for (const auto& r : timeline.records()) {
-    if (r.source == Source::sim && r.kind == "sample") continue;
+    if (r.kind == SimKind::sample) continue;
     if (r.at <= step.ended) {
       earlier.push_back(r);
     } else if (r.at <= until && later.size() < after) {
@@ -338,7 +338,7 @@ std::string format_seconds(Duration d) {
 std::string format_record(const Record& record) {
   char time[32];
   std::snprintf(time, sizeof time, "%9.3f s", std::chrono::duration<double>(record.at).count());
-  return std::string(time) + "  " + pad(std::string(to_string(record.source)), 6) + "  " +
+  return std::string(time) + "  " + pad(std::string(to_string(record.source())), 6) + "  " +
          describe_record(record);
 }
 
@@ -391,9 +391,7 @@ std::string failure_text(const ScenarioOutcome& o) {
       const Time to = e.window_to.value_or(Time::max());
       std::vector<Record> seen;
       for (const auto& r : o.timeline.records())
-        if (r.at >= *e.window_from && r.at <= to &&
-            !(r.source == Source::sim && r.kind == "sample"))
-          seen.push_back(r);
+        if (r.at >= *e.window_from && r.at <= to && !(r.kind == SimKind::sample)) seen.push_back(r);
       append_evidence(out, seen);
     }
   }

@@ -143,7 +143,7 @@ std::string expectations_html(const ScenarioOutcome& o) {
 std::string timeline_html(const Timeline& timeline) {
   std::map<std::string, int> sources;
   for (const auto& r : timeline.records())
-    ++sources[std::string(to_string(r.source))];
+    ++sources[std::string(to_string(r.source()))];
   std::string out =
       "<p><label>filter <input id=\"q\" oninput=\"filterTimeline()\" "
       "placeholder=\"text, e.g. MV:STOP\"></label> <label>source <select id=\"src\" "
@@ -159,9 +159,10 @@ std::string timeline_html(const Timeline& timeline) {
   std::size_t n = 0;
   for (const auto& r : timeline.records()) {
     if (++n > kMostTimelineRows) break;
-    const std::string source(to_string(r.source));
-    out += "<tr data-source=\"" + esc(source) + "\" data-kind=\"" + esc(r.kind) + "\"><td>" +
-           seconds3(r.at) + "</td><td>" + esc(source) + "</td><td>" + esc(r.kind) + "</td><td>" +
+    const std::string source(to_string(r.source()));
+    out += "<tr data-source=\"" + esc(source) + "\" data-kind=\"" +
+           esc(std::string(r.kind.name())) + "\"><td>" + seconds3(r.at) + "</td><td>" +
+           esc(source) + "</td><td>" + esc(std::string(r.kind.name())) + "</td><td>" +
            esc(describe_record(r)) + "</td></tr>\n";
   }
   out += "</tbody></table>\n";
@@ -225,23 +226,24 @@ nlohmann::json playback_json(const ScenarioOutcome& o) {
        fault_state = json::array();
   for (const auto& r : o.timeline.records()) {
     const double at = ms_of(r.at);
-    if (r.source == Source::wire && r.kind == "frame") {
+    if (r.kind == WireKind::frame) {
       if (r.data.value("stage", "") != "delivered" || frames.size() >= kMostPlaybackRecords)
         continue;
       const std::string text =
           r.data.contains("text") ? r.data.value("text", "") : r.data.value("hex", "");
       frames.push_back({at, r.data.value("dir", ""), r.data.value("frame", ""), text,
                         r.data.value("valid", true)});
-    } else if (r.source == Source::fault) {
+    } else if (r.source() == Source::fault) {
       if (faults.size() < kMostPlaybackRecords)
-        faults.push_back({at, r.data.value("dir", ""), r.kind, r.data.value("rule", ""),
-                          r.data.value("detail", "")});
-    } else if (r.source == Source::car && r.kind == "fault_state") {
+        faults.push_back({at, r.data.value("dir", ""), std::string(r.kind.name()),
+                          r.data.value("rule", ""), r.data.value("detail", "")});
+    } else if (r.kind == CarEventKind::fault_state) {
       fault_state.push_back({at, r.data.value("on", false)});
-    } else if ((r.source == Source::step && r.kind == "start") || r.source == Source::client ||
-               (r.source == Source::sim && r.kind != "sample")) {
+    } else if ((r.kind == StepKind::start) || r.source() == Source::client ||
+               ((r.source() == Source::sim && r.kind != SimKind::sample))) {
       if (events.size() < kMostPlaybackRecords)
-        events.push_back({at, std::string(to_string(r.source)), r.kind, describe_record(r)});
+        events.push_back({at, std::string(to_string(r.source())), std::string(r.kind.name()),
+                          describe_record(r)});
     }
   }
   j["frames"] = std::move(frames);

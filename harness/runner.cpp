@@ -206,7 +206,7 @@ void ScenarioRun::run() {
       scenario_, out_.steps,
       StepTargets{executor(), timeline_, *car_, *server_, client_->session()});
   // The world starts at rest: that is the state the first transition leaves.
-  timeline_.add(Source::sim, "at_rest");
+  timeline_.add(SimKind::at_rest);
   client_->session().start();
   observer_ = std::make_unique<SimObserver>(executor(), *car_, timeline_, options_.sample_period,
                                             [this] { client_->session().poll(); });

@@ -50,7 +50,7 @@ struct FieldTest {
 /// all hold.
 struct Matcher {
   Source source = Source::step;
-  std::string kind;
+  std::optional<RecordKind> kind;  ///< nullopt: any kind of `source`
   std::vector<FieldTest> tests;
   std::string text;  ///< as the scenario wrote it, for reports ("car received MV:STOP")
   friend bool operator==(const Matcher&, const Matcher&) = default;

@@ -10,7 +10,6 @@ class ClientReader : public config::Reader {
  public:
   explicit ClientReader(const ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
 
-
   ClientSpec client(const YAML::Node& n) const {
     if (n.IsScalar()) {
       if (n.Scalar() == "reference") return ReferenceClient{};

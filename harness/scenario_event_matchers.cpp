@@ -41,7 +41,7 @@ class EventMatcherReader : public config::Reader {
     }
     Matcher m;
     m.source = Source::client;
-    m.kind = kind;
+    m.kind = parse_record_kind(Source::client, kind);
     client_kind_tests(kind, v, where, m);
     return m;
   }
@@ -52,13 +52,13 @@ class EventMatcherReader : public config::Reader {
     m.source = Source::client;
     const std::string& word = v.Scalar();
     if (word == "stale" || word == "fresh") {
-      m.kind = word;
+      m.kind = parse_record_kind(Source::client, word);
       m.text =
           word == "stale" ? "client warned of stale telemetry" : "client telemetry fresh again";
       return m;
     }
     if (word == "parse_error") {
-      m.kind = word;
+      m.kind = ClientKind::parse_error;
       m.text = "client reported a frame it could not parse";
       return m;
     }
@@ -68,7 +68,7 @@ class EventMatcherReader : public config::Reader {
       fail(v, where + ": unknown client state '" + word + "' (expected " + join(known) + ")" +
                   config::did_you_mean(word, known));
     }
-    m.kind = "connection";
+    m.kind = ClientKind::connection;
     m.tests.push_back(field_test("state", FieldTest::Op::equals, word));
     m.text = "client " + word;
     return m;
@@ -152,7 +152,7 @@ class EventMatcherReader : public config::Reader {
                     "with station, speed_below, speed_above, near)" +
                     config::did_you_mean(word, kWords));
       }
-      m.kind = word;
+      m.kind = parse_record_kind(Source::sim, word);
       m.text = word == "at_rest"  ? "chassis at rest"
                : word == "moving" ? "chassis moving"
                                   : "collision";
@@ -165,7 +165,7 @@ class EventMatcherReader : public config::Reader {
     if (auto s = v["station"]) {
       check_keys(v, {"station"}, where);
       const auto station = whole(s, "'station'", 0);
-      m.kind = "station";
+      m.kind = SimKind::station;
       m.tests.push_back(field_test("station", FieldTest::Op::equals, station));
       m.text = "car reached station " + std::to_string(station);
       return m;
@@ -173,12 +173,12 @@ class EventMatcherReader : public config::Reader {
     if (auto c = v["collision"]) {
       check_keys(v, {"collision"}, where);
       const std::string with = scalar(c, "'collision'");
-      m.kind = "collision";
+      m.kind = SimKind::collision;
       m.tests.push_back(field_test("with", FieldTest::Op::contains, with));
       m.text = "collision with '" + with + "'";
       return m;
     }
-    m.kind = "sample";
+    m.kind = SimKind::sample;
     if (auto s = v["speed_below"]) {
       const double speed = number(s, "'speed_below'");
       m.tests.push_back(field_test("speed_mps", FieldTest::Op::less, speed));
@@ -212,11 +212,25 @@ class EventMatcherReader : public config::Reader {
     return m;
   }
 
+  /// A fault rule's kind: drop, corrupt, ...
+  RecordKind fault_kind(const YAML::Node& n, const std::string& where) const {
+    static const Keys kKinds = {"fragment",  "coalesce",   "corrupt", "drop",
+                                "duplicate", "garbage",    "delay",   "stall",
+                                "bandwidth", "disconnect", "reset",   "refuse"};
+    const std::string word = scalar(n, where);
+    const auto kind = link::parse_fault_kind(word);
+    if (!kind) {
+      fail(n, where + ": unknown fault kind '" + word + "' (known: " + join(kKinds) + ")" +
+                  config::did_you_mean(word, kKinds));
+    }
+    return *kind;
+  }
+
   Matcher fault_matcher(const YAML::Node& v, const std::string& where) const {
     Matcher m;
     m.source = Source::fault;
     if (v.IsScalar()) {
-      m.kind = v.Scalar() == "*" ? std::string() : v.Scalar();
+      if (v.Scalar() != "*") m.kind = fault_kind(v, where);
       m.text = "fault " + v.Scalar();
       return m;
     }
@@ -224,8 +238,8 @@ class EventMatcherReader : public config::Reader {
     check_keys(v, {"kind", "rule", "dir"}, where);
     m.text = "fault";
     if (auto k = v["kind"]) {
-      m.kind = scalar(k, "'kind'");
-      m.text += " " + m.kind;
+      m.kind = fault_kind(k, where + ": 'kind'");
+      m.text += " " + k.Scalar();
     }
     if (auto r = v["rule"]) {
       const std::string rule = scalar(r, "'rule'");
@@ -246,7 +260,7 @@ class EventMatcherReader : public config::Reader {
     Matcher m;
     m.source = Source::car;
     if (v.IsScalar() && v.Scalar() == "fault_state") {
-      m.kind = "fault_state";
+      m.kind = CarEventKind::fault_state;
       m.tests.push_back(field_test("on", FieldTest::Op::equals, true));
       m.text = "car entered its fault state";
       return m;
@@ -258,13 +272,13 @@ class EventMatcherReader : public config::Reader {
     if (auto b = v["behaviour"]) {
       if (v["fault_state"]) fail(v["fault_state"], where + ": one of behaviour, fault_state");
       const std::string name = scalar(b, "'behaviour'");
-      m.kind = "behaviour";
+      m.kind = CarEventKind::behaviour;
       if (name != "*") m.tests.push_back(field_test("name", FieldTest::Op::equals, name));
       m.text = "car behaviour " + name + " fired";
       return m;
     }
     const bool on = boolean(v["fault_state"], "'fault_state'");
-    m.kind = "fault_state";
+    m.kind = CarEventKind::fault_state;
     m.tests.push_back(field_test("on", FieldTest::Op::equals, on));
     m.text = on ? "car entered its fault state" : "car left its fault state";
     return m;
@@ -290,7 +304,7 @@ class EventMatcherReader : public config::Reader {
     const std::string text = resolve_step(v.IsMap() ? v["text"] : v, wanted, where);
     Matcher m;
     m.source = Source::step;
-    m.kind = chosen_phase;
+    m.kind = parse_record_kind(Source::step, chosen_phase);
     m.tests.push_back(field_test("text", FieldTest::Op::equals, text));
     m.text = "step '" + text + "' " + (chosen_phase == "start" ? "started" : "ended");
     return m;

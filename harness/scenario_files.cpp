@@ -69,7 +69,6 @@ class FileReader : public config::Reader {
     return link::load_fault_profile(path);
   }
 
-
  private:
   const ScenarioFacts& facts_;
 };

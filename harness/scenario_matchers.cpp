@@ -33,8 +33,6 @@ class MatcherReader : public config::Reader {
  public:
   explicit MatcherReader(const ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
 
-
-
   /// A matcher written alone (wait_until, schedule `when`).
   Matcher matcher_node(const YAML::Node& n, const std::string& where) const {
     if (!n.IsMap()) {
@@ -99,7 +97,7 @@ class MatcherReader : public config::Reader {
     if (v.IsScalar()) {
       if (v.Scalar() == "open" || v.Scalar() == "close") {
         Matcher m{Source::wire,
-                  v.Scalar(),
+                  parse_record_kind(Source::wire, v.Scalar()),
                   {},
                   "link " + std::string(v.Scalar() == "open" ? "opened" : "closed")};
         return m;
@@ -130,7 +128,7 @@ class MatcherReader : public config::Reader {
       fail(n[key], "'" + key + "' must be a frame kind (MV:STOP, SP) or * for any");
     Matcher m;
     m.source = Source::wire;
-    m.kind = "frame";
+    m.kind = WireKind::frame;
     const bool to_car = key == "received" || key == "sent_by_client";
     const bool delivered = key == "received" || key == "received_by_client";
     m.tests.push_back(field_test("dir", FieldTest::Op::equals, to_car ? "to_car" : "to_client"));
@@ -190,7 +188,8 @@ class MatcherReader : public config::Reader {
     std::string wanted = scalar(value, what);
     if (wanted.empty()) fail(value, what + " must not be empty");
     if (key == "hex") wanted = hex_digits(value, wanted, what);
-    m.tests.push_back(field_test(key, whole ? FieldTest::Op::equals : FieldTest::Op::contains, wanted));
+    m.tests.push_back(
+        field_test(key, whole ? FieldTest::Op::equals : FieldTest::Op::contains, wanted));
     m.text += " with " + key + (whole ? " " : " containing ") + "'" + wanted + "'";
   }
 
@@ -227,9 +226,8 @@ class MatcherReader : public config::Reader {
       if (!seen.insert(name).second) fail(it.first, where + ": '" + name + "' is given twice");
       if (const Keys known = known_frame_fields(facts_.car); !contains(known, name)) {
         if (const auto likely = closest(name, known)) {
-          fail(it.first, where + ": " + car_title(facts_.car) + " frames have no field '" +
-                             name + "' (they have " + join(known) + "); did you mean '" + *likely +
-                             "'?");
+          fail(it.first, where + ": " + car_title(facts_.car) + " frames have no field '" + name +
+                             "' (they have " + join(known) + "); did you mean '" + *likely + "'?");
         }
       }
       const std::string field = "fields." + name;

@@ -117,15 +117,13 @@ void read_anchor_occurrence(const ScenarioFacts& facts, const YAML::Node& n, Anc
 // scenario_event_matchers.cpp: the value under the source's key.
 Matcher read_client_matcher(const ScenarioFacts& facts, const YAML::Node& v,
                             const std::string& where);
-Matcher read_sim_matcher(const ScenarioFacts& facts, const YAML::Node& v,
-                         const std::string& where);
+Matcher read_sim_matcher(const ScenarioFacts& facts, const YAML::Node& v, const std::string& where);
 Matcher read_fault_matcher(const ScenarioFacts& facts, const YAML::Node& v,
                            const std::string& where);
-Matcher read_car_matcher(const ScenarioFacts& facts, const YAML::Node& v,
-                         const std::string& where);
+Matcher read_car_matcher(const ScenarioFacts& facts, const YAML::Node& v, const std::string& where);
 /// `phase` is "start" or "end".
-Matcher read_step_matcher(const ScenarioFacts& facts, const YAML::Node& v,
-                          const std::string& phase, const std::string& where);
+Matcher read_step_matcher(const ScenarioFacts& facts, const YAML::Node& v, const std::string& phase,
+                          const std::string& where);
 
 // scenario_expectations.cpp
 std::vector<ScheduledStep> read_schedule(const ScenarioFacts& facts, const YAML::Node& list);

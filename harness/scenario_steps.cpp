@@ -63,14 +63,13 @@ std::optional<std::pair<int, std::string>> check_action(mocks::CarKind car,
   return std::nullopt;
 }
 
-/// Steps: operator actions (checked by the car's own operator language), waits, car behaviours, fault changes and obstacles.
+/// Steps: operator actions (checked by the car's own operator language), waits, car behaviours,
+/// fault changes and obstacles.
 class StepReader : public config::Reader {
  public:
   explicit StepReader(const ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
 
-
   /// How a step reads in reports and in the timeline's step records.
-
 
   std::vector<Step> steps(const YAML::Node& list, const std::string& key,
                           const std::string& prefix) const {
@@ -143,7 +142,8 @@ class StepReader : public config::Reader {
     const std::string usage = " must be fail or {fail: \"words the reason contains\"}";
     if (n.IsScalar()) {
       if (n.Scalar() != "fail") {
-        fail(n, what + usage + ", got '" + n.Scalar() + "'" + config::did_you_mean(n.Scalar(), {"fail"}));
+        fail(n, what + usage + ", got '" + n.Scalar() + "'" +
+                    config::did_you_mean(n.Scalar(), {"fail"}));
       }
       s.expect_failure = true;
       return;

@@ -8,7 +8,6 @@ class VariableReader : public config::Reader {
  public:
   explicit VariableReader(ScenarioFacts& facts) : config::Reader(facts.file), facts_(facts) {}
 
-
   static bool valid_variable_name(std::string_view name) {
     if (name.empty()) return false;
     for (std::size_t i = 0; i < name.size(); ++i) {

@@ -75,7 +75,7 @@ void SimObserver::note_collisions() {
     static constexpr const char* kWith[] = {"wall", "obstacle", "vehicle"};
     const std::string with =
         c.other_name.empty() ? std::string(kWith[static_cast<int>(c.with)]) : c.other_name;
-    timeline_.add(Source::sim, "collision", {{"with", with}});
+    timeline_.add(SimKind::collision, {{"with", with}});
   }
 }
 
@@ -91,28 +91,28 @@ void SimObserver::note_station() {
     data["station"] = std::stoi(*tag);
   else
     data["station"] = *tag;
-  timeline_.add(Source::sim, "station", std::move(data));
+  timeline_.add(SimKind::station, std::move(data));
 }
 
 void SimObserver::note_motion(double speed_mps, double turn_radps) {
   if (!moving_ && (speed_mps >= kMovingMps || turn_radps >= kMovingRadps)) {
     moving_ = true;
-    timeline_.add(Source::sim, "moving");
+    timeline_.add(SimKind::moving);
   } else if (moving_ && speed_mps < kMovingMps / 2 && turn_radps < kMovingRadps / 2) {
     moving_ = false;
-    timeline_.add(Source::sim, "at_rest");
+    timeline_.add(SimKind::at_rest);
   }
 }
 
 void SimObserver::note_fault_state() {
   if (car_.firmware().in_fault() == in_fault_) return;
   in_fault_ = car_.firmware().in_fault();
-  timeline_.add(Source::car, "fault_state", {{"on", in_fault_}});
+  timeline_.add(CarEventKind::fault_state, {{"on", in_fault_}});
 }
 
 void SimObserver::sample(double speed_mps) {
   const sim::Pose pose = car_.vehicle().pose();
-  timeline_.add(Source::sim, "sample",
+  timeline_.add(SimKind::sample,
                 {{"x_m", sim::round_to(pose.x_m, 1e-4)},
                  {"y_m", sim::round_to(pose.y_m, 1e-4)},
                  {"heading_deg", sim::round_to(pose.heading_rad * 180 / std::numbers::pi, 0.01)},

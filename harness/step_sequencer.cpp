@@ -116,7 +116,7 @@ void StepSequencer::begin_step(std::size_t index, std::function<void(bool ok)> t
   o.started = targets_.executor.now();
   running_[index].then = std::move(then);
   targets_.timeline.add(
-      Source::step, "start",
+      StepKind::start,
       {{"index", index}, {"line", step.line}, {"text", step.text}, {"phase", o.phase}});
   std::visit(protocol::Overloaded{
                  [&](const ActionStep&) {
@@ -130,7 +130,7 @@ void StepSequencer::begin_step(std::size_t index, std::function<void(bool ok)> t
                  [&](const WaitUntilStep& w) { begin_wait_until(index, w); },
                  [&](const CarStep& c) {
                    targets_.timeline.add(
-                       Source::car, "behaviour",
+                       CarEventKind::behaviour,
                        {{"name", c.behaviour.name},
                         {"action", std::string(mocks::action_name(c.behaviour.action))}});
                    targets_.car.firmware().arm(c.behaviour);
@@ -171,13 +171,12 @@ void StepSequencer::finish_step(std::size_t index, bool ok, std::string reason, 
   o.ok = ok;
   o.reason = std::move(reason);
   o.ended = targets_.executor.now();
-  targets_.timeline.add(Source::step, "end",
-                        {{"index", index},
-                         {"line", o.line},
-                         {"text", o.text},
-                         {"phase", o.phase},
-                         {"ok", ok},
-                         {"reason", o.reason}});
+  targets_.timeline.add(StepKind::end, {{"index", index},
+                                        {"line", o.line},
+                                        {"text", o.text},
+                                        {"phase", o.phase},
+                                        {"ok", ok},
+                                        {"reason", o.reason}});
   if (r.then) r.then(ok);
 }
 
@@ -186,7 +185,7 @@ void StepSequencer::begin_wait_until(std::size_t index, const WaitUntilStep& wai
   // A match at this very moment, recorded just before the step began, counts.
   const auto& records = targets_.timeline.timeline().records();
   for (auto it = records.rbegin(); it != records.rend() && it->at >= started; ++it) {
-    if (it->source == Source::step && it->kind == "start") continue;
+    if (it->kind == StepKind::start) continue;
     if (matches(wait.until, *it)) {
       finish_later(index, true, "");
       return;
@@ -249,7 +248,7 @@ void StepSequencer::pump_actions() {
     const std::string text = std::get<ActionStep>(plan_[index]->action).text;
     client.execute(text, [this, index, text](bool ok, const std::string& reason) {
       --actions_under_way_;
-      targets_.timeline.add(Source::client, "action",
+      targets_.timeline.add(ClientKind::action,
                             {{"index", index}, {"text", text}, {"ok", ok}, {"reason", reason}});
       finish_step(index, ok, reason);
       pump_actions();

@@ -4,37 +4,19 @@
 
 namespace hil::harness {
 
-std::string_view to_string(Source source) {
-  switch (source) {
-    case Source::wire:
-      return "wire";
-    case Source::fault:
-      return "fault";
-    case Source::client:
-      return "client";
-    case Source::sim:
-      return "sim";
-    case Source::step:
-      return "step";
-    case Source::car:
-      return "car";
-  }
-  return "?";
-}
-
 void Timeline::add(Record record) {
   records_.push_back(std::move(record));
 }
 
-void Timeline::add(Time at, Source source, std::string kind, nlohmann::json data) {
-  records_.push_back(Record{at, source, std::move(kind), std::move(data)});
+void Timeline::add(Time at, RecordKind kind, nlohmann::json data) {
+  records_.push_back(Record{at, kind, std::move(data)});
 }
 
 nlohmann::ordered_json Timeline::to_json(const Record& record) {
   nlohmann::ordered_json j;
   j["t_ms"] = link::to_ms(record.at);
-  j["source"] = std::string(to_string(record.source));
-  j["kind"] = record.kind;
+  j["source"] = std::string(to_string(record.source()));
+  j["kind"] = std::string(record.kind.name());
   for (const auto& [key, value] : record.data.items())
     j[key] = value;
   return j;

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "harness/record_kind.hpp"
 #include "link/time.hpp"
 
 namespace hil::harness {
@@ -18,19 +19,8 @@ namespace hil::harness {
 using link::Duration;
 using link::Time;
 
-/// Where a record came from.
-enum class Source : std::uint8_t {
-  wire,    ///< a frame crossing the link, a link open/close
-  fault,   ///< the fault injector acted
-  client,  ///< the client reported something (reference events, an external program's output or
-           ///< exit)
-  sim,     ///< the simulated chassis (samples, stations, collisions, rest)
-  step,    ///< the scenario's own steps (operator actions, car events, waits)
-  car,     ///< the mock firmware (behaviours fired, fault state)
-};
-std::string_view to_string(Source source);  ///< "wire", "fault", ...
-
-/// One thing that happened. `kind` and `data` by source (the full list, with
+/// One thing that happened: its kind (harness/record_kind.hpp), which
+/// names its source, and its data. `kind` and `data` by source (the full list, with
 /// every field, is in docs/scenarios.md, "The timeline"):
 /// - wire, kind "frame": data {"dir": "to_car"|"to_client", "stage": "sent"|"delivered",
 ///   "frame": the frame's kind ("MV:STOP", "AUTH", "NACK"), "text" or "hex": the bytes,
@@ -79,17 +69,17 @@ std::string_view to_string(Source source);  ///< "wire", "fault", ...
 /// - car "behaviour" when a car step arms it: {"name", "action"} ("reject", "close", ...).
 struct Record {
   Time at{0};
-  Source source = Source::step;
-  std::string kind;
+  RecordKind kind{StepKind::start};
   nlohmann::json data = nlohmann::json::object();
+
+  Source source() const { return kind.source(); }
 };
 
 /// Records in the order they happened (equal times keep arrival order).
 class Timeline {
  public:
   void add(Record record);
-  void add(Time at, Source source, std::string kind,
-           nlohmann::json data = nlohmann::json::object());
+  void add(Time at, RecordKind kind, nlohmann::json data = nlohmann::json::object());
 
   const std::vector<Record>& records() const { return records_; }
   std::size_t size() const { return records_.size(); }

@@ -108,20 +108,20 @@ nlohmann::json message_fields(std::string_view message) {
 
 // ------------------------------------------------------------ RunTimeline
 
-void RunTimeline::add(Source source, std::string kind, nlohmann::json data) {
-  add_at(clock_.now(), source, std::move(kind), std::move(data));
+void RunTimeline::add(RecordKind kind, nlohmann::json data) {
+  add_at(clock_.now(), kind, std::move(data));
 }
 
-void RunTimeline::add_at(Time at, Source source, std::string kind, nlohmann::json data) {
+void RunTimeline::add_at(Time at, RecordKind kind, nlohmann::json data) {
   if (closed_) return;
   if (dispatching_) {
     // The record a listener holds lives in the timeline's vector, which
     // this would move; and the order of records would no longer be the
     // order things happened in.
-    throw std::logic_error("a timeline listener added a '" + kind +
+    throw std::logic_error("a timeline listener added a '" + std::string(kind.name()) +
                            "' record itself; it must post that work instead");
   }
-  timeline_.add(at, source, std::move(kind), std::move(data));
+  timeline_.add(at, kind, std::move(data));
   if (listeners_.empty()) return;
   // Listeners may come and go while they run: each one listening when the
   // record came is told, unless it has gone by its turn.
@@ -188,7 +188,7 @@ void WireRecorder::reset_splitters() {
 
 void WireRecorder::on_open(Time at, const std::string& client, const std::string& car) {
   reset_splitters();
-  timeline_.add_at(at, Source::wire, "open", {{"client", client}, {"car", car}});
+  timeline_.add_at(at, WireKind::open, {{"client", client}, {"car", car}});
 }
 
 void WireRecorder::on_sent(Time at, link::Direction d, protocol::ByteView bytes) {
@@ -225,7 +225,7 @@ void WireRecorder::write_frames(std::size_t stage, Time at, link::Direction d,
       data["error"] = error_kind(f.text);
       data["detail"] = f.text;
     }
-    timeline_.add_at(at, Source::wire, "frame", std::move(data));
+    timeline_.add_at(at, WireKind::frame, std::move(data));
   }
 }
 
@@ -234,7 +234,9 @@ void WireRecorder::on_fault(const link::FaultEvent& event) {
                       {"rule", event.rule},
                       {"detail", event.detail}};
   if (event.frame != 0) data["frame_number"] = event.frame;
-  timeline_.add_at(event.at, Source::fault, event.kind, std::move(data));
+  // The injector names each event's kind with link::to_string(FaultKind).
+  timeline_.add_at(event.at, link::parse_fault_kind(event.kind).value_or(link::FaultKind::drop),
+                   std::move(data));
 }
 
 void WireRecorder::on_close(Time at, const link::LinkClose& close) {
@@ -246,7 +248,7 @@ void WireRecorder::on_close(Time at, const link::LinkClose& close) {
       write_frames(stage, at, d, frames);
     }
   }
-  timeline_.add_at(at, Source::wire, "close",
+  timeline_.add_at(at, WireKind::close,
                    {{"by", std::string(link::to_string(close.by))},
                     {"reason", close.reason},
                     {"mode", close.mode == link::CloseMode::reset ? "reset" : "graceful"}});

@@ -43,9 +43,8 @@ class RunTimeline {
 
   /// Appends a record at the clock's time and tells every listener. Ignored
   /// once closed (what a run's teardown of links reports is not part of it).
-  void add(Source source, std::string kind, nlohmann::json data = nlohmann::json::object());
-  void add_at(Time at, Source source, std::string kind,
-              nlohmann::json data = nlohmann::json::object());
+  void add(RecordKind kind, nlohmann::json data = nlohmann::json::object());
+  void add_at(Time at, RecordKind kind, nlohmann::json data = nlohmann::json::object());
 
   /// Listeners see each record after it is in the timeline. They may add
   /// and remove listeners, but must not add records themselves (post the

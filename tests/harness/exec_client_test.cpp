@@ -46,19 +46,19 @@ TEST(ClientLines, ResultWordsOnlyCountAsTheFirstWord) {
 TEST(ClientLines, EventLinesBecomeTheReferenceClientsRecords) {
   auto line = parse_client_line("event connection connected");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, "connection");
+  EXPECT_EQ(line.record_kind, ClientKind::connection);
   EXPECT_EQ(line.record_data["state"], "connected");
 
   line = parse_client_line("[ 3.5] event command MV:FWD uncertain");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, "command");
+  EXPECT_EQ(line.record_kind, ClientKind::command);
   EXPECT_EQ(line.record_data["command"], "MV:FWD");
   EXPECT_EQ(line.record_data["state"], "uncertain");
 
   line = parse_client_line("event stale");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, "stale");
-  EXPECT_EQ(parse_client_line("event fresh").record_kind, "fresh");
+  EXPECT_EQ(line.record_kind, ClientKind::stale);
+  EXPECT_EQ(parse_client_line("event fresh").record_kind, ClientKind::fresh);
 
   line = parse_client_line("event notice Not in manual mode");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
@@ -66,12 +66,12 @@ TEST(ClientLines, EventLinesBecomeTheReferenceClientsRecords) {
 
   line = parse_client_line("event parse_error bad_checksum: checksum 00, computed 4D");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, "parse_error");
+  EXPECT_EQ(line.record_kind, ClientKind::parse_error);
   EXPECT_EQ(line.record_data["text"], "bad_checksum: checksum 00, computed 4D");
 
   line = parse_client_line("event movement disabled not connected");
   ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, "movement");
+  EXPECT_EQ(line.record_kind, ClientKind::movement);
   EXPECT_EQ(line.record_data["enabled"], false);
   EXPECT_EQ(line.record_data["reason"], "not connected");
   EXPECT_EQ(parse_client_line("event movement enabled").record_data["enabled"], true);

@@ -121,11 +121,11 @@ TEST(ExpectCountingLists, OnlyTheFirstFewTimesAreListed) {
 class ExpectAtTimes : public ::testing::Test {
  protected:
   void SetUp() override {
-    t_.add(ms(5000), Source::wire, "close", {{"by", "fault"}, {"reason", "dropped"}});
-    t_.add(ms(6100), Source::client, "connection", {{"state", "connected"}});
-    t_.add(ms(7900), Source::client, "connection", {{"state", "connected"}});
-    t_.add(ms(9500), Source::client, "connection", {{"state", "connected"}});
-    t_.add(ms(11250), Source::client, "connection", {{"state", "connected"}});
+    t_.add(ms(5000), WireKind::close, {{"by", "fault"}, {"reason", "dropped"}});
+    t_.add(ms(6100), ClientKind::connection, {{"state", "connected"}});
+    t_.add(ms(7900), ClientKind::connection, {{"state", "connected"}});
+    t_.add(ms(9500), ClientKind::connection, {{"state", "connected"}});
+    t_.add(ms(11250), ClientKind::connection, {{"state", "connected"}});
   }
   Expectation at(std::vector<Duration> times, bool only = false) {
     Expectation e = expect_in(client_state("connected"), whole_run(), Quantifier::at_times);
@@ -178,7 +178,7 @@ TEST_F(ExpectAtTimes, WithOnlyAMatchOutsideTheTimesFails) {
 
 TEST_F(ExpectAtTimes, TimesCountFromTheWindowStart) {
   Expectation e = at({seconds(1), seconds(3), seconds(6)});
-  e.window = Window{Anchor{Matcher{Source::wire, "close", {}, "link closed"}, 1, {}}, {}};
+  e.window = Window{Anchor{Matcher{Source::wire, WireKind::close, {}, "link closed"}, 1, {}}, {}};
   const auto o = check(e, t_, ms(20000));
   EXPECT_TRUE(o.passed) << o.message;
   EXPECT_EQ(o.window_from, ms(5000));
@@ -191,12 +191,12 @@ class ExpectAlways : public ::testing::Test {
  protected:
   void SetUp() override {
     for (int i = 0; i < 10; ++i)
-      t_.add(ms(1000 + 100 * i), Source::sim, "sample", {{"speed_mps", i < 6 ? 0.3 : 0.0}});
-    t_.add(ms(1650), Source::sim, "at_rest");
+      t_.add(ms(1000 + 100 * i), SimKind::sample, {{"speed_mps", i < 6 ? 0.3 : 0.0}});
+    t_.add(ms(1650), SimKind::at_rest);
   }
   ExpectationOutcome slow_between(Time from, Duration within) {
     return check(expect_in(Matcher{Source::sim,
-                                   "sample",
+                                   SimKind::sample,
                                    {test_of("speed_mps", Op::less, 0.01)},
                                    "speed below 0.01 m/s"},
                            between(from, within), Quantifier::always),
@@ -240,7 +240,7 @@ TEST(ExpectLabel, TheScenariosOwnLabelWinsAndOneIsMadeOtherwise) {
 
   // A matcher without the scenario's text is described from its fields.
   const Expectation bare =
-      expect_in(Matcher{Source::wire, "frame", {test_of("valid", Op::equals, false)}, ""},
+      expect_in(Matcher{Source::wire, WireKind::frame, {test_of("valid", Op::equals, false)}, ""},
                 whole_run(), Quantifier::never);
   EXPECT_EQ(check(bare, t, ms(1000)).label, "wire frame where valid = false, never");
   const Expectation last =
@@ -252,15 +252,14 @@ TEST(ExpectLabel, TheScenariosOwnLabelWinsAndOneIsMadeOtherwise) {
 
 TEST(ExpectEvidence, TheMatchesAndTheSameSourceAroundTheEdgesInTimeOrder) {
   Timeline t;
-  t.add(ms(400), Source::wire, "frame",
-        frame_data("to_client", "delivered", "FB:ST"));  // too early
-  t.add(ms(600), Source::wire, "frame", frame_data("to_client", "delivered", "FB:ST"));
+  t.add(ms(400), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));  // too early
+  t.add(ms(600), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));
   add_step_end(t, ms(1000), "release");  // another source
   add_delivered(t, ms(1200), "MV:STOP");
-  t.add(ms(1800), Source::wire, "frame", frame_data("to_client", "delivered", "FB:ST"));
-  t.add(ms(2000), Source::wire, "frame", frame_data("to_client", "delivered", "FB:ST"));  // far
+  t.add(ms(1800), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));
+  t.add(ms(2000), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));  // far
   add_delivered(t, ms(2500), "MV:STOP");
-  t.add(ms(2700), Source::wire, "frame", frame_data("to_client", "delivered", "FB:ST"));
+  t.add(ms(2700), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));
   const auto o =
       check(expect_in(car_received("MV:STOP"), between(ms(1000), milliseconds(300))), t, ms(4000));
   EXPECT_TRUE(o.passed);
@@ -276,7 +275,7 @@ TEST(ExpectEvidence, TheMatchesAndTheSameSourceAroundTheEdgesInTimeOrder) {
 TEST(ExpectEvidence, KeepsAtMostTenMatchesAndTwentyRecords) {
   Timeline t;
   for (int i = 0; i < 30; ++i)
-    t.add(ms(700 + 10 * i), Source::wire, "frame", frame_data("to_client", "delivered", "FB:ST"));
+    t.add(ms(700 + 10 * i), WireKind::frame, frame_data("to_client", "delivered", "FB:ST"));
   for (int i = 0; i < 30; ++i)
     add_delivered(t, ms(1000 + 10 * i), "MV:FWD");
   const auto o = check(
@@ -314,7 +313,7 @@ TEST(ExpectIssueExamples, StopWithin300msOfTheRelease) {
   const auto timeline = [](Time received) {
     Timeline t;
     add_step_end(t, ms(5000), "release");
-    t.add(ms(5050), Source::wire, "frame", frame_data("to_car", "sent", "MV:STOP"));
+    t.add(ms(5050), WireKind::frame, frame_data("to_car", "sent", "MV:STOP"));
     add_delivered(t, received, "MV:STOP");
     return t;
   };
@@ -335,19 +334,19 @@ TEST(ExpectIssueExamples, StopWithin300msOfTheRelease) {
 // "after the connection dropped at 5 s the client reconnected at 6 s, 8 s and
 // 11 s, each within 250 ms"
 TEST(ExpectIssueExamples, ReconnectsOnTheBackoffSchedule) {
-  Expectation e =
-      expect_in(client_state("connected"),
-                Window{Anchor{Matcher{Source::wire, "close", {}, "link closed"}, 1, {}}, {}},
-                Quantifier::at_times);
+  Expectation e = expect_in(
+      client_state("connected"),
+      Window{Anchor{Matcher{Source::wire, WireKind::close, {}, "link closed"}, 1, {}}, {}},
+      Quantifier::at_times);
   e.times = {seconds(1), seconds(3), seconds(6)};
   e.tolerance = milliseconds(250);
   const auto timeline = [](std::vector<std::int64_t> reconnects_ms) {
     Timeline t;
-    t.add(ms(200), Source::client, "connection", {{"state", "connected"}});
-    t.add(ms(5000), Source::wire, "close", {{"by", "fault"}, {"reason", "dropped"}});
+    t.add(ms(200), ClientKind::connection, {{"state", "connected"}});
+    t.add(ms(5000), WireKind::close, {{"by", "fault"}, {"reason", "dropped"}});
     for (const auto at : reconnects_ms) {
-      t.add(ms(at - 1), Source::client, "connection", {{"state", "connecting"}});
-      t.add(ms(at), Source::client, "connection", {{"state", "connected"}});
+      t.add(ms(at - 1), ClientKind::connection, {{"state", "connecting"}});
+      t.add(ms(at), ClientKind::connection, {{"state", "connected"}});
     }
     return t;
   };
@@ -367,7 +366,7 @@ TEST(ExpectIssueExamples, ExactlyOneRun) {
   const Expectation e = expect_in(car_received("ST:RUN"), whole_run(), Quantifier::exactly, 1);
   Timeline t;
   add_delivered(t, ms(1000), "ST:RUN");
-  t.add(ms(1000), Source::wire, "frame", frame_data("to_car", "sent", "ST:RUN"));
+  t.add(ms(1000), WireKind::frame, frame_data("to_car", "sent", "ST:RUN"));
   EXPECT_TRUE(check(e, t, ms(3000)).passed);
   add_delivered(t, ms(2000), "ST:RUN");
   const auto twice = check(e, t, ms(3000));
@@ -380,16 +379,18 @@ TEST(ExpectIssueExamples, ExactlyOneRun) {
 
 // "the car reached station 002 within 90 s and stopped"
 TEST(ExpectIssueExamples, ReachesStationTwoAndStops) {
-  const Matcher station{Source::sim, "station", {test_of("station", Op::equals, 2)}, "station 2"};
+  const Matcher station{
+      Source::sim, SimKind::station, {test_of("station", Op::equals, 2)}, "station 2"};
   const Expectation reached = expect_in(station, between(ms(0), seconds(90)));
-  const Expectation stopped = expect_in(Matcher{Source::sim, "at_rest", {}, "chassis at rest"},
-                                        Window{Anchor{station, 1, {}}, seconds(1)});
+  const Expectation stopped =
+      expect_in(Matcher{Source::sim, SimKind::at_rest, {}, "chassis at rest"},
+                Window{Anchor{station, 1, {}}, seconds(1)});
   // Station 1 at 30 s, station 2 at `station_2`, at rest at `at_rest`.
   const auto timeline = [](Time station_2, Time at_rest) {
     Timeline t;
-    t.add(ms(30000), Source::sim, "station", {{"station", 1}});
-    t.add(station_2, Source::sim, "station", {{"station", 2}});
-    t.add(at_rest, Source::sim, "at_rest");
+    t.add(ms(30000), SimKind::station, {{"station", 1}});
+    t.add(station_2, SimKind::station, {{"station", 2}});
+    t.add(at_rest, SimKind::at_rest);
     return t;
   };
   const auto both = check_all({reached, stopped}, timeline(ms(61000), ms(61400)), ms(62000));
@@ -411,20 +412,20 @@ TEST(ExpectIssueExamples, ReachesStationTwoAndStops) {
 TEST(ExpectIssueExamples, NeverABadChecksumFromTheClient) {
   const Expectation e =
       expect_in(Matcher{Source::wire,
-                        "frame",
+                        WireKind::frame,
                         {test_of("dir", Op::equals, "to_car"), test_of("stage", Op::equals, "sent"),
                          test_of("error", Op::equals, "checksum")},
                         "client sent a frame with a bad checksum"},
                 whole_run(), Quantifier::never);
   Timeline t;
-  t.add(ms(1000), Source::wire, "frame", frame_data("to_car", "sent", "MV:FWD"));
+  t.add(ms(1000), WireKind::frame, frame_data("to_car", "sent", "MV:FWD"));
   // Corrupted on the way by a fault: the client is not to blame.
-  t.add(ms(1000), Source::wire, "frame",
+  t.add(ms(1000), WireKind::frame,
         {{"dir", "to_car"}, {"stage", "delivered"}, {"valid", false}, {"error", "checksum"}});
   const auto ok = check(e, t, ms(5000));
   EXPECT_TRUE(ok.passed) << ok.message;
 
-  t.add(ms(2500), Source::wire, "frame",
+  t.add(ms(2500), WireKind::frame,
         {{"dir", "to_car"}, {"stage", "sent"}, {"valid", false}, {"error", "checksum"}});
   const auto bad = check(e, t, ms(5000));
   EXPECT_FALSE(bad.passed);
@@ -437,16 +438,16 @@ TEST(ExpectIssueExamples, NeverABadChecksumFromTheClient) {
 
 // "the chassis was at rest within 1 s of the emergency stop"
 TEST(ExpectIssueExamples, AtRestWithinOneSecondOfTheEmergencyStop) {
-  const Expectation e = expect_in(Matcher{Source::sim, "at_rest", {}, "chassis at rest"},
+  const Expectation e = expect_in(Matcher{Source::sim, SimKind::at_rest, {}, "chassis at rest"},
                                   Window{Anchor{step_end("estop"), 1, {}}, seconds(1)});
   // At rest at 1 s, moving at 2 s, the emergency stop at 4 s, and then...
   Timeline coasting;
-  coasting.add(ms(1000), Source::sim, "at_rest");
-  coasting.add(ms(2000), Source::sim, "moving");
+  coasting.add(ms(1000), SimKind::at_rest);
+  coasting.add(ms(2000), SimKind::moving);
   add_step_end(coasting, ms(4000), "estop");
   // ... at rest again at 4.6 s.
   Timeline good = coasting;
-  good.add(ms(4600), Source::sim, "at_rest");
+  good.add(ms(4600), SimKind::at_rest);
   EXPECT_TRUE(check(e, good, ms(6000)).passed);
 
   // ... still moving.
@@ -478,7 +479,7 @@ RandomRun random_run() {
     else if (pick == 1)
       add_delivered(run.timeline, ms(at), "MV:FWD");
     else
-      run.timeline.add(ms(at), Source::client, "connection", {{"state", "connected"}});
+      run.timeline.add(ms(at), ClientKind::connection, {{"state", "connected"}});
   }
   run.from = ms(*rc::gen::inRange(0, 2000));
   run.within = milliseconds(*rc::gen::inRange(0, 1000));
@@ -490,7 +491,7 @@ RC_GTEST_PROP(ExpectProperties, CountingQuantifiersAgreeWithABruteForceCount, ()
   const Matcher what = car_received("MV:STOP");
   std::uint64_t brute = 0;
   for (const auto& r : run.timeline.records())
-    if (r.source == Source::wire && r.data["frame"] == "MV:STOP" && r.at >= run.from &&
+    if (r.source() == Source::wire && r.data["frame"] == "MV:STOP" && r.at >= run.from &&
         r.at <= run.from + run.within)
       ++brute;
   const auto count = static_cast<std::uint64_t>(*rc::gen::inRange(0, 6));
@@ -529,7 +530,7 @@ RC_GTEST_PROP(ExpectProperties, MatchesAtTheAskedTimesAlwaysSatisfyAtTimes, ()) 
   e.tolerance = milliseconds(250);
   e.only = true;
   for (const int at : offsets) {
-    t.add(ms(at + 300 + jitter_ms), Source::client, "connection", {{"state", "connected"}});
+    t.add(ms(at + 300 + jitter_ms), ClientKind::connection, {{"state", "connected"}});
     e.times.push_back(ms(at + 300));
   }
   const auto o = check(e, t, ms(6000));
@@ -597,7 +598,7 @@ TEST(ExpectSlack, AnEventEdgeDoesNotMove) {
 
 TEST(ExpectSlack, TimesGetTheSlackOnTheirTolerance) {
   Timeline t;
-  t.add(ms(6080), Source::client, "connection", {{"state", "connecting"}});
+  t.add(ms(6080), ClientKind::connection, {{"state", "connecting"}});
   Expectation e =
       expect_in(client_state("connecting"), run_times(5000, 20000), Quantifier::at_times);
   e.times = {seconds(1)};

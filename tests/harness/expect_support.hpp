@@ -28,19 +28,22 @@ inline FieldTest test_of(std::string field, Op op, nlohmann::json value) {
 // The matchers as the loader builds them from QA's shorthand.
 inline Matcher car_received(const std::string& frame) {
   return Matcher{Source::wire,
-                 "frame",
+                 WireKind::frame,
                  {test_of("dir", Op::equals, "to_car"), test_of("stage", Op::equals, "delivered"),
                   test_of("frame", Op::kind_prefix, frame)},
                  "car received " + frame};
 }
 
 inline Matcher step_end(const std::string& text) {
-  return Matcher{Source::step, "end", {test_of("text", Op::equals, text)}, "step '" + text + "'"};
+  return Matcher{
+      Source::step, StepKind::end, {test_of("text", Op::equals, text)}, "step '" + text + "'"};
 }
 
 inline Matcher client_state(const std::string& state) {
-  return Matcher{
-      Source::client, "connection", {test_of("state", Op::equals, state)}, "client " + state};
+  return Matcher{Source::client,
+                 ClientKind::connection,
+                 {test_of("state", Op::equals, state)},
+                 "client " + state};
 }
 
 inline nlohmann::json frame_data(const std::string& dir, const std::string& stage,
@@ -49,15 +52,15 @@ inline nlohmann::json frame_data(const std::string& dir, const std::string& stag
 }
 
 inline void add_delivered(Timeline& t, Time at, const std::string& frame) {
-  t.add(at, Source::wire, "frame", frame_data("to_car", "delivered", frame));
+  t.add(at, WireKind::frame, frame_data("to_car", "delivered", frame));
 }
 
 inline void add_step_end(Timeline& t, Time at, const std::string& text) {
-  t.add(at, Source::step, "end", {{"index", 0}, {"line", 10}, {"text", text}, {"ok", true}});
+  t.add(at, StepKind::end, {{"index", 0}, {"line", 10}, {"text", text}, {"ok", true}});
 }
 
-inline Record record_with(nlohmann::json data, std::string kind = "sample") {
-  return Record{ms(0), Source::sim, std::move(kind), std::move(data)};
+inline Record record_with(nlohmann::json data, RecordKind kind = SimKind::sample) {
+  return Record{ms(0), kind, std::move(data)};
 }
 
 inline Expectation expect_in(Matcher what, Window window, Quantifier q = Quantifier::exists,

@@ -34,16 +34,18 @@ void expect_fields(const std::vector<FieldsCase>& cases, Holds&& holds) {
 // ------------------------------------------------------------------ matches
 
 TEST(ExpectMatches, NeedsTheSourceAndTheKindUnlessTheKindIsEmpty) {
-  const Record r{ms(1), Source::client, "stale", {}};
-  EXPECT_TRUE(matches(Matcher{Source::client, "stale", {}, ""}, r));
-  EXPECT_TRUE(matches(Matcher{Source::client, "", {}, ""}, r));
-  EXPECT_FALSE(matches(Matcher{Source::client, "notice", {}, ""}, r));
-  EXPECT_FALSE(matches(Matcher{Source::wire, "stale", {}, ""}, r));
+  const Record r{ms(1), ClientKind::stale, {}};
+  EXPECT_TRUE(matches(Matcher{Source::client, ClientKind::stale, {}, ""}, r));
+  EXPECT_TRUE(matches(Matcher{Source::client, std::nullopt, {}, ""}, r));
+  EXPECT_FALSE(matches(Matcher{Source::client, ClientKind::notice, {}, ""}, r));
+  EXPECT_FALSE(matches(Matcher{Source::wire, std::nullopt, {}, ""}, r));
 }
 
 TEST(ExpectMatches, EqualsComparesNumbersByValueAndNothingElseAcrossTypes) {
   const Record r = record_with({{"station", 2}, {"name", "2"}, {"on", true}});
-  const auto holds = [&](FieldTest t) { return matches(Matcher{Source::sim, "", {t}, ""}, r); };
+  const auto holds = [&](FieldTest t) {
+    return matches(Matcher{Source::sim, std::nullopt, {t}, ""}, r);
+  };
   EXPECT_TRUE(holds(test_of("station", Op::equals, 2.0)));
   EXPECT_TRUE(holds(test_of("station", Op::equals, 2u)));
   EXPECT_FALSE(holds(test_of("station", Op::equals, 3)));
@@ -60,16 +62,17 @@ TEST(ExpectMatches, AMissingFieldFailsEveryTestExceptNotEquals) {
   const Record r = record_with({{"speed_mps", 0.0}});
   for (const Op op : {Op::equals, Op::kind_prefix, Op::contains, Op::less, Op::less_equal,
                       Op::greater, Op::greater_equal}) {
-    EXPECT_FALSE(matches(Matcher{Source::sim, "", {test_of("station", op, 1)}, ""}, r))
+    EXPECT_FALSE(matches(Matcher{Source::sim, std::nullopt, {test_of("station", op, 1)}, ""}, r))
         << static_cast<int>(op);
   }
-  EXPECT_TRUE(matches(Matcher{Source::sim, "", {test_of("station", Op::not_equals, 1)}, ""}, r));
+  EXPECT_TRUE(
+      matches(Matcher{Source::sim, std::nullopt, {test_of("station", Op::not_equals, 1)}, ""}, r));
 }
 
 TEST(ExpectMatches, KindPrefixMatchesWholePartsOnly) {
   const auto received = [](const std::string& frame) {
     return matches(car_received("MV"),
-                   Record{ms(0), Source::wire, "frame", frame_data("to_car", "delivered", frame)});
+                   Record{ms(0), WireKind::frame, frame_data("to_car", "delivered", frame)});
   };
   EXPECT_TRUE(received("MV"));
   EXPECT_TRUE(received("MV:STOP"));
@@ -77,8 +80,8 @@ TEST(ExpectMatches, KindPrefixMatchesWholePartsOnly) {
   EXPECT_FALSE(received("MVX"));
   EXPECT_FALSE(received("ST:MV"));
   // The direction and stage still count.
-  EXPECT_FALSE(matches(car_received("MV"), Record{ms(0), Source::wire, "frame",
-                                                  frame_data("to_car", "sent", "MV:STOP")}));
+  EXPECT_FALSE(matches(car_received("MV"),
+                       Record{ms(0), WireKind::frame, frame_data("to_car", "sent", "MV:STOP")}));
 }
 
 /// The first expectation's matcher of a LOGI scenario whose expect list is `expectation`.
@@ -93,7 +96,7 @@ Matcher loaded(const std::string& expectation, const std::string& car = "logi") 
 Record frame_record(const std::string& dir, const std::string& stage, nlohmann::json data) {
   data["dir"] = dir;
   data["stage"] = stage;
-  return Record{ms(0), Source::wire, "frame", std::move(data)};
+  return Record{ms(0), WireKind::frame, std::move(data)};
 }
 
 TEST(ExpectMatches, ADamagedFrameNamedOnlyAsFarAsTheDecoderGotCountsAsInvalidOfTheKind) {
@@ -189,18 +192,18 @@ TEST(ExpectMatches, AFieldWithLeadingZerosIsTextAndMatchesOnlyItsOwnDigits) {
 }
 
 TEST(ExpectMatches, AFieldPathWalksIntoObjectsAndAFailureShowsWhatTheRecordHad) {
-  const Record r{ms(0), Source::wire, "frame", {{"fields", {{"percent", 30}}}}};
-  EXPECT_TRUE(
-      matches(Matcher{Source::wire, "", {test_of("fields.percent", Op::equals, 30)}, ""}, r));
-  EXPECT_FALSE(
-      matches(Matcher{Source::wire, "", {test_of("fields.percent.x", Op::equals, 30)}, ""}, r));
-  EXPECT_FALSE(
-      matches(Matcher{Source::wire, "", {test_of("fields.speed", Op::equals, 30)}, ""}, r));
+  const Record r{ms(0), WireKind::frame, {{"fields", {{"percent", 30}}}}};
+  EXPECT_TRUE(matches(
+      Matcher{Source::wire, std::nullopt, {test_of("fields.percent", Op::equals, 30)}, ""}, r));
+  EXPECT_FALSE(matches(
+      Matcher{Source::wire, std::nullopt, {test_of("fields.percent.x", Op::equals, 30)}, ""}, r));
+  EXPECT_FALSE(matches(
+      Matcher{Source::wire, std::nullopt, {test_of("fields.speed", Op::equals, 30)}, ""}, r));
 
   Timeline t;
   t.add(r);
   Expectation e;
-  e.what = Matcher{Source::wire, "frame", {test_of("fields.percent", Op::greater, 50)}, ""};
+  e.what = Matcher{Source::wire, WireKind::frame, {test_of("fields.percent", Op::greater, 50)}, ""};
   e.quantifier = Quantifier::always;
   const auto outcome = check(e, t, ms(100));
   EXPECT_FALSE(outcome.passed);
@@ -211,7 +214,7 @@ TEST(ExpectAlwaysOnFrames, JudgesOnlyTheFramesOfTheDirectionStageAndKindAsked) {
   Timeline t;
   const auto stat = [&](Time at, const std::string& dir, const std::string& stage,
                         const std::string& mode) {
-    t.add(at, Source::wire, "frame",
+    t.add(at, WireKind::frame,
           {{"dir", dir},
            {"stage", stage},
            {"frame", "STAT"},
@@ -220,7 +223,7 @@ TEST(ExpectAlwaysOnFrames, JudgesOnlyTheFramesOfTheDirectionStageAndKindAsked) {
   };
   stat(ms(500), "to_client", "sent", "MAN");
   stat(ms(500), "to_client", "delivered", "MAN");
-  t.add(ms(600), Source::wire, "frame",
+  t.add(ms(600), WireKind::frame,
         {{"dir", "to_car"}, {"stage", "delivered"}, {"frame", "MD:AUTO"}, {"valid", true}});
   stat(ms(1000), "to_client", "sent", "AUTO");  // sent, but lost on the way
   stat(ms(1500), "to_client", "delivered", "MAN");
@@ -241,17 +244,21 @@ TEST(ExpectAlwaysOnFrames, JudgesOnlyTheFramesOfTheDirectionStageAndKindAsked) {
 }
 
 TEST(ExpectMatches, TheFieldKindTestsTheRecordsKind) {
-  const Record r{ms(0), Source::fault, "drop:burst", {{"dir", "to_car"}}};
-  EXPECT_TRUE(
-      matches(Matcher{Source::fault, "", {test_of("kind", Op::kind_prefix, "drop")}, ""}, r));
-  EXPECT_TRUE(
-      matches(Matcher{Source::fault, "", {test_of("kind", Op::equals, "drop:burst")}, ""}, r));
-  EXPECT_FALSE(matches(Matcher{Source::fault, "", {test_of("kind", Op::equals, "drop")}, ""}, r));
+  const Record r{ms(0), link::FaultKind::drop, {{"dir", "to_car"}}};
+  const auto kind_is = [&](Op op, const char* word) {
+    return matches(Matcher{Source::fault, std::nullopt, {test_of("kind", op, word)}, ""}, r);
+  };
+  EXPECT_TRUE(kind_is(Op::kind_prefix, "drop"));
+  EXPECT_TRUE(kind_is(Op::equals, "drop"));
+  EXPECT_FALSE(kind_is(Op::equals, "corrupt"));
+  EXPECT_FALSE(kind_is(Op::kind_prefix, "dup"));
 }
 
 TEST(ExpectMatches, ContainsLooksForASubstringOfAString) {
-  const Record r{ms(0), Source::client, "notice", {{"text", "Not in manual mode"}, {"n", 12}}};
-  const auto holds = [&](FieldTest t) { return matches(Matcher{Source::client, "", {t}, ""}, r); };
+  const Record r{ms(0), ClientKind::notice, {{"text", "Not in manual mode"}, {"n", 12}}};
+  const auto holds = [&](FieldTest t) {
+    return matches(Matcher{Source::client, std::nullopt, {t}, ""}, r);
+  };
   EXPECT_TRUE(holds(test_of("text", Op::contains, "manual")));
   EXPECT_TRUE(holds(test_of("text", Op::contains, "Not in manual mode")));
   EXPECT_FALSE(holds(test_of("text", Op::contains, "Manual")));
@@ -261,7 +268,8 @@ TEST(ExpectMatches, ContainsLooksForASubstringOfAString) {
 TEST(ExpectMatches, OrderingTestsCompareNumbersAtTheirBoundaries) {
   const Record r = record_with({{"speed_mps", 0.5}, {"label", "fast"}});
   const auto holds = [&](Op op, nlohmann::json v) {
-    return matches(Matcher{Source::sim, "sample", {test_of("speed_mps", op, std::move(v))}, ""}, r);
+    return matches(
+        Matcher{Source::sim, SimKind::sample, {test_of("speed_mps", op, std::move(v))}, ""}, r);
   };
   EXPECT_TRUE(holds(Op::less, 0.6));
   EXPECT_FALSE(holds(Op::less, 0.5));
@@ -272,14 +280,15 @@ TEST(ExpectMatches, OrderingTestsCompareNumbersAtTheirBoundaries) {
   EXPECT_TRUE(holds(Op::greater_equal, 0.5));
   EXPECT_FALSE(holds(Op::greater_equal, 1));
   EXPECT_FALSE(holds(Op::less, "1"));
-  EXPECT_FALSE(matches(Matcher{Source::sim, "sample", {test_of("label", Op::less, 1)}, ""}, r));
+  EXPECT_FALSE(
+      matches(Matcher{Source::sim, SimKind::sample, {test_of("label", Op::less, 1)}, ""}, r));
 }
 
 TEST(ExpectMatches, EveryTestMustHold) {
-  const Record r{ms(0), Source::wire, "frame", frame_data("to_client", "delivered", "MV:STOP")};
+  const Record r{ms(0), WireKind::frame, frame_data("to_client", "delivered", "MV:STOP")};
   EXPECT_FALSE(matches(car_received("MV:STOP"), r));
-  EXPECT_TRUE(
-      matches(Matcher{Source::wire, "frame", {test_of("frame", Op::equals, "MV:STOP")}, ""}, r));
+  EXPECT_TRUE(matches(
+      Matcher{Source::wire, WireKind::frame, {test_of("frame", Op::equals, "MV:STOP")}, ""}, r));
 }
 
 // ------------------------------------------------------------------ resolve
@@ -333,7 +342,7 @@ TEST(ExpectWindow, IncludesBothEndsAndNothingANanosecondBeyond) {
   EXPECT_TRUE(check(e, at_start, ms(10000)).passed);
 
   Timeline early;
-  early.add(ms(1000) - nanoseconds(1), Source::wire, "frame",
+  early.add(ms(1000) - nanoseconds(1), WireKind::frame,
             frame_data("to_car", "delivered", "MV:STOP"));
   add_step_end(early, ms(1000), "release");
   EXPECT_FALSE(check(e, early, ms(10000)).passed);

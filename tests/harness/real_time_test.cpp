@@ -38,7 +38,7 @@ Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Ste
 
 std::vector<std::string> lines_of(const ScenarioOutcome& o) {
   std::vector<std::string> out;
-  for (const auto& r : of(o, Source::client, "output"))
+  for (const auto& r : of(o, ClientKind::output))
     out.push_back(r.data["line"].get<std::string>());
   return out;
 }
@@ -46,7 +46,7 @@ std::vector<std::string> lines_of(const ScenarioOutcome& o) {
 // The frames the car decoded, in order: what the client made it do.
 std::vector<std::string> received(const ScenarioOutcome& o) {
   std::vector<std::string> out;
-  for (const auto& r : of(o, Source::wire, "frame"))
+  for (const auto& r : of(o, WireKind::frame))
     if (r.data["dir"] == "to_car" && r.data["stage"] == "delivered" && r.data["valid"] == true)
       out.push_back(r.data["frame"].get<std::string>());
   return out;
@@ -86,7 +86,7 @@ TEST(ExternalClient, EachActionLineGetsItsResultAndAFailGivesItsReason) {
   EXPECT_FALSE(o.steps[2].ran) << "the sequence stops at the failed step";
   EXPECT_FALSE(o.passed());
 
-  const auto exits = of(o, Source::client, "exit");
+  const auto exits = of(o, ClientKind::exit);
   ASSERT_EQ(exits.size(), 1u) << summary(o);
   EXPECT_EQ(exits[0].data["code"], 0);
   ASSERT_FALSE(o.expectations.empty());
@@ -107,22 +107,24 @@ TEST(ExternalClient, EventLinesAndOtherOutputAreRecordedForExpectations) {
   Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
   Expectation connected;
   connected.label = "the client said it connected";
-  connected.what = Matcher{
-      Source::client, "connection", {{"state", FieldTest::Op::equals, "connected"}}, "connected"};
+  connected.what = Matcher{Source::client,
+                           ClientKind::connection,
+                           {{"state", FieldTest::Op::equals, "connected"}},
+                           "connected"};
   s.expectations.push_back(connected);
   const ScenarioOutcome o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << summary(o);
 
-  const auto states = of(o, Source::client, "connection");
+  const auto states = of(o, ClientKind::connection);
   ASSERT_EQ(states.size(), 3u);
   EXPECT_EQ(states[0].data["state"], "connecting");
   EXPECT_EQ(states[1].data["state"], "connected");
   EXPECT_EQ(states[2].data["state"], "disconnected");
-  const auto commands = of(o, Source::client, "command");
+  const auto commands = of(o, ClientKind::command);
   ASSERT_EQ(commands.size(), 1u);
   EXPECT_EQ(commands[0].data["command"], "SP");
   EXPECT_EQ(commands[0].data["state"], "accepted");
-  const auto outputs = of(o, Source::client, "output");
+  const auto outputs = of(o, ClientKind::output);
   ASSERT_EQ(outputs.size(), 2u) << summary(o);
   for (const auto& r : outputs) {
     if (r.data["stream"] == "stdout")
@@ -130,7 +132,7 @@ TEST(ExternalClient, EventLinesAndOtherOutputAreRecordedForExpectations) {
     else
       EXPECT_EQ(r.data["line"], "to stderr");
   }
-  EXPECT_LT(states[2].at, of(o, Source::client, "exit").at(0).at + milliseconds(1))
+  EXPECT_LT(states[2].at, of(o, ClientKind::exit).at(0).at + milliseconds(1))
       << "what it printed on the way out is part of the run";
 }
 
@@ -153,14 +155,14 @@ s.close()
   ASSERT_TRUE(o.passed()) << summary(o);
   const auto lines = lines_of(o);
   ASSERT_EQ(lines.size(), 2u) << summary(o);
-  const auto opens = of(o, Source::wire, "open");
+  const auto opens = of(o, WireKind::open);
   ASSERT_EQ(opens.size(), 1u) << "the program reached the mock car";
   // "arg 127.0.0.1 PORT": a real port, and the same in the environment.
   ASSERT_EQ(lines[1].rfind("arg 127.0.0.1 ", 0), 0u) << lines[1];
   const std::string port = lines[1].substr(std::string("arg 127.0.0.1 ").size());
   EXPECT_GT(std::stoi(port), 0);
   EXPECT_EQ(lines[0], "env 127.0.0.1 " + port + " tcp://127.0.0.1:" + port);
-  EXPECT_EQ(of(o, Source::wire, "close").size(), 1u);
+  EXPECT_EQ(of(o, WireKind::close).size(), 1u);
 }
 
 TEST(ExternalClient, ASerialCarGivesThePathOfItsPty) {
@@ -183,7 +185,7 @@ TEST(ExternalClient, AProgramThatExitsEarlyFailsTheActionsItOwes) {
   ASSERT_EQ(o.steps.size(), 2u);
   EXPECT_FALSE(o.steps[0].ok);
   EXPECT_EQ(o.steps[0].reason, "the client exited with code 3 before answering");
-  const auto exits = of(o, Source::client, "exit");
+  const auto exits = of(o, ClientKind::exit);
   ASSERT_EQ(exits.size(), 1u);
   EXPECT_EQ(exits[0].data["code"], 3);
   EXPECT_FALSE(o.expectations.back().passed) << "exit code 3 is not a clean exit";
@@ -198,11 +200,11 @@ TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
   ASSERT_TRUE(o.error.empty()) << o.error;
   EXPECT_TRUE(o.steps[0].ok);
   EXPECT_FALSE(o.passed());
-  const auto exits = of(o, Source::client, "exit");
+  const auto exits = of(o, ClientKind::exit);
   ASSERT_EQ(exits.size(), 1u) << summary(o);
   EXPECT_EQ(exits[0].data["signal"], 9);
   EXPECT_EQ(exits[0].data["killed"], true);
-  const auto notices = of(o, Source::client, "notice");
+  const auto notices = of(o, ClientKind::notice);
   ASSERT_EQ(notices.size(), 2u);
   EXPECT_EQ(notices[0].data["text"],
             "the client did not exit within 5 s of its input closing: sent SIGTERM");
@@ -233,7 +235,7 @@ TEST(ExternalClient, AnOkResultHasNoReason) {
   Scenario s = exec_scenario(mocks::CarKind::logi, kEchoClient, {action("speed 50")});
   const ScenarioOutcome o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << summary(o);
-  const auto actions = of(o, Source::client, "action");
+  const auto actions = of(o, ClientKind::action);
   ASSERT_EQ(actions.size(), 1u);
   EXPECT_EQ(actions[0].data["reason"], "");
 }
@@ -247,12 +249,14 @@ TEST(ExternalClient, WhatTheProgramDoesAfterItsInputClosedIsNotJudgedByTheScenar
   Expectation never;
   never.label = "no ST:STOP during the session";
   never.quantifier = Quantifier::never;
-  never.what = Matcher{
-      Source::client, "command", {{"command", FieldTest::Op::equals, "ST:STOP"}}, "ST:STOP"};
+  never.what = Matcher{Source::client,
+                       ClientKind::command,
+                       {{"command", FieldTest::Op::equals, "ST:STOP"}},
+                       "ST:STOP"};
   s.expectations.push_back(never);
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
-  EXPECT_EQ(of(o, Source::client, "command").size(), 1u) << "still in the timeline";
+  EXPECT_EQ(of(o, ClientKind::command).size(), 1u) << "still in the timeline";
   EXPECT_EQ(o.expectations.size(), 2u);
 }
 
@@ -274,7 +278,8 @@ TEST(ExternalClient, AnExpectationOnTheExitCodeReplacesTheCleanExitRule) {
                     {action("speed 50")});
   Expectation exit;
   exit.label = "exits with 4";
-  exit.what = Matcher{Source::client, "exit", {{"code", FieldTest::Op::equals, 4}}, "exit 4"};
+  exit.what =
+      Matcher{Source::client, ClientKind::exit, {{"code", FieldTest::Op::equals, 4}}, "exit 4"};
   s.expectations.push_back(exit);
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);

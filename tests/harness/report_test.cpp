@@ -27,7 +27,7 @@ Record frame(int at_ms, const char* dir, const char* stage, const char* text, bo
   nlohmann::json data = {
       {"dir", dir}, {"stage", stage}, {"frame", "MV:STOP"}, {"text", text}, {"valid", valid}};
   if (!valid) data["error"] = "checksum";
-  return Record{milliseconds(at_ms), Source::wire, "frame", data};
+  return Record{milliseconds(at_ms), WireKind::frame, data};
 }
 
 StepOutcome step(int line, const char* text, bool ok, const char* reason, int from_ms, int to_ms) {
@@ -76,10 +76,10 @@ ScenarioOutcome passing() {
 
 ScenarioOutcome failed_step() {
   ScenarioOutcome o = logi_run("reject", "rejected-mode", 11, 2000, 0.1);
-  o.timeline.add(milliseconds(1000), Source::step, "start", {{"text", "mode MAN"}});
+  o.timeline.add(milliseconds(1000), StepKind::start, {{"text", "mode MAN"}});
   o.timeline.add(frame(1000, "to_car", "delivered", "LOGI:MO:MAN:xx#"));
-  o.timeline.add(milliseconds(1100), Source::sim, "sample", {{"x_m", 1.0}});
-  o.timeline.add(milliseconds(1500), Source::client, "notice", {{"text", "mode refused"}});
+  o.timeline.add(milliseconds(1100), SimKind::sample, {{"x_m", 1.0}});
+  o.timeline.add(milliseconds(1500), ClientKind::notice, {{"text", "mode refused"}});
   o.steps = {step(4, "connect", true, "", 0, 100),
              step(6, "mode MAN", false, "the car refused MO:MAN", 1000, 1500),
              step(7, "press FWD", false, "not run", 1500, 1500)};
@@ -246,13 +246,14 @@ TEST(ReportConsole, RecordsReadAsOneLineEach) {
             "    5.000 s  wire    car received  LOGI:MV:STOP:A1#\\r\\n");
   EXPECT_EQ(format_record(frame(12, "to_client", "sent", "LOGI:X:00#", false)),
             "    0.012 s  wire    car sent  LOGI:X:00#  (invalid: checksum)");
-  EXPECT_EQ(format_record(
-                Record{milliseconds(6000), Source::client, "connection", {{"state", "connected"}}}),
-            "    6.000 s  client  connection connected");
-  EXPECT_EQ(format_record(Record{milliseconds(90000), Source::sim, "station", {{"station", 2}}}),
+  EXPECT_EQ(
+      format_record(Record{milliseconds(6000), ClientKind::connection, {{"state", "connected"}}}),
+      "    6.000 s  client  connection connected");
+  EXPECT_EQ(format_record(Record{milliseconds(90000), SimKind::station, {{"station", 2}}}),
             "   90.000 s  sim     station 2");
-  EXPECT_EQ(format_record(Record{milliseconds(1), Source::car, "mystery", {{"a", 1}}}),
-            "    0.001 s  car     mystery {\"a\":1}");
+  // A kind with no words of its own shows everything it carries.
+  EXPECT_EQ(format_record(Record{milliseconds(1), ClientKind::start, {{"a", 1}}}),
+            "    0.001 s  client  start {\"a\":1}");
 }
 
 // Markup outside tags must be only what the writer put there: after
@@ -412,9 +413,9 @@ TEST(ReportPlayback, RunPagesDrawWithTheLiveViewsScriptAndCarryTheRun) {
   o.trajectories = {t};
   o.timeline.add(frame(130, "to_car", "sent", "LOGI:MV:STOP:A1#"));
   o.timeline.add(frame(140, "to_client", "delivered", "</script><b>", false));
-  o.timeline.add(milliseconds(150), Source::fault, "corrupt",
+  o.timeline.add(milliseconds(150), link::FaultKind::corrupt,
                  {{"dir", "to_client"}, {"rule", "bad-cs"}, {"detail", "checksum"}});
-  o.timeline.add(milliseconds(160), Source::client, "notice", {{"text", "parse error"}});
+  o.timeline.add(milliseconds(160), ClientKind::notice, {{"text", "parse error"}});
 
   const std::string page = run_page_html(entry(o));
   // The same drawing as `hil mock --view`, inline: the page opens offline.

@@ -37,11 +37,11 @@ Step faults(std::string text, link::FaultProfile p) {
   return step_of(std::move(text), FaultsStep{std::move(p)});
 }
 
-Matcher sim_kind(std::string kind) {
-  return Matcher{Source::sim, std::move(kind), {}, "sim"};
+Matcher sim_kind(SimKind kind) {
+  return Matcher{Source::sim, kind, {}, "sim"};
 }
 Matcher station(int n) {
-  return Matcher{Source::sim, "station", {{"station", FieldTest::Op::equals, n}}, "station"};
+  return Matcher{Source::sim, SimKind::station, {{"station", FieldTest::Op::equals, n}}, "station"};
 }
 
 Scenario scenario(mocks::CarKind kind, std::vector<Step> steps) {
@@ -56,14 +56,13 @@ Scenario scenario(mocks::CarKind kind, std::vector<Step> steps) {
 std::vector<Record> wire(const ScenarioOutcome& o, const std::string& dir,
                          const std::string& stage) {
   std::vector<Record> out;
-  for (const auto& r : of(o, Source::wire, "frame"))
+  for (const auto& r : of(o, WireKind::frame))
     if (r.data["dir"] == dir && r.data["stage"] == stage) out.push_back(r);
   return out;
 }
 
-std::optional<Time> step_time(const ScenarioOutcome& o, const std::string& kind,
-                              const std::string& text) {
-  for (const auto& r : of(o, Source::step, kind))
+std::optional<Time> step_time(const ScenarioOutcome& o, StepKind kind, const std::string& text) {
+  for (const auto& r : of(o, kind))
     if (r.data["text"] == text) return r.at;
   return std::nullopt;
 }
@@ -88,13 +87,13 @@ TEST(RunnerLogi, ReleaseSendsMvStopAtTheReleaseStepsExactTimeAndTheCarComesToRes
   Expectation stop_received;
   stop_received.line = 1;
   stop_received.what = Matcher{Source::wire,
-                               "frame",
+                               WireKind::frame,
                                {{"dir", FieldTest::Op::equals, "to_car"},
                                 {"stage", FieldTest::Op::equals, "delivered"},
                                 {"frame", FieldTest::Op::kind_prefix, "MV:STOP"}},
                                "car received MV:STOP"};
-  stop_received.window.from.event =
-      Matcher{Source::step, "start", {{"text", FieldTest::Op::equals, "release"}}, "step release"};
+  stop_received.window.from.event = Matcher{
+      Source::step, StepKind::start, {{"text", FieldTest::Op::equals, "release"}}, "step release"};
   stop_received.window.within = milliseconds(300);
   s.expectations.push_back(stop_received);
 
@@ -104,21 +103,21 @@ TEST(RunnerLogi, ReleaseSendsMvStopAtTheReleaseStepsExactTimeAndTheCarComesToRes
   EXPECT_EQ(o.seed, 7u);
   EXPECT_EQ(o.repro_command, "hil run test --seed 7");
 
-  const auto release = step_time(o, "start", "release");
+  const auto release = step_time(o, StepKind::start, "release");
   ASSERT_TRUE(release);
   std::vector<Time> stops;
   for (const auto& r : wire(o, "to_car", "delivered"))
     if (r.data["frame"] == "MV:STOP") stops.push_back(r.at);
   ASSERT_FALSE(stops.empty());
   EXPECT_EQ(stops.front(), *release) << "no latency on mem://, none added by the runner";
-  const auto press = step_time(o, "start", "press FWD");
+  const auto press = step_time(o, StepKind::start, "press FWD");
   ASSERT_TRUE(press);
-  EXPECT_EQ(*release - *step_time(o, "start", "wait"), seconds(1))
+  EXPECT_EQ(*release - *step_time(o, StepKind::start, "wait"), seconds(1))
       << "the 1 s wait ends exactly when the release begins";
 
   // Motion between press and release, rest after.
-  const auto moving = of(o, Source::sim, "moving");
-  const auto rest = of(o, Source::sim, "at_rest");
+  const auto moving = of(o, SimKind::moving);
+  const auto rest = of(o, SimKind::at_rest);
   ASSERT_EQ(moving.size(), 1u);
   ASSERT_EQ(rest.size(), 2u) << "at the start, and after the release";
   EXPECT_GT(moving[0].at, *press);
@@ -126,26 +125,26 @@ TEST(RunnerLogi, ReleaseSendsMvStopAtTheReleaseStepsExactTimeAndTheCarComesToRes
   EXPECT_GT(rest[1].at, *release);
   EXPECT_LT(rest[1].at, *release + seconds(1));
   double fastest = 0;
-  for (const auto& r : of(o, Source::sim, "sample"))
+  for (const auto& r : of(o, SimKind::sample))
     fastest = std::max(fastest, r.data["speed_mps"].get<double>());
   EXPECT_GT(fastest, 0.05);
-  EXPECT_EQ(of(o, Source::sim, "sample").back().data["speed_mps"], 0.0);
+  EXPECT_EQ(of(o, SimKind::sample).back().data["speed_mps"], 0.0);
 
   // The client's own story: connected, and its commands accepted.
-  const auto connections = of(o, Source::client, "connection");
+  const auto connections = of(o, ClientKind::connection);
   ASSERT_GE(connections.size(), 2u);
   EXPECT_EQ(connections[1].data["state"], "connected");
   std::vector<std::string> accepted;
-  for (const auto& r : of(o, Source::client, "command"))
+  for (const auto& r : of(o, ClientKind::command))
     if (r.data["state"] == "accepted") accepted.push_back(r.data["command"]);
   EXPECT_EQ(accepted, (std::vector<std::string>{"SP", "MD:MAN", "MV:FWD", "MV:STOP"}));
-  const auto actions = of(o, Source::client, "action");
+  const auto actions = of(o, ClientKind::action);
   ASSERT_EQ(actions.size(), 5u);
   for (const auto& a : actions)
     EXPECT_TRUE(a.data["ok"].get<bool>()) << a.data.dump();
 
   // Every sample is on the 100 ms grid.
-  for (const auto& r : of(o, Source::sim, "sample"))
+  for (const auto& r : of(o, SimKind::sample))
     EXPECT_EQ(r.at.count() % milliseconds(100).count(), 0) << link::format_ms(r.at);
   EXPECT_FALSE(o.trajectories.empty());
   EXPECT_GT(o.trajectories[0].samples.size(), 10u);
@@ -184,7 +183,7 @@ TEST(RunnerLogi, AfterTheCarHangsUpAt5sTheClientReconnectsAt6s) {
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure();
   std::vector<std::pair<Time, std::string>> states;
-  for (const auto& r : of(o, Source::client, "connection"))
+  for (const auto& r : of(o, ClientKind::connection))
     states.emplace_back(r.at, r.data["state"]);
   const std::vector<std::pair<Time, std::string>> expected = {
       {Time(0), "connecting"},
@@ -194,7 +193,7 @@ TEST(RunnerLogi, AfterTheCarHangsUpAt5sTheClientReconnectsAt6s) {
       {seconds(6) + kLogiLatency, "connected"},
   };
   EXPECT_EQ(states, expected);
-  const auto behaviours = of(o, Source::car, "behaviour");
+  const auto behaviours = of(o, CarEventKind::behaviour);
   ASSERT_EQ(behaviours.size(), 1u);
   EXPECT_EQ(behaviours[0].at, seconds(5));
   EXPECT_EQ(o.steps.back().phase, "schedule");
@@ -219,41 +218,41 @@ TEST(RunnerLogi, RefusedConnectionsAreFaultRecordsAndTheClientGetsBackInWhenThey
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure();
   std::vector<Time> attempts;
-  for (const auto& r : of(o, Source::client, "connection"))
+  for (const auto& r : of(o, ClientKind::connection))
     if (r.data["state"] == "connecting" && r.at > seconds(5)) attempts.push_back(r.at);
   EXPECT_EQ(attempts, (std::vector<Time>{seconds(6) + kLogiLatency, seconds(8) + kLogiLatency,
                                          seconds(11) + kLogiLatency}));
   std::vector<Time> refused;
-  for (const auto& r : of(o, Source::fault, "refuse")) {
+  for (const auto& r : of(o, link::FaultKind::refuse)) {
     refused.push_back(r.at);
     EXPECT_EQ(r.data["rule"], "unreachable");
   }
   EXPECT_EQ(refused, (std::vector<Time>{seconds(6) + kLogiLatency, seconds(8) + kLogiLatency}));
-  const auto opens = of(o, Source::wire, "open");
+  const auto opens = of(o, WireKind::open);
   ASSERT_EQ(opens.size(), 2u) << "a refused connection gets no link";
   EXPECT_EQ(opens[1].at, seconds(11) + kLogiLatency);
-  EXPECT_EQ(of(o, Source::client, "connection").back().data["state"], "connected");
+  EXPECT_EQ(of(o, ClientKind::connection).back().data["state"], "connected");
 }
 
 TEST(RunnerLogi, AnAutoRunReachesStation2AndTheCarStopsThere) {
   Scenario s = scenario(mocks::CarKind::logi,
                         {action("connect"), action("speed 60"), action("mode AUTO"),
                          action("station 2"), action("run"), wait_until(station(2), seconds(90)),
-                         wait_until(sim_kind("at_rest"), seconds(5))});
+                         wait_until(sim_kind(SimKind::at_rest), seconds(5))});
   Expectation at_rest;
   at_rest.line = 9;
-  at_rest.what = sim_kind("at_rest");
+  at_rest.what = sim_kind(SimKind::at_rest);
   at_rest.window.from.event = station(2);
   at_rest.window.within = seconds(2);
   s.expectations.push_back(at_rest);
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
-  const auto stations = of(o, Source::sim, "station");
+  const auto stations = of(o, SimKind::station);
   ASSERT_FALSE(stations.empty());
   EXPECT_EQ(stations.back().data["station"], 2);
   EXPECT_EQ(stations.back().data["tag"], "002");
   EXPECT_LT(o.run_time, seconds(90));
-  EXPECT_EQ(of(o, Source::sim, "sample").back().data["speed_mps"], 0.0);
+  EXPECT_EQ(of(o, SimKind::sample).back().data["speed_mps"], 0.0);
 }
 
 TEST(RunnerLogi, ARejectedCommandFailsItsStepStopsTheSequenceAndTeardownStillRuns) {
@@ -276,10 +275,10 @@ TEST(RunnerLogi, ARejectedCommandFailsItsStepStopsTheSequenceAndTeardownStillRun
   EXPECT_TRUE(o.steps[4].ran);
   EXPECT_TRUE(o.steps[4].ok) << o.steps[4].reason;
   EXPECT_EQ(o.first_failure().rfind("step line 0 (speed 50): ", 0), 0u) << o.first_failure();
-  EXPECT_FALSE(step_time(o, "start", "mode MAN"));
+  EXPECT_FALSE(step_time(o, StepKind::start, "mode MAN"));
   const auto rejected =
       std::count_if(o.timeline.records().begin(), o.timeline.records().end(), [](const Record& r) {
-        return r.source == Source::client && r.kind == "command" && r.data["state"] == "rejected";
+        return r.kind == ClientKind::command && r.data["state"] == "rejected";
       });
   EXPECT_GE(rejected, 1);
 }
@@ -302,15 +301,15 @@ TEST(RunnerLogi, FaultsFromTheStartAreRecordedUntilAFaultsStepTurnsThemOff) {
   s.faults.rules = {corrupt, split};
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
-  const auto off = step_time(o, "end", "faults off");
+  const auto off = step_time(o, StepKind::end, "faults off");
   ASSERT_TRUE(off);
-  const auto fragments = of(o, Source::fault, "fragment");
-  const auto corrupted = of(o, Source::fault, "corrupt");
+  const auto fragments = of(o, link::FaultKind::fragment);
+  const auto corrupted = of(o, link::FaultKind::corrupt);
   ASSERT_GE(fragments.size(), 3u);
   ASSERT_EQ(corrupted.size(), 1u);
   EXPECT_EQ(corrupted[0].data["rule"], "bad checksum");
   EXPECT_EQ(corrupted[0].data["dir"], "to_client");
-  for (const auto& f : of(o, Source::fault, "fragment"))
+  for (const auto& f : of(o, link::FaultKind::fragment))
     EXPECT_LT(f.at, *off) << link::format_ms(f.at);
   // The corrupted STAT reached the client invalid; what was sent was fine.
   bool invalid_delivered = false;
@@ -323,7 +322,7 @@ TEST(RunnerLogi, FaultsFromTheStartAreRecordedUntilAFaultsStepTurnsThemOff) {
   EXPECT_TRUE(invalid_delivered);
   for (const auto& r : wire(o, "to_client", "sent"))
     EXPECT_TRUE(r.data["valid"].get<bool>());
-  EXPECT_FALSE(of(o, Source::client, "parse_error").empty());
+  EXPECT_FALSE(of(o, ClientKind::parse_error).empty());
 }
 
 TEST(RunnerLogi, ARunThatOutlivesItsTimeoutFailsTheRestAndStillTearsDown) {
@@ -358,7 +357,7 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
   Scenario s =
       scenario(mocks::CarKind::logi, {action("connect"), action("speed 50"), wait(seconds(3))});
   Matcher sp{Source::wire,
-             "frame",
+             WireKind::frame,
              {{"dir", FieldTest::Op::equals, "to_car"},
               {"stage", FieldTest::Op::equals, "delivered"},
               {"frame", FieldTest::Op::kind_prefix, "SP"}},
@@ -379,7 +378,7 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
   ASSERT_TRUE(last_stat);
   EXPECT_EQ(*last_stat, seconds(1) + kLogiLatency)
       << "STAT every 500 ms, each after the car's latency, until the mute at 1.2 s";
-  const auto stale = of(o, Source::client, "stale");
+  const auto stale = of(o, ClientKind::stale);
   ASSERT_EQ(stale.size(), 1u);
   EXPECT_EQ(stale[0].at, *last_stat + seconds(2));
 }
@@ -391,10 +390,10 @@ TEST(RunnerOtherCars, AnObstaclePutAheadOfTheWr8IsHitAndCanBeTakenAway) {
        action("drive 100"), wait(seconds(1)), step_of("lift", ObstacleStep{false, 0, "parcel"})});
   const auto o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
-  const auto hits = of(o, Source::sim, "collision");
+  const auto hits = of(o, SimKind::collision);
   ASSERT_EQ(hits.size(), 1u);
   EXPECT_EQ(hits[0].data["with"], "parcel");
-  const auto rest = of(o, Source::sim, "at_rest");
+  const auto rest = of(o, SimKind::at_rest);
   ASSERT_EQ(rest.size(), 2u);
   EXPECT_GE(rest[1].at, hits[0].at);
   ASSERT_EQ(o.arena.obstacles.size(), 1u + sim::default_warehouse_arena().obstacles.size());
@@ -410,7 +409,7 @@ TEST(RunnerOtherCars, AnObstaclePutAheadOfTheWr8IsHitAndCanBeTakenAway) {
 void expect_frames_both_ways(const ScenarioOutcome& o) {
   EXPECT_FALSE(wire(o, "to_car", "delivered").empty());
   EXPECT_FALSE(wire(o, "to_client", "delivered").empty());
-  for (const auto& r : of(o, Source::wire, "frame"))
+  for (const auto& r : of(o, WireKind::frame))
     EXPECT_TRUE(r.data["valid"].get<bool>()) << r.data.dump();
 }
 
@@ -423,9 +422,9 @@ TEST(RunnerOtherCars, Wr8LogsInAndDrives30cm) {
   for (const auto& r : wire(o, "to_car", "delivered"))
     if (r.data["frame"] == "AUTH") auth = true;
   EXPECT_TRUE(auth);
-  ASSERT_FALSE(of(o, Source::client, "login").empty());
-  EXPECT_EQ(of(o, Source::client, "login")[0].data["ok"], true);
-  EXPECT_FALSE(of(o, Source::sim, "moving").empty());
+  ASSERT_FALSE(of(o, ClientKind::login).empty());
+  EXPECT_EQ(of(o, ClientKind::login)[0].data["ok"], true);
+  EXPECT_FALSE(of(o, SimKind::moving).empty());
 }
 
 TEST(RunnerOtherCars, ArduinoAnswersPingSpeedAndStatus) {
@@ -433,8 +432,8 @@ TEST(RunnerOtherCars, ArduinoAnswersPingSpeedAndStatus) {
       scenario(mocks::CarKind::arduino, {action("PING"), action("V 160"), action("STATUS")}));
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
   expect_frames_both_ways(o);
-  EXPECT_EQ(of(o, Source::client, "connection").front().data["state"], "connecting");
-  EXPECT_EQ(of(o, Source::client, "command").size(), 3u);
+  EXPECT_EQ(of(o, ClientKind::connection).front().data["state"], "connecting");
+  EXPECT_EQ(of(o, ClientKind::command).size(), 3u);
 }
 
 TEST(RunnerOtherCars, LekaRunsAGroupAndAnswersInfo) {
@@ -442,7 +441,7 @@ TEST(RunnerOtherCars, LekaRunsAGroupAndAnswersInfo) {
       run_scenario(scenario(mocks::CarKind::leka, {action("ear all 255 0 0"), action("info")}));
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
   expect_frames_both_ways(o);
-  const auto connected = of(o, Source::client, "connection").front();
+  const auto connected = of(o, ClientKind::connection).front();
   EXPECT_EQ(connected.data["state"], "connected");
   EXPECT_EQ(connected.at, Time(0));
 }
@@ -497,7 +496,7 @@ Step must_fail(Step step, std::string contains = "") {
 
 Matcher never_seen() {
   return Matcher{Source::client,
-                 "notice",
+                 ClientKind::notice,
                  {{"text", FieldTest::Op::equals, "no such notice"}},
                  "a notice that never comes"};
 }
@@ -558,21 +557,23 @@ TEST(RunnerConcurrentActions, AScheduledEmergencyStopGoesOutBesideAnActionUnderW
                         {action("connect"), action("mode MAN"),
                          car("swallow SP", mocks::Ignore{"SP", std::nullopt, std::nullopt}),
                          must_fail(action("speed 60")), wait(milliseconds(100))});
-  const Matcher speed_starts{
-      Source::step, "start", {{"text", FieldTest::Op::equals, "speed 60"}}, "speed 60 starts"};
+  const Matcher speed_starts{Source::step,
+                             StepKind::start,
+                             {{"text", FieldTest::Op::equals, "speed 60"}},
+                             "speed 60 starts"};
   s.schedule.push_back(ScheduledStep{Anchor{speed_starts, 1, milliseconds(300)}, action("estop")});
   const ScenarioOutcome o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
 
-  const auto speed = step_time(o, "start", "speed 60");
+  const auto speed = step_time(o, StepKind::start, "speed 60");
   ASSERT_TRUE(speed);
   const auto stops = received_at(o, "MV:STOP");
   ASSERT_FALSE(stops.empty());
   EXPECT_EQ(stops.front(), *speed + milliseconds(300));
-  const auto speed_end = step_time(o, "end", "speed 60");
+  const auto speed_end = step_time(o, StepKind::end, "speed 60");
   ASSERT_TRUE(speed_end);
   EXPECT_GT(*speed_end, stops.front() + seconds(1)) << "the SP was still under way";
-  const auto estop_end = step_time(o, "end", "estop");
+  const auto estop_end = step_time(o, StepKind::end, "estop");
   ASSERT_TRUE(estop_end);
   EXPECT_LT(*estop_end, *speed_end);
 }
@@ -585,7 +586,7 @@ TEST(RunnerConcurrentActions, ConfirmResendsTheUncertainRunOfAnEarlierStep) {
                 must_fail(action("run"), "uncertain"), action("confirm"), wait(milliseconds(100))});
   const ScenarioOutcome o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
-  const auto confirm = step_time(o, "start", "confirm");
+  const auto confirm = step_time(o, StepKind::start, "confirm");
   ASSERT_TRUE(confirm);
   const auto runs = received_at(o, "ST:RUN");
   ASSERT_EQ(runs.size(), 2u)

@@ -27,11 +27,11 @@ inline Step wait(Duration d) {
   return step_of("wait", WaitStep{d});
 }
 
-/// The records of one source and kind, in time order.
-inline std::vector<Record> of(const ScenarioOutcome& o, Source source, const std::string& kind) {
+/// The records of one kind, in time order.
+inline std::vector<Record> of(const ScenarioOutcome& o, RecordKind kind) {
   std::vector<Record> out;
   for (const auto& r : o.timeline.records())
-    if (r.source == source && r.kind == kind) out.push_back(r);
+    if (r.kind == kind) out.push_back(r);
   return out;
 }
 

@@ -35,7 +35,8 @@ TEST(ScenarioYamlMatchers, WireDirectionsAndStages) {
                                                {"stage", Op::equals, "delivered"},
                                                {"frame", Op::kind_prefix, "FB:MV"},
                                                {"valid", Op::equals, true}}));
-  EXPECT_EQ(matcher_of("{wire: close}"), (Matcher{Source::wire, "close", {}, "link closed"}));
+  EXPECT_EQ(matcher_of("{wire: close}"),
+            (Matcher{Source::wire, WireKind::close, {}, "link closed"}));
 }
 
 TEST(ScenarioYamlMatchers, FrameContentTextHexMessageAndFields) {
@@ -127,17 +128,19 @@ TEST(ScenarioYamlMatchers, FrameContentMistakesAreReportedWhereTheyAre) {
 }
 
 TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
-  EXPECT_EQ(
-      matcher_of("{client: parse_error}"),
-      (Matcher{Source::client, "parse_error", {}, "client reported a frame it could not parse"}));
+  EXPECT_EQ(matcher_of("{client: parse_error}"),
+            (Matcher{Source::client,
+                     ClientKind::parse_error,
+                     {},
+                     "client reported a frame it could not parse"}));
   EXPECT_EQ(matcher_of("{client: {parse_error: bad_checksum}}"),
             (Matcher{Source::client,
-                     "parse_error",
+                     ClientKind::parse_error,
                      {{"text", Op::contains, "bad_checksum"}},
                      "client could not parse a frame: 'bad_checksum'"}));
   EXPECT_EQ(matcher_of("{client: {movement: false, reason: not connected}}"),
             (Matcher{Source::client,
-                     "movement",
+                     ClientKind::movement,
                      {{"enabled", Op::equals, false}, {"reason", Op::contains, "not connected"}},
                      "client disabled movement because of 'not connected'"}));
   const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - client: ";
@@ -148,28 +151,30 @@ TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
 
 TEST(ScenarioYamlMatchers, ClientEvents) {
   EXPECT_EQ(matcher_of("{client: stale}"),
-            (Matcher{Source::client, "stale", {}, "client warned of stale telemetry"}));
-  EXPECT_EQ(matcher_of("{client: fresh}").kind, "fresh");
+            (Matcher{Source::client, ClientKind::stale, {}, "client warned of stale telemetry"}));
+  EXPECT_EQ(matcher_of("{client: fresh}").kind, ClientKind::fresh);
   EXPECT_EQ(matcher_of("{client: {login: false, reason: refused}}"),
             (Matcher{Source::client,
-                     "login",
+                     ClientKind::login,
                      {{"ok", Op::equals, false}, {"reason", Op::contains, "refused"}},
                      "client login refused because of 'refused'"}));
   EXPECT_EQ(matcher_of("{client: {notice: \"Not in manual mode\"}}"),
             (Matcher{Source::client,
-                     "notice",
+                     ClientKind::notice,
                      {{"text", Op::contains, "Not in manual mode"}},
                      "client notice containing 'Not in manual mode'"}));
   EXPECT_EQ(matcher_of("{client: {command: SP, state: rejected}}").tests,
             (std::vector<FieldTest>{{"command", Op::kind_prefix, "SP"},
                                     {"state", Op::equals, "rejected"}}));
-  EXPECT_EQ(matcher_of("{client: {exit: 0}}"),
-            (Matcher{Source::client, "exit", {{"code", Op::equals, 0}}, "client exited with 0"}));
+  EXPECT_EQ(
+      matcher_of("{client: {exit: 0}}"),
+      (Matcher{
+          Source::client, ClientKind::exit, {{"code", Op::equals, 0}}, "client exited with 0"}));
   EXPECT_EQ(matcher_of("{client: {output: ok}}").tests,
             (std::vector<FieldTest>{{"line", Op::contains, "ok"}}));
   EXPECT_EQ(matcher_of("{client: {action: \"press FWD\", ok: false}}"),
             (Matcher{Source::client,
-                     "action",
+                     ClientKind::action,
                      {{"text", Op::equals, "press FWD"}, {"ok", Op::equals, false}},
                      "action 'press FWD' failed"}));
   EXPECT_EQ(matcher_of("{client: disconnected}").tests,
@@ -177,11 +182,12 @@ TEST(ScenarioYamlMatchers, ClientEvents) {
 }
 
 TEST(ScenarioYamlMatchers, SimulationEvents) {
-  EXPECT_EQ(matcher_of("{sim: moving}").kind, "moving");
-  EXPECT_EQ(matcher_of("{sim: collision}").kind, "collision");
+  EXPECT_EQ(matcher_of("{sim: moving}").kind, SimKind::moving);
+  EXPECT_EQ(matcher_of("{sim: collision}").kind, SimKind::collision);
   EXPECT_EQ(
       matcher_of("{sim: {speed_below: 0.01}}"),
-      (Matcher{Source::sim, "sample", {{"speed_mps", Op::less, 0.01}}, "speed below 0.01 m/s"}));
+      (Matcher{
+          Source::sim, SimKind::sample, {{"speed_mps", Op::less, 0.01}}, "speed below 0.01 m/s"}));
   EXPECT_EQ(matcher_of("{sim: {near: [1.5, 0.4], radius: 0.2}}").tests,
             (std::vector<FieldTest>{{"x_m", Op::greater_equal, 1.3},
                                     {"x_m", Op::less_equal, 1.7},
@@ -193,15 +199,29 @@ TEST(ScenarioYamlMatchers, StepsByTheirTextOrItsFirstWords) {
   EXPECT_EQ(matcher_of("{step: release}"), step_ended("release"));
   // "speed" starts exactly one step: "speed 50".
   EXPECT_EQ(matcher_of("{step: speed}"), step_ended("speed 50"));
-  EXPECT_EQ(matcher_of("{step: {text: run, at: start}}").kind, "start");
+  EXPECT_EQ(matcher_of("{step: {text: run, at: start}}").kind, StepKind::start);
 }
 
 TEST(ScenarioYamlMatchers, FaultAndCarEvents) {
-  EXPECT_EQ(matcher_of("{fault: drop}"), (Matcher{Source::fault, "drop", {}, "fault drop"}));
+  EXPECT_EQ(matcher_of("{fault: drop}"),
+            (Matcher{Source::fault, link::FaultKind::drop, {}, "fault drop"}));
   EXPECT_EQ(matcher_of("{car: fault_state}").tests,
             (std::vector<FieldTest>{{"on", Op::equals, true}}));
   EXPECT_EQ(matcher_of("{car: {behaviour: no-moves}}").tests,
             (std::vector<FieldTest>{{"name", Op::equals, "no-moves"}}));
+  // Any fault, and a rule kind that does not exist (it could never match).
+  EXPECT_EQ(matcher_of("{fault: \"*\"}").kind, std::nullopt);
+  const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - ";
+  expect_errors({
+      {head + "{fault: dorp}\n",
+       "t.yaml:5:13: expectation 1: 'fault': unknown fault kind 'dorp' (known: fragment, "
+       "coalesce, corrupt, drop, duplicate, garbage, delay, stall, bandwidth, disconnect, "
+       "reset, refuse); did you mean 'drop'?"},
+      {head + "{fault: {kind: corupt}}\n",
+       "t.yaml:5:20: expectation 1: 'fault': 'kind': unknown fault kind 'corupt' (known: "
+       "fragment, coalesce, corrupt, drop, duplicate, garbage, delay, stall, bandwidth, "
+       "disconnect, reset, refuse); did you mean 'corrupt'?"},
+  });
 }
 
 // ------------------------------------------------- windows and quantifiers
@@ -224,7 +244,7 @@ TEST(ScenarioYamlWindows, FromTheStartAtATimeBetweenAndAfter) {
             (Window{Anchor{step_ended("release"), 1, Duration{0}}, std::nullopt}));
   EXPECT_EQ(
       expectation_of("{sim: at_rest, after: {step: release, at: start}}").window.from.event->kind,
-      "start");
+      StepKind::start);
   EXPECT_EQ(
       expectation_of("{sim: at_rest, after: {received: \"MV:STOP\", occurrence: 2, offset: 1s}}")
           .window.from,
@@ -243,7 +263,7 @@ TEST(ScenarioYamlQuantifiers, EveryQuantifier) {
   EXPECT_TRUE(only.only);
   const auto always = expectation_of("{always: {sim: {speed_below: 0.5}}, after: release}");
   EXPECT_EQ(always.quantifier, Quantifier::always);
-  EXPECT_EQ(always.what.kind, "sample");
+  EXPECT_EQ(always.what.kind, SimKind::sample);
   EXPECT_EQ(always.label, "always: speed below 0.5 m/s after step 'release' ended");
 }
 

@@ -76,7 +76,7 @@ inline Step step_of(int line, std::string text, StepAction action) {
 
 inline Matcher car_received(const std::string& frame) {
   return Matcher{Source::wire,
-                 "frame",
+                 WireKind::frame,
                  {{"dir", Op::equals, "to_car"},
                   {"stage", Op::equals, "delivered"},
                   {"frame", Op::kind_prefix, frame}},
@@ -84,12 +84,13 @@ inline Matcher car_received(const std::string& frame) {
 }
 
 inline Matcher step_ended(const std::string& text) {
-  return Matcher{Source::step, "end", {{"text", Op::equals, text}}, "step '" + text + "' ended"};
+  return Matcher{
+      Source::step, StepKind::end, {{"text", Op::equals, text}}, "step '" + text + "' ended"};
 }
 
 inline Matcher step_started(const std::string& text) {
   return Matcher{
-      Source::step, "start", {{"text", Op::equals, text}}, "step '" + text + "' started"};
+      Source::step, StepKind::start, {{"text", Op::equals, text}}, "step '" + text + "' started"};
 }
 
 }  // namespace hil::harness::test

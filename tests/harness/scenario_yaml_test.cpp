@@ -49,7 +49,7 @@ expect:
   ASSERT_EQ(s.expectations.size(), 1u);
   const auto& e = s.expectations[0];
   EXPECT_EQ(e.what, (Matcher{Source::client,
-                             "connection",
+                             ClientKind::connection,
                              {{"state", Op::equals, "connecting"}},
                              "client connecting"}));
   EXPECT_EQ(e.quantifier, Quantifier::at_times);
@@ -87,10 +87,11 @@ TEST(ScenarioYamlReleaseChecks, Station2Within90sAndStopped) {
 )");
   ASSERT_EQ(s.expectations.size(), 2u);
   const Matcher station{
-      Source::sim, "station", {{"station", Op::equals, 2}}, "car reached station 2"};
+      Source::sim, SimKind::station, {{"station", Op::equals, 2}}, "car reached station 2"};
   EXPECT_EQ(s.expectations[0].what, station);
   EXPECT_EQ(s.expectations[0].window, (Window{Anchor{}, seconds(90)}));
-  EXPECT_EQ(s.expectations[1].what, (Matcher{Source::sim, "at_rest", {}, "chassis at rest"}));
+  EXPECT_EQ(s.expectations[1].what,
+            (Matcher{Source::sim, SimKind::at_rest, {}, "chassis at rest"}));
   EXPECT_EQ(s.expectations[1].window, (Window{Anchor{station, 1, Duration{0}}, seconds(2)}));
 }
 
@@ -102,7 +103,7 @@ TEST(ScenarioYamlReleaseChecks, ClientNeverSentABadChecksum) {
   const auto& e = s.expectations.at(0);
   EXPECT_EQ(e.quantifier, Quantifier::never);
   EXPECT_EQ(e.what, (Matcher{Source::wire,
-                             "frame",
+                             WireKind::frame,
                              {{"dir", Op::equals, "to_car"},
                               {"stage", Op::equals, "sent"},
                               {"valid", Op::equals, false},
@@ -119,7 +120,7 @@ TEST(ScenarioYamlReleaseChecks, AtRestWithin1sOfTheEmergencyStop) {
 )");
   const auto& e = s.expectations.at(0);
   EXPECT_EQ(e.what.source, Source::sim);
-  EXPECT_EQ(e.what.kind, "at_rest");
+  EXPECT_EQ(e.what.kind, SimKind::at_rest);
   EXPECT_TRUE(e.what.tests.empty());
   EXPECT_EQ(e.window, (Window{Anchor{step_started("estop"), 1, Duration{0}}, seconds(1)}));
   EXPECT_EQ(e.label, "chassis at rest within 1s after step 'estop' started");
@@ -362,10 +363,10 @@ TEST(ScenarioYamlSteps, EveryKindOfStep) {
   EXPECT_EQ(s.steps[1], step_of(5, "speed 50", ActionStep{"speed 50"}));
   EXPECT_EQ(s.steps[2], step_of(6, "wait 1500ms", WaitStep{milliseconds(1500)}));
   const auto& until = std::get<WaitUntilStep>(s.steps[3].action);
-  EXPECT_EQ(
-      until.until,
-      (Matcher{
-          Source::client, "connection", {{"state", Op::equals, "connected"}}, "client connected"}));
+  EXPECT_EQ(until.until, (Matcher{Source::client,
+                                  ClientKind::connection,
+                                  {{"state", Op::equals, "connected"}},
+                                  "client connected"}));
   EXPECT_EQ(until.timeout, seconds(5));
   EXPECT_EQ(s.steps[3].text, "wait until {client: connected}");
   const auto& until2 = std::get<WaitUntilStep>(s.steps[4].action);
@@ -497,14 +498,14 @@ TEST(ScenarioYamlSteps, ScheduleAtATimeOrOnAnEvent) {
   EXPECT_EQ(s.schedule[1].when, (Anchor{car_received("ST:RUN"), 2, milliseconds(100)}));
   EXPECT_EQ(std::get<CarStep>(s.schedule[1].step.action).behaviour.action,
             mocks::Action{mocks::MuteTelemetry{seconds(3)}});
-  EXPECT_EQ(
-      s.schedule[2].when.event,
-      (Matcher{
-          Source::step, "start", {{"text", Op::equals, "release"}}, "step 'release' started"}));
+  EXPECT_EQ(s.schedule[2].when.event, (Matcher{Source::step,
+                                               StepKind::start,
+                                               {{"text", Op::equals, "release"}},
+                                               "step 'release' started"}));
   EXPECT_EQ(s.schedule[2].when.offset, milliseconds(-50));
   EXPECT_EQ(s.schedule[2].step, step_of(19, "estop", ActionStep{"estop"}));
   EXPECT_EQ(s.schedule[3].when.occurrence, -1);
-  EXPECT_EQ(s.schedule[3].when.event->kind, "stale");
+  EXPECT_EQ(s.schedule[3].when.event->kind, ClientKind::stale);
 }
 
 // ----------------------------------------------------------------- variables

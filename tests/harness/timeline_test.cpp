@@ -17,11 +17,11 @@ namespace {
 
 TEST(Timeline, WritesOneOrderedJsonObjectPerRecord) {
   Timeline t;
-  t.add(Time(link::milliseconds(1500)), Source::wire, "frame",
+  t.add(Time(link::milliseconds(1500)), WireKind::frame,
         {{"dir", "to_car"}, {"stage", "delivered"}, {"frame", "MV:STOP"}});
-  t.add(Time(link::milliseconds(1500)), Source::client, "stale");
+  t.add(Time(link::milliseconds(1500)), ClientKind::stale);
   ASSERT_EQ(t.size(), 2u);
-  EXPECT_EQ(t.records()[1].kind, "stale");
+  EXPECT_EQ(t.records()[1].kind, ClientKind::stale);
   EXPECT_EQ(t.to_ndjson(),
             "{\"t_ms\":1500.0,\"source\":\"wire\",\"kind\":\"frame\",\"dir\":\"to_car\","
             "\"frame\":\"MV:STOP\",\"stage\":\"delivered\"}\n"
@@ -89,7 +89,7 @@ std::vector<Record> frames_of(const std::string& protocol, link::Direction dir,
   recorder.on_sent(clock.now(), dir, bytes);
   std::vector<Record> frames;
   for (const auto& r : timeline.timeline().records())
-    if (r.kind == "frame") frames.push_back(r);
+    if (r.kind == WireKind::frame) frames.push_back(r);
   return frames;
 }
 
@@ -104,18 +104,18 @@ TEST(RunTimelineListeners, EachListenerSeesEachRecordOnceAndMayLeaveOrJoinWhileT
   RunTimeline::ListenerId second = 0;
   RunTimeline::ListenerId joined = 0;
   const auto first = timeline.listen([&](const Record& r) {
-    seen.push_back("first " + r.kind);
+    seen.push_back("first " + std::string(r.kind.name()));
     // The first record makes the second listener leave before its turn and a
     // third one join, which hears only the records after it.
-    if (r.kind == "a") {
+    if (r.kind == StepKind::start) {
       timeline.unlisten(second);
-      joined = timeline.listen([&](const Record& r2) { seen.push_back("joined " + r2.kind); });
+      joined = timeline.listen([&](const Record& r2) { seen.push_back("joined " + std::string(r2.kind.name())); });
     }
   });
-  second = timeline.listen([&](const Record& r) { seen.push_back("second " + r.kind); });
-  timeline.add(Source::step, "a");
-  timeline.add(Source::step, "b");
-  EXPECT_EQ(seen, (std::vector<std::string>{"first a", "first b", "joined b"}));
+  second = timeline.listen([&](const Record& r) { seen.push_back("second " + std::string(r.kind.name())); });
+  timeline.add(StepKind::start);
+  timeline.add(StepKind::end);
+  EXPECT_EQ(seen, (std::vector<std::string>{"first start", "first end", "joined end"}));
   EXPECT_EQ(timeline.timeline().size(), 2u);
   timeline.unlisten(first);
   timeline.unlisten(joined);
@@ -125,14 +125,14 @@ TEST(RunTimelineListeners, AListenerThatAddsARecordItselfIsRefusedAndTheTimeline
   StillClock clock;
   RunTimeline timeline(clock);
   const auto id = timeline.listen([&](const Record& r) {
-    if (r.kind == "a") timeline.add(Source::step, "echo");
+    if (r.kind == StepKind::start) timeline.add(ClientKind::notice);
   });
-  EXPECT_THROW(timeline.add(Source::step, "a"), std::logic_error);
+  EXPECT_THROW(timeline.add(StepKind::start), std::logic_error);
   timeline.unlisten(id);
-  timeline.add(Source::step, "b");
+  timeline.add(StepKind::end);
   ASSERT_EQ(timeline.timeline().size(), 2u);
-  EXPECT_EQ(timeline.timeline().records()[0].kind, "a");
-  EXPECT_EQ(timeline.timeline().records()[1].kind, "b");
+  EXPECT_EQ(timeline.timeline().records()[0].kind, StepKind::start);
+  EXPECT_EQ(timeline.timeline().records()[1].kind, StepKind::end);
 }
 
 TEST(WireRecorderFields, EachProtocolsDecodedFieldsAreInTheFrameRecord) {
