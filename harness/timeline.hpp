@@ -52,7 +52,8 @@ using link::Time;
 ///   its fault record.
 /// - fault: also "frame_number" (1-based in its direction) when the rule acted on a frame.
 /// - client "connection": also "attempt" (reconnect attempt, 0 for the operator's connect),
-///   "detail" (the client library's own name of the state), Arduino "reason"; the Arduino
+///   "detail" (the client's own name of the state where it has one, such as the Arduino
+///   link's "OPEN", else the state's word), Arduino "reason"; the Arduino
 ///   link also reaches "degraded" and "down". "command": also "request" (the client's id),
 ///   LOGI "text" (the frame) and "attempt"; WR8 "command" is the task ("drive", "turn",
 ///   "settings"); Arduino has no "command" but "detail" ("ACK OK", "NACK BAD_V") and states
