@@ -433,7 +433,7 @@ class LekaReference final : public ReferenceSession {
   link::Executor& executor_;
   RunTimeline& timeline_;
   client::leka::LekaSession session_;
-  client::leka::ScriptRunner runner_;
+  client::leka::OperatorRunner runner_;
   client::ConnectionState state_ = client::ConnectionState::disconnected;
   std::uint64_t generation_ = 0;
   RunTimeline::ListenerId listener_ = 0;

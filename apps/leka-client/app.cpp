@@ -252,7 +252,7 @@ class Run {
   std::map<std::size_t, const leka::OperatorLine*> lines_;
   ProgramLoop program_;
   leka::LekaSession session_;
-  leka::ScriptRunner runner_;
+  leka::OperatorRunner runner_;
   bool finishing_ = false;
 };
 

@@ -371,15 +371,15 @@ std::vector<Bytes> frames_of(const OperatorLine& line, const ClientConfig& confi
 
 // ------------------------------------------------------------------ runner
 
-ScriptRunner::ScriptRunner(link::Executor& executor, LekaSession& session)
+OperatorRunner::OperatorRunner(link::Executor& executor, LekaSession& session)
     : executor_(executor), session_(session) {}
 
-ScriptRunner::~ScriptRunner() {
+OperatorRunner::~OperatorRunner() {
   *alive_ = false;
   cancel();
 }
 
-void ScriptRunner::run(Script script, LineCallback on_line, DoneCallback on_done) {
+void OperatorRunner::run(Script script, LineCallback on_line, DoneCallback on_done) {
   cancel();
   script_ = std::move(script);
   index_ = 0;
@@ -389,14 +389,14 @@ void ScriptRunner::run(Script script, LineCallback on_line, DoneCallback on_done
   next();
 }
 
-void ScriptRunner::cancel() {
+void OperatorRunner::cancel() {
   running_ = false;
   ++generation_;
   if (timer_ != 0) executor_.cancel(timer_);
   timer_ = 0;
 }
 
-void ScriptRunner::next() {
+void OperatorRunner::next() {
   if (!running_) return;
   if (index_ >= script_.lines.size()) {
     running_ = false;
@@ -421,7 +421,7 @@ void ScriptRunner::next() {
   start_group(line);
 }
 
-void ScriptRunner::start_group(const ScriptLine& line) {
+void OperatorRunner::start_group(const ScriptLine& line) {
   if (!session_.is_open()) return finish(false, "the port is not open");
   const auto frames = frames_of(line.line, session_.core().config());
   current_.frames = frames.size();
@@ -466,7 +466,7 @@ void ScriptRunner::start_group(const ScriptLine& line) {
   });
 }
 
-void ScriptRunner::check_group() {
+void OperatorRunner::check_group() {
   if (!running_) return;
   if (!session_.is_open()) return finish(false, "the port closed");
   if (session_.core().queued_frames() > 0) {
@@ -485,7 +485,7 @@ void ScriptRunner::check_group() {
   finish(true);
 }
 
-void ScriptRunner::finish(bool ok, std::string error) {
+void OperatorRunner::finish(bool ok, std::string error) {
   if (!running_) return;
   if (timer_ != 0) executor_.cancel(timer_);
   timer_ = 0;

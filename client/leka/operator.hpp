@@ -93,17 +93,17 @@ struct LineResult {
 /// the session), its infos must be answered within the session's
 /// info_timeout, and a wait lasts exactly its duration. The next line starts
 /// when the previous one is finished. Stops at the first failure.
-class ScriptRunner {
+class OperatorRunner {
  public:
   using LineCallback = std::function<void(const LineResult&)>;
   /// true when every line succeeded.
   using DoneCallback = std::function<void(bool ok)>;
 
   /// `executor` and `session` must outlive the runner; the session is open.
-  ScriptRunner(link::Executor& executor, LekaSession& session);
-  ~ScriptRunner();
-  ScriptRunner(const ScriptRunner&) = delete;
-  ScriptRunner& operator=(const ScriptRunner&) = delete;
+  OperatorRunner(link::Executor& executor, LekaSession& session);
+  ~OperatorRunner();
+  OperatorRunner(const OperatorRunner&) = delete;
+  OperatorRunner& operator=(const OperatorRunner&) = delete;
 
   void run(Script script, LineCallback on_line, DoneCallback on_done);
   /// Stops without reporting further lines or calling on_done.

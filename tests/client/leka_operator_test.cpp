@@ -295,7 +295,7 @@ struct LekaOperatorRunner : ::testing::Test, test::VirtualCar<mocks::LekaFirmwar
     session->open();
     executor.run_for(Duration::zero());
     ASSERT_TRUE(session->is_open());
-    runner = std::make_unique<ScriptRunner>(executor, *session);
+    runner = std::make_unique<OperatorRunner>(executor, *session);
   }
 
   Script script(const std::string& text) {
@@ -321,7 +321,7 @@ struct LekaOperatorRunner : ::testing::Test, test::VirtualCar<mocks::LekaFirmwar
   }
 
   std::unique_ptr<LekaSession> session;
-  std::unique_ptr<ScriptRunner> runner;
+  std::unique_ptr<OperatorRunner> runner;
   std::vector<LineResult> results;
   std::optional<bool> done;
   Time done_at{0};
