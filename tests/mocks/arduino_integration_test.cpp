@@ -28,6 +28,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/serial_port.hpp"
 #include "tests/mocks/serial_support.hpp"
 
 namespace hil::mocks {
@@ -43,16 +44,10 @@ using test::TempDir;
 /// 9600 baud, and the answers decoded as the PC side decodes them.
 class SerialClient {
  public:
-  SerialClient(asio::io_context& io, const std::string& path) : port_(io) {
-    port_.assign(test::open_serial_port(path, B9600));
-    read();
-  }
-  ~SerialClient() { *alive_ = false; }
+  SerialClient(asio::io_context& io, const std::string& path)
+      : port_(io, path, B9600, [this](protocol::ByteView b) { on_bytes(b); }) {}
 
-  void write(const std::string& text) {
-    const auto n = ::write(port_.native_handle(), text.data(), text.size());
-    ASSERT_EQ(n, static_cast<ssize_t>(text.size())) << "write to the port failed";
-  }
+  void write(const std::string& text) { port_.write(protocol::to_bytes(text)); }
 
   /// Answers decoded so far, oldest first; anything that did not decode is a
   /// test failure.
@@ -60,32 +55,25 @@ class SerialClient {
   std::size_t bytes_received() const { return bytes_; }
 
  private:
-  void read() {
-    port_.async_read_some(asio::buffer(buffer_),
-                          [this, alive = alive_](std::error_code ec, std::size_t n) {
-                            if (!*alive) return;
-                            bytes_ += n;
-                            items_.clear();
-                            decoder_.feed(protocol::ByteView(buffer_.data(), n), items_);
-                            for (auto& item : items_) {
-                              if (auto* f = std::get_if<protocol::Frame<arduino::Message>>(&item)) {
-                                answers_.push_back(f->message);
-                              } else {
-                                ADD_FAILURE() << "undecodable bytes from the robot: "
-                                              << std::get<protocol::DecodeError>(item).detail;
-                              }
-                            }
-                            if (!ec) read();
-                          });
+  void on_bytes(protocol::ByteView bytes) {
+    bytes_ += bytes.size();
+    items_.clear();
+    decoder_.feed(bytes, items_);
+    for (auto& item : items_) {
+      if (auto* f = std::get_if<protocol::Frame<arduino::Message>>(&item)) {
+        answers_.push_back(f->message);
+      } else {
+        ADD_FAILURE() << "undecodable bytes from the robot: "
+                      << std::get<protocol::DecodeError>(item).detail;
+      }
+    }
   }
 
-  asio::posix::stream_descriptor port_;
-  std::array<std::uint8_t, 512> buffer_{};
   arduino::Decoder decoder_;  // the PC's 256-byte guard
   std::vector<arduino::Item> items_;
   std::vector<arduino::Message> answers_;
   std::size_t bytes_ = 0;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  test::SerialPort port_;  // last: it may call on_bytes until it is gone
 };
 
 /// The robot behind pty://<tmpdir>/arduino0, driven in real time, in the

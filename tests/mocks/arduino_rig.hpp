@@ -49,6 +49,19 @@ struct Robot {
   std::shared_ptr<test::ClientEnd> client;
 };
 
+/// A 12 m by 12 m arena with nothing in it, the robot in its middle: no
+/// echo ever comes back to the sonar.
+inline sim::WorldDef open_field() {
+  sim::WorldDef world;
+  world.arena.width_m = 12;
+  world.arena.height_m = 12;
+  world.arena.obstacles.clear();
+  world.arena.tapes.clear();
+  world.arena.tags.clear();
+  world.arena.start = sim::Pose{6, 6, 0};
+  return world;
+}
+
 inline double heading_deg(const sim::Pose& pose) {
   return sim::rad_to_deg(pose.heading_rad);
 }

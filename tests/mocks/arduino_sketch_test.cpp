@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "mocks/arduino.hpp"
 #include "protocol/arduino/sketch.hpp"
@@ -110,23 +111,20 @@ TEST(ArduinoSketchFirmware, CommandsAreCaseInsensitiveAndUnknownOnesAreBadCmd) {
 
 TEST(ArduinoSketchFirmware, MalformedFramesGetNoAnswerAndRefusalsEchoWhatTheBoardEchoes) {
   Board board;
-  EXPECT_EQ(board.ask("^1*00$"), "");
-  EXPECT_EQ(board.ask("^01|V|1*0*63$"), "");
-  EXPECT_EQ(board.ask("^zz|PING| *00$"), "^zz|NACK|BAD_CS*0F$");
-  EXPECT_EQ(board.ask("^G1|PING| *46$"), "^00|NACK|BAD_SEQ*58$");
+  const std::pair<const char*, const char*> frames_and_answers[] = {
+      {"^1*00$", ""},
+      {"^01|V|1*0*63$", ""},
+      {"^zz|PING| *00$", "^zz|NACK|BAD_CS*0F$"},
+      {"^G1|PING| *46$", "^00|NACK|BAD_SEQ*58$"},
+  };
+  for (const auto& [frame, answer] : frames_and_answers)
+    EXPECT_EQ(board.ask(frame), answer) << frame;
   EXPECT_EQ(board.firmware().stats().bad_frames, 4u);
   EXPECT_EQ(board.firmware().stats().frames_in, 0u);
 }
 
 TEST(ArduinoSketchFirmware, NoEchoReadsBZero) {
-  sim::WorldDef open_field;
-  open_field.arena.width_m = 12;
-  open_field.arena.height_m = 12;
-  open_field.arena.obstacles.clear();
-  open_field.arena.tapes.clear();
-  open_field.arena.tags.clear();
-  open_field.arena.start = sim::Pose{6, 6, 0};
-  Board board(open_field);
+  Board board(test_arduino::open_field());
   EXPECT_EQ(board.ask("^05|B| *67$"), "^05|ACK|B:0*04$");
 }
 

@@ -427,18 +427,11 @@ TEST(ArduinoFirmware, SonarReadsTheDistanceToAWallInWholeCentimetres) {
 }
 
 TEST(ArduinoFirmware, SonarWithoutAnEchoReadsTheConfiguredValue) {
-  sim::WorldDef open_field;
-  open_field.arena.width_m = 12;
-  open_field.arena.height_m = 12;
-  open_field.arena.obstacles.clear();
-  open_field.arena.tapes.clear();
-  open_field.arena.tags.clear();
-  open_field.arena.start = sim::Pose{6, 6, 0};
-  Robot robot(readme_board(), open_field);
+  Robot robot(readme_board(), test_arduino::open_field());
   EXPECT_EQ(robot.ask(request(0x01, arduino::SonarRead{})), ack(0x01, "0"));
   ArduinoConfig config = readme_board();
   config.no_echo_cm = 400;
-  Robot other(config, open_field);
+  Robot other(config, test_arduino::open_field());
   EXPECT_EQ(other.ask(request(0x01, arduino::SonarRead{})), ack(0x01, "400"));
 }
 

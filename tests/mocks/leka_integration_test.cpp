@@ -28,6 +28,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/serial_port.hpp"
 #include "tests/mocks/serial_support.hpp"
 
 namespace hil::mocks {
@@ -45,32 +46,16 @@ using test::TempDir;
 /// byte the robot sends collected.
 class SerialClient {
  public:
-  SerialClient(asio::io_context& io, const std::string& path) : port_(io) {
-    port_.assign(test::open_serial_port(path, B115200));
-    read();
-  }
-  ~SerialClient() { *alive_ = false; }
+  SerialClient(asio::io_context& io, const std::string& path)
+      : port_(io, path, B115200,
+              [this](protocol::ByteView b) { received_.append(protocol::to_string(b)); }) {}
 
-  void write(const Bytes& bytes) {
-    const auto n = ::write(port_.native_handle(), bytes.data(), bytes.size());
-    ASSERT_EQ(n, static_cast<ssize_t>(bytes.size())) << "write to the port failed";
-  }
+  void write(const Bytes& bytes) { port_.write(bytes); }
   std::string text() const { return received_; }
 
  private:
-  void read() {
-    port_.async_read_some(asio::buffer(buffer_),
-                          [this, alive = alive_](std::error_code ec, std::size_t n) {
-                            if (!*alive) return;
-                            received_.append(buffer_.begin(), buffer_.begin() + n);
-                            if (!ec) read();
-                          });
-  }
-
-  asio::posix::stream_descriptor port_;
-  std::array<char, 512> buffer_{};
   std::string received_;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  test::SerialPort port_;  // last: it may write to received_ until it is gone
 };
 
 /// The robot behind pty://<tmpdir>/leka0 at 115200 baud, in real time.

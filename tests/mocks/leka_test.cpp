@@ -37,9 +37,7 @@ constexpr Rgb kGreen{0, 255, 0};
 constexpr Rgb kBlue{0, 0, 255};
 constexpr Rgb kWhite{255, 255, 255};
 
-link::Time at_ms(int ms) {
-  return link::Time(milliseconds(ms));
-}
+using test::at_ms;
 
 using hil::test::hex;
 

@@ -21,6 +21,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/mock_test_support.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -37,13 +38,9 @@ class TcpCar {
         firmware_(world_, vehicle_),
         server_(context_, firmware_, options()) {
     server_.start();
-    link::connect(context_, link::parse_endpoint(server_.address()),
-                  [this](std::error_code ec, link::BytePipePtr pipe) {
-                    if (ec) return;
-                    pipe_ = pipe;
-                    pipe_->start({[this](protocol::ByteView b) { decoder_.feed(b, items_); },
-                                  [this](std::error_code) { closed_ = true; }});
-                  });
+    test::connect_client(context_, server_, pipe_,
+                         {[this](protocol::ByteView b) { decoder_.feed(b, items_); },
+                          [this](std::error_code) { closed_ = true; }});
     EXPECT_TRUE(link::test::run_until(io_, [&] { return pipe_ && firmware_.connected(); }));
   }
   ~TcpCar() {

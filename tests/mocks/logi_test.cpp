@@ -9,8 +9,11 @@
 
 #include <cmath>
 #include <functional>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "protocol/logi/codec.hpp"
@@ -126,6 +129,16 @@ class Bench {
     return true;
   }
 
+  /// Runs until the car is not running (as run_until(done, limit)).
+  bool run_until_stopped(link::Duration limit) {
+    return run_until([this] { return !state().running; }, limit);
+  }
+  /// Sets the target station and starts the run, whatever the answers.
+  void start_run(std::string_view station) {
+    ask("GS:" + std::string(station));
+    ask("ST:RUN");
+  }
+
   Time now() const { return car_.now(); }
   LogiFirmware& fw() { return car_.firmware(); }
   const LogiState& state() { return car_.firmware().state(); }
@@ -159,8 +172,13 @@ class Bench {
   std::uint64_t decode_errors_ = 0;
 };
 
-Time at_ms(int ms) {
-  return Time(milliseconds(ms));
+using test::at_ms;
+
+/// Sends each command in turn and expects its answer.
+void expect_answers(Bench& b,
+                    std::initializer_list<std::pair<std::string_view, std::string_view>> asked) {
+  for (const auto& [command, answer] : asked)
+    EXPECT_EQ(b.ask(command), answer) << command;
 }
 
 double speed_of(const sim::Twist& t) {
@@ -251,19 +269,19 @@ TEST(LogiFirmware, StatFieldsAtRestOnTheWarehouseStart) {
   b.run_until(at_ms(500));
   const auto stats = b.stats();
   ASSERT_EQ(stats.size(), 1u);
-  logi::Status expected;
-  expected.speed_percent = 50;
-  expected.station = 0;
-  expected.running = false;
-  expected.mode = Mode::automatic;
-  expected.manual = Direction::stop;
   // The beam's right edge (15 degrees) meets the south wall 0.6 m / sin 15 = 2.32 m
-  // from the nose, nearer than the east wall straight ahead (2.66 m).
-  expected.distance_cm = 232;
-  expected.track_mask = 0b0110;  // tape centred between H3 and H2
-  expected.deviation = 0;
-  expected.obstacle = false;
-  expected.rpm = {0, 0, 0, 0};
+  // from the nose, nearer than the east wall straight ahead (2.66 m); the
+  // tape is centred between H3 and H2.
+  const logi::Status expected{.speed_percent = 50,
+                              .station = 0,
+                              .running = false,
+                              .mode = Mode::automatic,
+                              .manual = Direction::stop,
+                              .distance_cm = 232,
+                              .track_mask = 0b0110,
+                              .deviation = 0,
+                              .obstacle = false,
+                              .rpm = {0, 0, 0, 0}};
   EXPECT_EQ(stats[0].second, expected);
   EXPECT_EQ(logi::encode_text(stats[0].second),
             logi::frame_text("STAT:SP:050,STA:000,RUN:0,MODE:AUTO,MAN:STOP,DIS:232,TRK:0110,DEV:0,"
@@ -294,8 +312,7 @@ TEST(LogiFirmware, StatFieldsFollowTheSimulationWhileStrafing) {
 
 TEST(LogiFirmware, StatKeepsStationAndRunFromTheRun) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   b.run_until(at_ms(1000));
   const auto stats = b.stats();
   ASSERT_EQ(stats.size(), 2u);
@@ -366,16 +383,16 @@ TEST(LogiFirmware, StationAcceptsTheConfiguredListOnly) {
   EXPECT_EQ(b.state().station, 1);
   EXPECT_EQ(b.ask("GS:002"), "FB:GS:1");
   EXPECT_EQ(b.state().station, 2);
-  EXPECT_EQ(b.ask("GS:003"), "FB:GS:0");
-  EXPECT_EQ(b.ask("GS:000"), "FB:GS:0");
-  EXPECT_EQ(b.ask("GS:999"), "FB:GS:0");
-  EXPECT_EQ(b.ask("GS:x"), "FB:GS:0");
-  EXPECT_EQ(b.ask("GS:1"), "FB:GS:0");
+  expect_answers(b, {
+                        {"GS:003", "FB:GS:0"},
+                        {"GS:000", "FB:GS:0"},
+                        {"GS:999", "FB:GS:0"},
+                        {"GS:x", "FB:GS:0"},
+                        {"GS:1", "FB:GS:0"},
+                    });
   EXPECT_EQ(b.state().station, 2);
 
-  LogiConfig config;
-  config.stations = {1, 2, 7};
-  Bench seven(config);
+  Bench seven(LogiConfig{.stations = {1, 2, 7}});
   EXPECT_EQ(seven.ask("GS:007"), "FB:GS:1");
   EXPECT_EQ(seven.state().station, 7);
 }
@@ -384,11 +401,10 @@ TEST(LogiFirmware, ModeSwitchesBothWaysAndRefusesNonsense) {
   Bench b;
   EXPECT_EQ(b.ask("MD:MAN"), "FB:MD:1");
   EXPECT_EQ(b.state().mode, Mode::manual);
-  EXPECT_EQ(b.ask("MD:MAN"), "FB:MD:1");  // already there
-  EXPECT_EQ(b.ask("MD:AUTO"), "FB:MD:1");
+  // MAN again (already there), then AUTO.
+  expect_answers(b, {{"MD:MAN", "FB:MD:1"}, {"MD:AUTO", "FB:MD:1"}});
   EXPECT_EQ(b.state().mode, Mode::automatic);
-  EXPECT_EQ(b.ask("MD:HALF"), "FB:MD:0");
-  EXPECT_EQ(b.ask("MD:auto"), "FB:MD:0");
+  expect_answers(b, {{"MD:HALF", "FB:MD:0"}, {"MD:auto", "FB:MD:0"}});
   EXPECT_EQ(b.state().mode, Mode::automatic);
 }
 
@@ -406,10 +422,12 @@ TEST(LogiFirmware, EveryMoveIsRefusedInAutoAndNothingMoves) {
 TEST(LogiFirmware, MalformedMoveAndRunAreRefused) {
   Bench b;
   b.ask("MD:MAN");
-  EXPECT_EQ(b.ask("MV:UP"), "FB:MV:0");
-  EXPECT_EQ(b.ask("MV:fwd"), "FB:MV:0");
-  EXPECT_EQ(b.ask("ST:GO"), "FB:ST:0");
-  EXPECT_EQ(b.ask("ST:"), "FB:ST:0");
+  expect_answers(b, {
+                        {"MV:UP", "FB:MV:0"},
+                        {"MV:fwd", "FB:MV:0"},
+                        {"ST:GO", "FB:ST:0"},
+                        {"ST:", "FB:ST:0"},
+                    });
   EXPECT_EQ(b.state().manual, Direction::stop);
 }
 
@@ -457,9 +475,7 @@ TEST(LogiFirmware, ALowercaseChecksumIsDroppedUnlessConfigured) {
   Bench strict;
   EXPECT_EQ(strict.ask_raw("LOGI:SP:030:d5#"), "");
   EXPECT_EQ(strict.fw().stats().bad_frames, 1u);
-  LogiConfig config;
-  config.accept_lowercase_checksum = true;
-  Bench lenient(config);
+  Bench lenient(LogiConfig{.accept_lowercase_checksum = true});
   EXPECT_EQ(lenient.ask_raw("LOGI:SP:030:d5#"), "FB:SP:1");
   EXPECT_EQ(lenient.state().speed_percent, 30);
 }
@@ -467,9 +483,11 @@ TEST(LogiFirmware, ALowercaseChecksumIsDroppedUnlessConfigured) {
 TEST(LogiFirmware, GarbageUnknownCodesAndOversizedRunsAreDroppedAndCounted) {
   Bench b;
   EXPECT_EQ(b.ask_raw("hello"), "");
-  EXPECT_EQ(b.ask("ZZ:1"), "");
-  EXPECT_EQ(b.ask("SPEED:050"), "");
-  EXPECT_EQ(b.ask("NOCOLON"), "");
+  expect_answers(b, {
+                        {"ZZ:1", ""},
+                        {"SPEED:050", ""},
+                        {"NOCOLON", ""},
+                    });
   EXPECT_EQ(b.fw().stats().bad_frames, 4u);
   // 256 bytes at most are held: the first 256 come out as one oversized piece...
   EXPECT_EQ(b.ask_raw("LOGI:" + std::string(400, 'A')), "");
@@ -621,10 +639,12 @@ TEST(LogiFirmware, StopCommandAndModeSwitchHaltManualMotion) {
 
 TEST(LogiFirmware, AutoRunFromTheStartStopsOnStation001AndNeedsGsAgain) {
   Bench b;
-  EXPECT_EQ(b.ask("MD:AUTO"), "FB:MD:1");
-  EXPECT_EQ(b.ask("GS:001"), "FB:GS:1");
-  EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:1");
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(10)));
+  expect_answers(b, {
+                        {"MD:AUTO", "FB:MD:1"},
+                        {"GS:001", "FB:GS:1"},
+                        {"ST:RUN", "FB:ST:1"},
+                    });
+  ASSERT_TRUE(b.run_until_stopped(seconds(10)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
   EXPECT_EQ(b.state().arrivals, 1u);
   b.run_for(seconds(1));
@@ -641,7 +661,7 @@ TEST(LogiFirmware, AutoRunFromTheStartStopsOnStation001AndNeedsGsAgain) {
   EXPECT_FALSE(b.state().station_armed);
   EXPECT_EQ(b.ask("GS:002"), "FB:GS:1");
   EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:1");
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(40)));
+  ASSERT_TRUE(b.run_until_stopped(seconds(40)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
   EXPECT_NEAR(b.pose().y_m, 2.4, 0.02);
   EXPECT_NEAR(b.pose().x_m, 2.0, 0.1);
@@ -649,8 +669,7 @@ TEST(LogiFirmware, AutoRunFromTheStartStopsOnStation001AndNeedsGsAgain) {
 
 TEST(LogiFirmware, AutoRunTo002PassesStation001WithoutStopping) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   bool passed_001 = false;
   ASSERT_TRUE(b.run_until(
       [&] {
@@ -674,8 +693,7 @@ TEST(LogiFirmware, TheFollowerIsStableFrom20To100Percent) {
     SCOPED_TRACE(sp);
     Bench b;
     b.ask("SP:" + std::string(sp < 100 ? "0" : "") + std::to_string(sp));
-    b.ask("GS:002");
-    b.ask("ST:RUN");
+    b.start_run("002");
     const sim::Tape& tape = b.car().world().arena().tapes.at(0);
     double worst_m = 0;
     int lost_ticks = 0;
@@ -696,15 +714,14 @@ TEST(LogiFirmware, TheFollowerIsStableFrom20To100Percent) {
 
 TEST(LogiFirmware, ARunStartedOnItsStationsTagGoesRoundTheLoop) {
   Bench b;
-  b.ask("GS:001");
-  b.ask("ST:RUN");
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(10)));
+  b.start_run("001");
+  ASSERT_TRUE(b.run_until_stopped(seconds(10)));
   b.run_for(seconds(1));
   ASSERT_EQ(b.vehicle().rfid(), std::optional<std::string>("001"));  // stopped on the tag
   b.ask("GS:001");
   const Time start = b.now();
   EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:1");
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(60)));
+  ASSERT_TRUE(b.run_until_stopped(seconds(60)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
   EXPECT_EQ(b.state().arrivals, 2u);
   EXPECT_GT(b.now() - start, seconds(25));  // 7.7 m of tape at 0.25 m/s or less
@@ -714,8 +731,7 @@ TEST(LogiFirmware, ARunStartedOnItsStationsTagGoesRoundTheLoop) {
 
 TEST(LogiFirmware, StopPausesARunThatRunResumes) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   b.run_for(seconds(2));
   EXPECT_EQ(b.ask("ST:STOP"), "FB:ST:1");
   EXPECT_FALSE(b.state().running);
@@ -727,7 +743,7 @@ TEST(LogiFirmware, StopPausesARunThatRunResumes) {
   b.run_for(seconds(1));
   EXPECT_EQ(b.pose(), held);
   EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:1");  // no new GS needed after a stop
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(40)));
+  ASSERT_TRUE(b.run_until_stopped(seconds(40)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
   EXPECT_NEAR(b.pose().y_m, 2.4, 0.02);
 }
@@ -741,14 +757,13 @@ TEST(LogiFirmware, SpeedZeroHoldsARunInPlaceUntilSpeedComesBack) {
   EXPECT_TRUE(b.state().running);
   EXPECT_NEAR(b.pose().x_m, 1.2, 1e-6);
   EXPECT_EQ(b.ask("SP:060"), "FB:SP:1");  // takes effect on the run under way
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(10)));
+  ASSERT_TRUE(b.run_until_stopped(seconds(10)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
 }
 
 TEST(LogiFirmware, StationCannotChangeDuringARun) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   b.run_for(milliseconds(500));
   EXPECT_EQ(b.ask("GS:001"), "FB:GS:0");
   EXPECT_EQ(b.state().station, 2);
@@ -757,8 +772,7 @@ TEST(LogiFirmware, StationCannotChangeDuringARun) {
 
 TEST(LogiFirmware, ManualModeTakesOverFromARun) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   b.run_for(milliseconds(500));
   EXPECT_EQ(b.ask("MV:STOP"), "FB:MV:0");  // MV is refused in AUTO, STOP included
   EXPECT_TRUE(b.state().running);
@@ -773,9 +787,8 @@ TEST(LogiFirmware, ManualModeTakesOverFromARun) {
 
 TEST(LogiFirmware, LosingTheLineEndsTheRunAfterTheTimeout) {
   Bench b({}, short_tape());
-  b.ask("GS:001");
-  b.ask("ST:RUN");
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(10)));
+  b.start_run("001");
+  ASSERT_TRUE(b.run_until_stopped(seconds(10)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::line_lost);
   EXPECT_EQ(b.state().track_mask, 0);
   b.run_for(seconds(1));
@@ -798,8 +811,7 @@ TEST(LogiFirmware, LosingTheLineEndsTheRunAfterTheTimeout) {
 
 TEST(LogiFirmware, TheObstacleLockHaltsAnAutoRunAndLetsItGoWhenClear) {
   Bench b({}, corridor());
-  b.ask("GS:001");
-  b.ask("ST:RUN");
+  b.start_run("001");
   ASSERT_TRUE(b.run_until([&] { return b.state().obstacle; }, seconds(10)));
   EXPECT_TRUE(b.state().running);
   b.run_for(seconds(2));
@@ -820,7 +832,7 @@ TEST(LogiFirmware, TheObstacleLockHaltsAnAutoRunAndLetsItGoWhenClear) {
   // The parcel is carried off: put the car on the tape beyond it.
   b.vehicle().place({2.3, 0.5, 0.0});
   ASSERT_TRUE(b.run_until([&] { return !b.state().obstacle; }, milliseconds(100)));
-  ASSERT_TRUE(b.run_until([&] { return !b.state().running; }, seconds(10)));
+  ASSERT_TRUE(b.run_until_stopped(seconds(10)));
   EXPECT_EQ(b.state().last_run_end, LogiRunEnd::arrived);
   EXPECT_NEAR(b.pose().x_m, 3.0, 0.05);
 }
@@ -894,8 +906,7 @@ TEST(LogiFirmware, TheStopDistanceIsConfigurable) {
 
 TEST(LogiFirmware, TheFaultStateStopsTheCarAndRefusesMotion) {
   Bench b;
-  b.ask("GS:002");
-  b.ask("ST:RUN");
+  b.start_run("002");
   b.fw().arm(Behaviour{"", When{at_ms(1000), "", 1}, EnterFault{}});
   b.run_until(at_ms(1000));
   EXPECT_TRUE(b.fw().in_fault());
@@ -906,12 +917,14 @@ TEST(LogiFirmware, TheFaultStateStopsTheCarAndRefusesMotion) {
   EXPECT_EQ(b.fw().summary().substr(0, 10), "AUTO FAULT");
   EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:0");
   EXPECT_EQ(b.ask("SP:080"), "FB:SP:1");  // settings still work
-  EXPECT_EQ(b.ask("GS:001"), "FB:GS:1");
-  EXPECT_EQ(b.ask("ST:STOP"), "FB:ST:1");
-  EXPECT_EQ(b.ask("MD:MAN"), "FB:MD:1");
-  EXPECT_EQ(b.ask("MV:FWD"), "FB:MV:0");
-  EXPECT_EQ(b.ask("MV:CW"), "FB:MV:0");
-  EXPECT_EQ(b.ask("MV:STOP"), "FB:MV:1");
+  expect_answers(b, {
+                        {"GS:001", "FB:GS:1"},
+                        {"ST:STOP", "FB:ST:1"},
+                        {"MD:MAN", "FB:MD:1"},
+                        {"MV:FWD", "FB:MV:0"},
+                        {"MV:CW", "FB:MV:0"},
+                        {"MV:STOP", "FB:MV:1"},
+                    });
   const sim::Pose held = b.pose();
   b.run_for(seconds(1));
   EXPECT_EQ(b.pose(), held);
@@ -924,9 +937,11 @@ TEST(LogiFirmware, TheFaultStateStopsTheCarAndRefusesMotion) {
   b.run_for(milliseconds(1));
   EXPECT_FALSE(b.fw().in_fault());
   EXPECT_EQ(b.state().manual, Direction::stop);  // nothing restarts by itself
-  EXPECT_EQ(b.ask("MV:FWD"), "FB:MV:1");
-  EXPECT_EQ(b.ask("MD:AUTO"), "FB:MD:1");
-  EXPECT_EQ(b.ask("ST:RUN"), "FB:ST:1");
+  expect_answers(b, {
+                        {"MV:FWD", "FB:MV:1"},
+                        {"MD:AUTO", "FB:MD:1"},
+                        {"ST:RUN", "FB:ST:1"},
+                    });
 }
 
 TEST(LogiFirmware, ARejectAnswersNegativelyWithoutEffect) {
@@ -1027,8 +1042,7 @@ TEST(LogiFirmware, StopOnDisconnectHaltsManualMotionAndEndsARun) {
   }
   {
     Bench b(config);
-    b.ask("GS:002");
-    b.ask("ST:RUN");
+    b.start_run("002");
     b.run_for(milliseconds(500));
     b.client().pipe->close();
     b.run_for(milliseconds(500));
@@ -1041,8 +1055,7 @@ TEST(LogiFirmware, StopOnDisconnectHaltsManualMotionAndEndsARun) {
 
 TEST(LogiFirmware, AnAutoRunFinishesWithNoClientConnected) {
   Bench b;
-  b.ask("GS:001");
-  b.ask("ST:RUN");
+  b.start_run("001");
   b.client().pipe->close();
   b.run_until(at_ms(10000));
   EXPECT_FALSE(b.fw().connected());

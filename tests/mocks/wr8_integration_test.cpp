@@ -22,6 +22,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
+#include "tests/mocks/mock_test_support.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -39,16 +40,10 @@ class TcpCar {
         firmware_(world_, vehicle_, config),
         server_(context_, firmware_, server_options()) {
     server_.start();
-    link::connect(context_, link::parse_endpoint(server_.address()),
-                  [this](std::error_code ec, link::BytePipePtr pipe) {
-                    if (ec) {
-                      closed_ = ec;
-                      return;
-                    }
-                    pipe_ = pipe;
-                    pipe_->start({[this](protocol::ByteView b) { on_data(b); },
-                                  [this](std::error_code why) { closed_ = why; }});
-                  });
+    test::connect_client(context_, server_, pipe_,
+                         {[this](protocol::ByteView b) { on_data(b); },
+                          [this](std::error_code why) { closed_ = why; }},
+                         [this](std::error_code ec) { closed_ = ec; });
     EXPECT_TRUE(link::test::run_until(io_, [&] { return pipe_ || closed_; }));
     EXPECT_TRUE(pipe_) << "could not connect to " << server_.address();
     EXPECT_TRUE(link::test::run_until(io_, [&] { return firmware_.connected(); }));

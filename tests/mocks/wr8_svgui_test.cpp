@@ -24,7 +24,6 @@
 namespace hil::mocks {
 namespace {
 
-namespace wr8 = protocol::wr8;
 using link::milliseconds;
 using link::seconds;
 using protocol::Bytes;
@@ -32,9 +31,7 @@ using ::testing::ElementsAre;
 
 using Car = test::VirtualCar<SvguiFirmware>;
 
-std::int64_t ms_of(Time t) {
-  return std::chrono::duration_cast<milliseconds>(t).count();
-}
+using test::ms_of;
 
 Bytes text_bytes(std::string_view text) {
   return Bytes(text.begin(), text.end());
@@ -92,14 +89,7 @@ class Gui {
   void send(const svgui::Message& m) { send_bytes(svgui::encode_prefixed(m, version_)); }
 
   void run_until(Time t) {
-    for (;;) {
-      collect();
-      const auto due = car_.executor().next_due();
-      if (!due || *due > t) break;
-      car_.executor().run_one();
-    }
-    car_.run_until(t);
-    collect();
+    car_.run_until_each(t, [this] { collect(); });
   }
   void run_for(Duration d) { run_until(car_.now() + d); }
 
@@ -123,24 +113,17 @@ class Gui {
  private:
   void collect() {
     const Bytes bytes = client_->take();
-    if (bytes.empty()) return;
-    items_.clear();
-    decoder_.feed(protocol::ByteView(bytes), items_);
-    for (auto& item : items_) {
-      if (const auto* e = std::get_if<protocol::DecodeError>(&item)) {
-        ADD_FAILURE() << "the vehicle sent bytes its GUI cannot decode: " << e->detail;
-        continue;
-      }
-      auto& frame = std::get<protocol::Frame<svgui::Message>>(item);
-      log_.push_back(Received{ms_of(car_.now()), frame.raw, frame.message});
-    }
+    test::decode_frames<svgui::Message>(
+        decoder_, bytes,
+        "the vehicle sent bytes its GUI cannot decode: ", [this](const auto& frame) {
+          log_.push_back(Received{ms_of(car_.now()), frame.raw, frame.message});
+        });
   }
 
   svgui::Version version_;
   Car car_;
   std::shared_ptr<test::ClientEnd> client_;
   svgui::Decoder decoder_;
-  std::vector<svgui::Item> items_;
   std::vector<Received> log_;
 };
 
@@ -315,7 +298,7 @@ TEST(Wr8SvguiData, V2019SendsItsFortyTwoByteDataOnTheConfiguredPeriod) {
     EXPECT_EQ(got[k].raw[0], 0x2A);
     EXPECT_EQ(got[k].raw[1], 0x06);
     const auto& data = std::get<svgui::Data>(got[k].message);
-    EXPECT_EQ(data.state, wr8::State::wait);
+    EXPECT_EQ(data.state, protocol::wr8::State::wait);
     EXPECT_EQ(data.timestamp_ms, 100u * (k + 1));
     EXPECT_EQ(data.motor_battery, 100u);
   }

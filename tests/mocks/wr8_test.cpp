@@ -30,14 +30,8 @@ using link::seconds;
 using protocol::Bytes;
 
 using Car = test::VirtualCar<Wr8Firmware>;
-
-Time at_ms(std::int64_t ms) {
-  return Time(milliseconds(ms));
-}
-
-std::int64_t ms_of(Time t) {
-  return std::chrono::duration_cast<milliseconds>(t).count();
-}
+using test::at_ms;
+using test::ms_of;
 
 /// One packet the client received, and when.
 struct Packet {
@@ -96,16 +90,25 @@ class Gui {
     ASSERT_TRUE(std::holds_alternative<wr8::AuthReply>(log_.back().message));
   }
 
+  /// Authenticates and forgets the bytes received so far, for a test that
+  /// reads the raw bytes (client(), take_hex()).
+  void authenticate_raw() {
+    authenticate();
+    client().take();
+  }
+  /// The bytes received since the last look, in hex.
+  std::string take_hex() { return protocol::to_hex(client().take()); }
+
+  /// Authenticates, runs to `t` and forgets what arrived so far.
+  void settle(Time t) {
+    authenticate();
+    run_until(t);
+    take();
+  }
+
   /// Runs every event up to `t`, recording each packet at its exact time.
   void run_until(Time t) {
-    for (;;) {
-      collect();
-      const auto due = car_.executor().next_due();
-      if (!due || *due > t) break;
-      car_.executor().run_one();
-    }
-    car_.run_until(t);
-    collect();
+    car_.run_until_each(t, [this] { collect(); });
   }
   void run_for(Duration d) { run_until(car_.now() + d); }
 
@@ -124,23 +127,16 @@ class Gui {
  private:
   void collect() {
     const Bytes bytes = client_->take();
-    if (bytes.empty()) return;
-    items_.clear();
-    decoder_.feed(protocol::ByteView(bytes), items_);
-    for (auto& item : items_) {
-      if (const auto* e = std::get_if<protocol::DecodeError>(&item)) {
-        ADD_FAILURE() << "the car sent bytes a GUI cannot decode: " << e->detail;
-        continue;
-      }
-      log_.push_back(Packet{car_.now(), std::get<protocol::Frame<wr8::Message>>(item).message});
-    }
+    test::decode_frames<wr8::Message>(
+        decoder_, bytes, "the car sent bytes a GUI cannot decode: ", [this](const auto& frame) {
+          log_.push_back(Packet{car_.now(), frame.message});
+        });
   }
 
   Wr8Config config_;
   Car car_;
   std::shared_ptr<test::ClientEnd> client_;
   wr8::Decoder decoder_;
-  std::vector<wr8::Item> items_;
   std::vector<Packet> log_;
 };
 
@@ -377,11 +373,10 @@ TEST(Wr8Data, ThePeriodIsConfigurable) {
 
 TEST(Wr8Data, AtRestCarriesStopAndTheFourReadingsInTheProfileUnits) {
   Gui gui;
-  gui.authenticate();
-  gui.client().take();
+  gui.authenticate_raw();
   gui.car().run_until(at_ms(100));
   // STOP, 100 ms, 17 block bytes: odometry 0 cm, speed 0.0f, angle 0.0f, battery 100 %.
-  EXPECT_EQ(protocol::to_hex(gui.client().take()),
+  EXPECT_EQ(gui.take_hex(),
             "06 02 64 00 00 00 11 00 00 00 00 00 01 00 00 00 00 02 00 00 00 00 03 64");
 }
 
@@ -398,9 +393,7 @@ TEST(Wr8Data, MutedTelemetryLeavesGapsAndResumesOnTheGrid) {
 
 TEST(Wr8Data, FollowsADriveInRunStateAndItsNumbersAgreeWithEachOther) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.drive(1, 100);
   gui.run_until(at_ms(6000));
   const auto got = gui.take();
@@ -431,9 +424,7 @@ TEST(Wr8Data, FollowsADriveInRunStateAndItsNumbersAgreeWithEachOther) {
 
 TEST(Wr8Task, CheckCompletesAtOnce) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.task(7, wr8::TaskCode::check);
   EXPECT_EQ(answers(gui.take()), (std::vector<Answer>{{1000, 7, kCompleted}}));
   gui.send_unchecked(wr8::Task{8, wr8::TaskCode::check, {wr8::Word::from_i32(1)}});
@@ -442,9 +433,7 @@ TEST(Wr8Task, CheckCompletesAtOnce) {
 
 TEST(Wr8Task, DriveCompletesOnTheFirstControlTickAfterTheWheelsCovered100Cm) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   const sim::Pose start = gui.vehicle().pose();
   gui.drive(1, 100);
   EXPECT_EQ(answers(gui.take()), (std::vector<Answer>{{1000, 1, kStarted}}));
@@ -484,9 +473,7 @@ TEST(Wr8Task, DriveCompletesOnTheFirstControlTickAfterTheWheelsCovered100Cm) {
 
 TEST(Wr8Task, DriveRefusesDistancesItCannotDrive) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.drive(1, 0);
   gui.drive(2, -10);
   gui.drive(3, 1001);  // past max_drive_cm
@@ -502,9 +489,7 @@ TEST(Wr8Task, DriveRefusesDistancesItCannotDrive) {
 
 TEST(Wr8Task, ANewMotionTaskWhileOneRunsIsAnErrorAndTheRunningOneGoesOn) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.drive(1, 50);
   gui.run_until(at_ms(1200));
   gui.drive(2, 50);
@@ -530,9 +515,7 @@ TEST(Wr8Task, ANewMotionTaskWhileOneRunsIsAnErrorAndTheRunningOneGoesOn) {
 
 TEST(Wr8Task, TurnCompletesWhenTheWheelsReachTheAngle) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.turn(1, 15);
   // The servo slews 1.5 degrees per 1/120 s step: ten steps, the last ending
   // at 1083.3 ms; the control tick at 1090 ms sees the wheels there.
@@ -569,9 +552,7 @@ TEST(Wr8Task, RunStateWhileTheWheelsTurn) {
 
 TEST(Wr8Task, TurnOutOfTheSteeringRangeIsAnError) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.turn(1, 31);
   gui.turn(2, -31);
   gui.turn(3, 30);  // the limit itself is fine
@@ -583,9 +564,7 @@ TEST(Wr8Task, TurnOutOfTheSteeringRangeIsAnError) {
 
 TEST(Wr8Task, TurningToTheAngleTheWheelsAlreadyHaveCompletesOnTheNextTick) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1003));
-  gui.take();
+  gui.settle(at_ms(1003));
   gui.turn(1, 0);
   gui.run_until(at_ms(1100));
   EXPECT_EQ(answers(gui.take()), (std::vector<Answer>{{1003, 1, kStarted}, {1010, 1, kCompleted}}));
@@ -593,9 +572,7 @@ TEST(Wr8Task, TurningToTheAngleTheWheelsAlreadyHaveCompletesOnTheNextTick) {
 
 TEST(Wr8Task, BlinkCompletesAfterTheBlinkTimeInWaitState) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.task(1, wr8::TaskCode::blink);
   gui.run_until(at_ms(1500));
   gui.task(2, wr8::TaskCode::blink);  // one blink at a time
@@ -612,9 +589,7 @@ TEST(Wr8Task, BlinkTimeIsConfigurable) {
   Wr8Config config;
   config.blink_duration = milliseconds(750);
   Gui gui(config);
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.task(1, wr8::TaskCode::blink);
   gui.run_until(at_ms(2000));
   EXPECT_EQ(answers(gui.take()), (std::vector<Answer>{{1000, 1, kStarted}, {1750, 1, kCompleted}}));
@@ -622,12 +597,11 @@ TEST(Wr8Task, BlinkTimeIsConfigurable) {
 
 TEST(Wr8Task, GetSettingsSendsAllFourSettingsWithTheSameCoiThenCompleted) {
   Gui gui;
-  gui.authenticate();
-  gui.client().take();
+  gui.authenticate_raw();
   gui.client().write(wr8::encode(wr8::Task{5, wr8::TaskCode::get_settings, {}}));
   gui.car().run_for(milliseconds(0));
   // SETTINGS COI 5: P 1.5, I 0.25, D 0.05 (float32), servo zero 90 (int32); then RESPONSE.
-  EXPECT_EQ(protocol::to_hex(gui.client().take()),
+  EXPECT_EQ(gui.take_hex(),
             "04 05 14 00 00 00 C0 3F 01 00 00 80 3E 02 CD CC 4C 3D 03 5A 00 00 00 05 05 02");
 }
 
@@ -710,9 +684,7 @@ TEST(Wr8Settings, TheStallTimeoutIsConfigurable) {
   config.p = config.i = config.d = 0;
   config.stall_timeout = milliseconds(500);
   Gui gui(config);
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.drive(1, 100);
   gui.run_until(at_ms(2000));
   EXPECT_EQ(answers(gui.take()), (std::vector<Answer>{{1000, 1, kStarted}, {1500, 1, kError}}));
@@ -751,9 +723,7 @@ TEST(Wr8Settings, TheGainsChangeHowTheCarDrives) {
 
 TEST(Wr8Settings, ServoZeroOffsetsTheWheelsAndTheCarDrifts) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.settings(1, {servo_zero(95)});  // 5 servo degrees left of the mechanical centre
   gui.run_until(at_ms(1100));
   auto got = gui.take();
@@ -839,9 +809,7 @@ TEST(Wr8Fault, StopsTheCarFailsTheTaskAndRefusesTasksUntilCleared) {
 
 TEST(Wr8Behaviour, RejectAnswersErrorWithNoEffect) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.fw().arm(Behaviour{"", When{}, Reject{"TASK", 1}});
   gui.fw().arm(Behaviour{"", When{}, Reject{"SETTINGS", 1}});
   gui.drive(1, 100);
@@ -867,9 +835,7 @@ TEST(Wr8Behaviour, ARejectedAuthIsARefusedLogin) {
 
 TEST(Wr8Behaviour, IgnoreSwallowsCommandsWithoutAnswerOrEffect) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.fw().arm(Behaviour{"", When{}, Ignore{"TASK", 2, std::nullopt}});
   gui.drive(1, 100);
   gui.task(2, wr8::TaskCode::check);
@@ -943,9 +909,7 @@ TEST(Wr8Connection, WithStopOnDisconnectOffTheDriveFinishesUnwatched) {
 
 TEST(Wr8Malformed, TasksAndSettingsThatCannotBeUsedAreAnsweredErrorWithTheirCoi) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   const auto body = [](std::initializer_list<std::uint8_t> b) { return Bytes(b); };
   // drive with no distance (the profile wants one parameter)
   gui.send_bytes(wr8::raw_packet(3, body({0x11, 0x01, 0x00})));
@@ -968,9 +932,7 @@ TEST(Wr8Malformed, TasksAndSettingsThatCannotBeUsedAreAnsweredErrorWithTheirCoi)
 
 TEST(Wr8Malformed, GarbageAndVehiclePacketsAreCountedAndSkipped) {
   Gui gui;
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   // Bytes that are no packet code, then packet codes only a vehicle sends,
   // then a good task: the stream stays in step.
   gui.send_bytes(Bytes{0xFF, 0xFE, 0x80, 0x06, 0x05, 0x02, 0x03, 0x21, 0x00, 0x00});
@@ -1035,9 +997,7 @@ TEST(Wr8Profile, ABigEndianEntriesProfileIsSpokenBothWays) {
   // (Wr8Firmware::adapter()), so a frame-aware link carries them whole.
   ServerOptions options;
   Gui gui(config, options);  // its GUI decodes with the same profile
-  gui.authenticate();
-  gui.run_until(at_ms(1000));
-  gui.take();
+  gui.settle(at_ms(1000));
   gui.drive(1, 20);
   gui.run_until(at_ms(3000));
   const auto got = gui.take();

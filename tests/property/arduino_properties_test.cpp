@@ -5,7 +5,7 @@
 // operator session, checked from its frame log, its events and the chassis.
 //
 // Each property was seen to fail with its rule broken on purpose in a copy
-// of client/arduino/client_core.cpp (never in this tree), then the copy was
+// of client/arduino/core.cpp (never in this tree), then the copy was
 // thrown away; 300 sessions per property found each of these:
 //   - timeouts growing base x (attempt + 1) instead of doubling, a BAD_CS
 //     resend counted as a retry, an ACK taken whatever its SEQ:
@@ -34,7 +34,7 @@
 #include <variant>
 #include <vector>
 
-#include "client/arduino/client_core.hpp"
+#include "client/arduino/core.hpp"
 #include "client/arduino/session.hpp"
 #include "link/executor.hpp"
 #include "link/faults/profile.hpp"
@@ -46,6 +46,7 @@
 #include "sim/presets.hpp"
 #include "tests/client/client_test_support.hpp"
 #include "tests/property/random_faults.hpp"
+#include "tests/property/session_commands.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -255,22 +256,16 @@ RC_GTEST_PROP(ArduinoClientProperties,
 rc::Gen<link::FaultProfile> gen_faults() {
   return rc::gen::exec([] {
     RandomFaults faults(30);
-    if (RandomFaults::coin()) faults.add_sometimes(link::Drop{});
+    faults.maybe(link::Drop{});
     if (RandomFaults::coin())
       faults.add_sometimes(
           link::Corrupt{.target = link::CorruptTarget::random, .field = "", .bits = 1});
     if (RandomFaults::coin())
       faults.add_sometimes(
           link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1});
-    if (RandomFaults::coin()) faults.add_sometimes(link::Duplicate{1});
-    if (RandomFaults::coin())
-      faults.add_sometimes(link::Delay{milliseconds(*rc::gen::inRange(0, 800)),
-                                       milliseconds(*rc::gen::inRange(0, 800))});
-    if (RandomFaults::coin()) {
-      const auto piece = *rc::gen::inRange<std::size_t>(1, 9);
-      faults.add_sometimes(
-          link::Fragment{{1, piece}, {Duration::zero(), milliseconds(*rc::gen::inRange(0, 30))}});
-    }
+    faults.maybe(link::Duplicate{1});
+    faults.maybe_delay(800);
+    faults.maybe_fragment();
     if (RandomFaults::coin())
       faults.add_sometimes(link::Coalesce{2, milliseconds(*rc::gen::inRange(1, 200))});
     if (RandomFaults::coin()) faults.add_sometimes(link::Garbage{{1, 1}, {'\r', '\n', '~', '#'}});
@@ -379,7 +374,7 @@ std::vector<WireFrame> wire_of(const ArduinoRig& rig) {
   for (const auto& e : rig.session->log().entries()) {
     WireFrame f;
     f.at = Time{e.utc_us};
-    f.tx = e.direction == LogDirection::tx;
+    f.tx = e.kind == LogKind::tx;
     f.raw = e.raw;
     const protocol::Bytes bytes(e.raw.begin(), e.raw.end());
     const auto item = proto::decode_frame(bytes, rig.session->core().config().dialect);
@@ -471,14 +466,15 @@ std::vector<Exchange> check_attempt_times(const ArduinoRig& rig,
   // proving PINGs go out (the board has just reset; nothing queued may
   // reach it before it answered), also on a port the robot turned away.
   for (std::size_t i = 0; i < rig.links.size(); ++i) {
-    if (rig.links[i].to != LinkState::degraded) continue;
+    if (rig.links[i].to != ConnectionState::degraded) continue;
     const Time from = rig.links[i].at;
     std::optional<Time> to;
     bool down = false;
     for (std::size_t j = i + 1; j < rig.links.size() && !to; ++j) {
-      if (rig.links[j].to != LinkState::reconnecting && rig.links[j].to != LinkState::degraded) {
+      if (rig.links[j].to != ConnectionState::reconnecting &&
+          rig.links[j].to != ConnectionState::degraded) {
         to = rig.links[j].at;
-        down = rig.links[j].to == LinkState::down;
+        down = rig.links[j].to == ConnectionState::down;
       }
     }
     // A frame logged after the operator opened the port in the instant the
@@ -593,23 +589,27 @@ void check_results(const ArduinoRig& rig, const std::vector<WireFrame>& wire,
 /// on the reopened port, nothing but that PING while reconnecting.
 void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire) {
   const ClientConfig& config = rig.session->core().config();
-  static const std::set<std::pair<LinkState, LinkState>> edges = {
-      {LinkState::closed, LinkState::opening},        {LinkState::opening, LinkState::open},
-      {LinkState::opening, LinkState::down},          {LinkState::open, LinkState::degraded},
-      {LinkState::degraded, LinkState::reconnecting}, {LinkState::reconnecting, LinkState::open},
-      {LinkState::reconnecting, LinkState::down},     {LinkState::down, LinkState::opening}};
-  LinkState s = LinkState::closed;
+  static const std::set<std::pair<ConnectionState, ConnectionState>> edges = {
+      {ConnectionState::disconnected, ConnectionState::connecting},
+      {ConnectionState::connecting, ConnectionState::connected},
+      {ConnectionState::connecting, ConnectionState::down},
+      {ConnectionState::connected, ConnectionState::degraded},
+      {ConnectionState::degraded, ConnectionState::reconnecting},
+      {ConnectionState::reconnecting, ConnectionState::connected},
+      {ConnectionState::reconnecting, ConnectionState::down},
+      {ConnectionState::down, ConnectionState::connecting}};
+  ConnectionState s = ConnectionState::disconnected;
   for (std::size_t i = 0; i < rig.links.size(); ++i) {
     const LinkChanged& l = rig.links[i];
     RC_ASSERT(l.from == s);
-    RC_ASSERT(l.to == LinkState::closed || edges.count({l.from, l.to}) == 1);
+    RC_ASSERT(l.to == ConnectionState::disconnected || edges.count({l.from, l.to}) == 1);
     s = l.to;
-    if (l.to == LinkState::reconnecting) {
+    if (l.to == ConnectionState::reconnecting) {
       RC_ASSERT(i > 0);
-      RC_ASSERT(rig.links[i - 1].to == LinkState::degraded);
+      RC_ASSERT(rig.links[i - 1].to == ConnectionState::degraded);
       RC_ASSERT(l.at == rig.links[i - 1].at + config.reconnect_base_delay);
     }
-    if (l.to == LinkState::open && l.from == LinkState::reconnecting) {
+    if (l.to == ConnectionState::connected && l.from == ConnectionState::reconnecting) {
       // The last frame in before it: the ACK to a PING sent while reconnecting.
       const WireFrame* ack = nullptr;
       for (const auto& f : wire) {
@@ -626,7 +626,7 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
   // of attempts degrades it then.
   for (std::size_t i = 0; i < rig.links.size(); ++i) {
     const LinkChanged& l = rig.links[i];
-    if (l.from != LinkState::open || l.to != LinkState::degraded) continue;
+    if (l.from != ConnectionState::connected || l.to != ConnectionState::degraded) continue;
     const bool request_timed_out = std::any_of(
         rig.done.begin(), rig.done.end(),
         [&](const auto& d) { return d.at == l.at && d.result.code == ResultCode::timeout; });
@@ -649,7 +649,7 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
   for (const auto& d : rig.done) {
     if (d.result.code != ResultCode::timeout) continue;
     RC_ASSERT(std::any_of(rig.links.begin(), rig.links.end(), [&](const LinkChanged& l) {
-      return l.at == d.at && l.to == LinkState::degraded;
+      return l.at == d.at && l.to == ConnectionState::degraded;
     }));
   }
   // Reopen attempts: within one DEGRADED series the next attempt's PING goes
@@ -665,7 +665,7 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
     const Time began = wire[x.first].at;
     std::optional<std::size_t> s_now;
     for (std::size_t i = 0; i < rig.links.size() && rig.links[i].at <= began; ++i) {
-      if (rig.links[i].to == LinkState::degraded) s_now = i;
+      if (rig.links[i].to == ConnectionState::degraded) s_now = i;
     }
     RC_ASSERT(s_now.has_value());
     if (s_now != series) {
@@ -680,8 +680,8 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
         wire[x.sends.back()].at + config.base_timeout * (std::int64_t{1} << x.retries);
     bool opened = false;
     for (const auto& l : rig.links) {
-      if (l.from == LinkState::reconnecting && l.to == LinkState::open && l.at >= began &&
-          l.at <= timeout_end)
+      if (l.from == ConnectionState::reconnecting && l.to == ConnectionState::connected &&
+          l.at >= began && l.at <= timeout_end)
         opened = true;
     }
     bool closed_early = false;
@@ -702,10 +702,10 @@ void check_link_states(const ArduinoRig& rig, const std::vector<WireFrame>& wire
   }
   for (std::size_t i = 0; i < rig.links.size(); ++i) {
     const LinkChanged& l = rig.links[i];
-    if (l.from != LinkState::reconnecting || l.to != LinkState::down) continue;
+    if (l.from != ConnectionState::reconnecting || l.to != ConnectionState::down) continue;
     std::optional<std::size_t> s_down;
     for (std::size_t j = 0; j < i; ++j) {
-      if (rig.links[j].to == LinkState::degraded) s_down = j;
+      if (rig.links[j].to == ConnectionState::degraded) s_down = j;
     }
     RC_ASSERT(s_down.has_value());
     RC_ASSERT(failures_of_series[*s_down] == config.max_reconnect_attempts);
@@ -733,7 +733,7 @@ std::string dump(const ArduinoRig& rig, const std::vector<WireFrame>& wire) {
     out += ms(f.at) + (f.tx ? " TX " : " RX ") + f.raw + (f.message ? "" : " (does not decode)") +
            "\n";
   for (const auto& l : rig.links)
-    out += ms(l.at) + " LINK " + std::string(to_string(l.to)) + " (" + l.reason + ")\n";
+    out += ms(l.at) + " LINK " + std::string(link_name(l.to)) + " (" + l.reason + ")\n";
   for (const auto& d : rig.done) {
     out += ms(d.at) + " DONE #" + std::to_string(d.id) + " " +
            proto::describe({0, rig.bodies.at(d.id)}) + " -> " +
@@ -758,14 +758,14 @@ struct Submit : ArduinoCommand {
   void apply(OperatorModel&) const override {}
   void run(const OperatorModel& model, ArduinoRig& rig) const override {
     const std::size_t before = rig.done.size();
-    const LinkState state = rig.session->state();
+    const ConnectionState state = rig.session->state();
     const RequestId id = rig.session->request(body);
     rig.bodies[id] = body;
     const bool ended_at_once = rig.done.size() > before && rig.done.back().id == id;
     if (!is_valid_request(body)) {
       RC_ASSERT(ended_at_once);
       RC_ASSERT(rig.done.back().result.code == ResultCode::invalid_request);
-    } else if (model.closed || state == LinkState::down) {
+    } else if (model.closed || state == ConnectionState::down) {
       // A closed or DOWN link takes no request; it says so at once.
       RC_ASSERT(ended_at_once);
       RC_ASSERT(rig.done.back().result.code == ResultCode::link_down);
@@ -777,42 +777,23 @@ struct Submit : ArduinoCommand {
   void show(std::ostream& os) const override { os << "request " << proto::describe({0, body}); }
 };
 
-struct Advance : ArduinoCommand {
-  int ms = *rc::gen::inRange(1, 4000);
-  void apply(OperatorModel&) const override {}
-  void run(const OperatorModel&, ArduinoRig& rig) const override {
-    rig.car.executor.run_for(milliseconds(ms));
-  }
-  void show(std::ostream& os) const override { os << "advance " << ms << " ms"; }
-};
+using Advance = hil::test::AdvanceTime<ArduinoCommand, OperatorModel, ArduinoRig, 4000>;
 
 struct CarMisbehaves : ArduinoCommand {
   int kind = *rc::gen::inRange(0, 4);
   int ms = *rc::gen::inRange(100, 30'000);
   void apply(OperatorModel&) const override {}
+  using Kind = hil::test::Misbehaviour;
+  static constexpr Kind kKinds[] = {Kind::ignore_all, Kind::reject_next, Kind::hang_up,
+                                    Kind::reset};
   void run(const OperatorModel&, ArduinoRig& rig) const override {
-    mocks::Action action;
-    switch (kind) {
-      case 0:
-        action = mocks::Ignore{.match = "", .count = {}, .duration = milliseconds(ms)};
-        break;
-      case 1:
-        action = mocks::Reject{.match = "", .count = 1};
-        break;
-      case 2:
-        action = mocks::CloseConnection{link::CloseMode::graceful};
-        break;
-      default:
-        action = mocks::CloseConnection{link::CloseMode::reset};
-        break;
-    }
-    rig.car.firmware->arm({.name = "", .when = {}, .action = action});
+    rig.car.firmware->arm(hil::test::misbehaviour(kKinds[kind], milliseconds(ms)));
   }
   void show(std::ostream& os) const override {
     static const char* names[] = {"ignores everything for", "rejects the next request", "hangs up",
                                   "resets the connection"};
     os << "robot " << names[kind];
-    if (kind == 0) os << " " << ms << " ms";
+    if (hil::test::lasts(kKinds[kind])) os << " " << ms << " ms";
   }
 };
 
@@ -820,7 +801,7 @@ struct OperatorToggles : ArduinoCommand {
   bool close = *rc::gen::weightedElement<bool>({{1, true}, {2, false}});
   void apply(OperatorModel& model) const override { model.closed = close; }
   void run(const OperatorModel& model, ArduinoRig& rig) const override {
-    const LinkState before = rig.session->state();
+    const ConnectionState before = rig.session->state();
     if (close) {
       const std::size_t done_before = rig.done.size();
       const std::size_t waiting = [&] {
@@ -831,7 +812,7 @@ struct OperatorToggles : ArduinoCommand {
             rig.queued.begin(), rig.queued.end(), [&](RequestId id) { return !ended.count(id); }));
       }();
       rig.session->close();
-      RC_ASSERT(rig.session->state() == LinkState::closed);
+      RC_ASSERT(rig.session->state() == ConnectionState::disconnected);
       // Everything still waiting ends link_down, at once.
       RC_ASSERT(rig.done.size() == done_before + waiting);
       for (std::size_t i = done_before; i < rig.done.size(); ++i)
@@ -841,11 +822,11 @@ struct OperatorToggles : ArduinoCommand {
       rig.logged_at_operator_open.push_back(rig.session->log().entries().size());
       rig.session->open();
       rig.car.executor.run_for(Duration::zero());
-      if (model.closed || before == LinkState::down) {
+      if (model.closed || before == ConnectionState::down) {
         // A mem:// port always opens; a robot still busy with the port the
         // operator closed in this very instant may hang up on it at once.
-        const LinkState now = rig.session->state();
-        RC_ASSERT(now == LinkState::open || now == LinkState::degraded);
+        const ConnectionState now = rig.session->state();
+        RC_ASSERT(now == ConnectionState::connected || now == ConnectionState::degraded);
       }
     }
   }
@@ -920,7 +901,7 @@ RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAnd
   }
   // OPENING and OPEN, nothing else: with nothing lost, nothing degrades.
   RC_ASSERT(rig.links.size() == 2u);
-  RC_ASSERT(rig.session->state() == LinkState::open);
+  RC_ASSERT(rig.session->state() == ConnectionState::connected);
 }
 
 }  // namespace

@@ -72,61 +72,37 @@ const char* name_of(Prop p) {
 }
 
 Focus focus_for(Prop p) {
-  Focus f;
   switch (p) {
     case Prop::backoff_delays:
     case Prop::reconnects_automatically:
     case Prop::safe_state_and_reconfirm:
-      f.drop_link = 5;
-      f.disconnect = 2;
-      break;
+      return {.disconnect = 2, .drop_link = 5};
     case Prop::stale_after_2s:
     case Prop::telemetry_visible:
-      f.mute = 5;
-      f.faults = 4;
-      break;
+      return {.mute = 5, .faults = 4};
     case Prop::bad_checksum_dropped:
     case Prop::stream_gives_every_frame:
     case Prop::status_and_feedback_parsed:
     case Prop::log_has_tx_rx_errors:
-      f.faults = 8;
-      break;
+      return {.faults = 8};
     case Prop::feedback_timeout_800ms:
     case Prop::retry_rules:
     case Prop::single_outbound_queue:
-      f.ignore = 6;
-      f.reject = 3;
-      f.faults = 4;
-      f.run = 4;
-      f.station = 4;
-      break;
+      return {.station = 4, .run = 4, .reject = 3, .ignore = 6, .faults = 4};
     case Prop::mode_conflict:
-      f.mode = 8;
-      f.reject = 4;
-      break;
+      return {.mode = 8, .reject = 4};
     case Prop::emergency_stop_order:
     case Prop::emergency_stop_accessible:
-      f.estop = 8;
-      f.run = 5;
-      f.station = 5;
-      break;
+      return {.station = 5, .run = 5, .estop = 8};
     case Prop::chassis_rests_after_stop:
     case Prop::stop_on_release:
-      f.estop = 5;
-      f.faults = 4;
-      f.run = 4;
-      f.station = 4;
-      break;
+      return {.station = 4, .run = 4, .estop = 5, .faults = 4};
     case Prop::auto_flow:
-      f.station = 6;
-      f.run = 6;
-      f.stop = 4;
-      f.press = 1;  // a press switches the car to MAN, where RUN is refused
-      break;
+      // A press switches the car to MAN, where RUN is refused.
+      return {.press = 1, .station = 6, .run = 6, .stop = 4};
     default:
-      break;
+      return {};
   }
-  return f;
 }
 
 namespace {
@@ -144,32 +120,8 @@ bool is_stop(const proto::Message& m) {
 
 }  // namespace
 
-const char* dir_word(Direction d) {
-  switch (d) {
-    case Direction::stop:
-      return "STOP";
-    case Direction::fwd:
-      return "FWD";
-    case Direction::bwd:
-      return "BWD";
-    case Direction::left:
-      return "LEFT";
-    case Direction::right:
-      return "RIGHT";
-    case Direction::lf:
-      return "LF";
-    case Direction::rf:
-      return "RF";
-    case Direction::lb:
-      return "LB";
-    case Direction::rb:
-      return "RB";
-    case Direction::cw:
-      return "CW";
-    case Direction::ccw:
-      return "CCW";
-  }
-  return "?";
+std::string dir_word(Direction d) {
+  return std::string(proto::to_string(d));
 }
 
 std::string ms(Duration d) {

@@ -33,7 +33,7 @@ using link::seconds;
 using link::Time;
 
 /// A direction as the LOGI command table spells it ("FWD", "CCW").
-const char* dir_word(protocol::logi::Direction d);
+std::string dir_word(protocol::logi::Direction d);
 /// A duration in milliseconds, as the checks print it.
 std::string ms(Duration d);
 /// A frame's bytes as text (LOGI frames are ASCII).

@@ -23,6 +23,27 @@ class RandomFaults {
     add(direction(), sometimes(*rc::gen::inRange(1, max_percent_ + 1) / 100.0), std::move(action));
   }
 
+  /// By chance (heads), `action` as add_sometimes() adds it.
+  void maybe(link::FaultAction action) {
+    if (coin()) add_sometimes(std::move(action));
+  }
+
+  /// By chance (heads), a delay of 0..max_ms, plus 0..max_ms of jitter.
+  void maybe_delay(int max_ms) {
+    if (coin())
+      add_sometimes(link::Delay{link::milliseconds(*rc::gen::inRange(0, max_ms)),
+                                link::milliseconds(*rc::gen::inRange(0, max_ms))});
+  }
+
+  /// By chance (heads), writes cut into pieces of 1..8 bytes, 0..30 ms apart.
+  void maybe_fragment() {
+    if (coin()) {
+      const auto piece = *rc::gen::inRange<std::size_t>(1, 9);
+      add_sometimes(link::Fragment{
+          {1, piece}, {link::Duration::zero(), link::milliseconds(*rc::gen::inRange(0, 30))}});
+    }
+  }
+
   /// Up to two stalls of 100 ms .. max_stall_ms at random times in the
   /// first minute, each on a random direction.
   void add_stalls(int max_stall_ms) {
@@ -74,5 +95,26 @@ class RandomFaults {
   int max_percent_;
   link::FaultProfile profile_;
 };
+
+/// Faults that change no byte a client reads, for protocols without a
+/// checksum (a changed byte would be another valid packet): sometimes drops,
+/// duplicates, delays of up to max_delay_ms, fragments and coalesced writes,
+/// each firing with 1..max_percent %; stalls of up to max_stall_ms; breaks.
+inline rc::Gen<link::FaultProfile> gen_faults_without_corruption(int max_percent, int max_delay_ms,
+                                                                 int max_stall_ms) {
+  return rc::gen::exec([=] {
+    RandomFaults faults(max_percent);
+    faults.maybe(link::Drop{});
+    faults.maybe(link::Duplicate{1});
+    faults.maybe_delay(max_delay_ms);
+    faults.maybe_fragment();
+    if (RandomFaults::coin())
+      faults.add_sometimes(link::Coalesce{*rc::gen::inRange<std::size_t>(2, 6),
+                                          link::milliseconds(*rc::gen::inRange(1, 300))});
+    faults.add_stalls(max_stall_ms);
+    faults.add_breaks();
+    return faults.take();
+  });
+}
 
 }  // namespace hil::test

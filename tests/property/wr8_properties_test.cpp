@@ -51,38 +51,13 @@
 #include "sim/presets.hpp"
 #include "tests/client/client_test_support.hpp"
 #include "tests/property/random_faults.hpp"
+#include "tests/property/session_commands.hpp"
 
 namespace hil::client::wr8 {
 namespace {
 
 using link::milliseconds;
 using link::seconds;
-using hil::test::RandomFaults;
-
-/// Faults that keep the oracle sound. WR8 packets carry no checksum, so a
-/// corrupted COI or code would be a different valid packet that no client
-/// can tell from the real one: corruption and byte drops are left out.
-rc::Gen<link::FaultProfile> gen_faults() {
-  return rc::gen::exec([] {
-    RandomFaults faults(25);
-    if (RandomFaults::coin()) faults.add_sometimes(link::Drop{});
-    if (RandomFaults::coin()) faults.add_sometimes(link::Duplicate{1});
-    if (RandomFaults::coin())
-      faults.add_sometimes(link::Delay{milliseconds(*rc::gen::inRange(0, 400)),
-                                       milliseconds(*rc::gen::inRange(0, 400))});
-    if (RandomFaults::coin()) {
-      const auto piece = *rc::gen::inRange<std::size_t>(1, 9);
-      faults.add_sometimes(
-          link::Fragment{{1, piece}, {Duration::zero(), milliseconds(*rc::gen::inRange(0, 30))}});
-    }
-    if (RandomFaults::coin())
-      faults.add_sometimes(link::Coalesce{*rc::gen::inRange<std::size_t>(2, 6),
-                                          milliseconds(*rc::gen::inRange(1, 300))});
-    faults.add_stalls(4000);
-    faults.add_breaks();
-    return faults.take();
-  });
-}
 
 /// One connection as the mock server's link saw it.
 struct Connection {
@@ -324,7 +299,7 @@ void check_coi_correlation(const Wr8Rig& rig) {
 void check_cancellations(const Wr8Rig& rig) {
   std::set<Time> lost;
   for (const auto& [t, c] : rig.of<ConnectionEvent>()) {
-    if (c.state == ConnectionState::waiting_to_reconnect ||
+    if (c.state == ConnectionState::reconnecting ||
         c.state == ConnectionState::disconnected)
       lost.insert(t);
   }
@@ -384,7 +359,7 @@ void check_reconnects(const Wr8Rig& rig) {
     const auto& [t, c] = changes[i];
     if (c.state == ConnectionState::connected) failures = 0;
     if (c.state == ConnectionState::authenticating) authenticating_since = t;
-    if (c.state == ConnectionState::waiting_to_reconnect) {
+    if (c.state == ConnectionState::reconnecting) {
       ++failures;
       RC_ASSERT(c.attempt == failures);
       if (i + 1 < changes.size() && changes[i + 1].second.state == ConnectionState::connecting) {
@@ -466,7 +441,7 @@ std::string dump(const Wr8Rig& rig) {
         out += "  " + ms(t) + " client got " + proto::describe(m, profile) + "\n";
     }
   }
-  for (const auto& e : rig.core().log()->snapshot()) {
+  for (const auto& e : rig.core().log()->entries()) {
     if (e.kind != LogKind::rx || e.description.rfind("Data", 0) != 0)
       out += ms(e.at) + " " + std::string(to_string(e.kind)) + " " + e.description + "\n";
   }
@@ -569,14 +544,7 @@ struct Burst : Wr8Command {
   void show(std::ostream& os) const override { os << count << " checks at once"; }
 };
 
-struct Advance : Wr8Command {
-  int ms = *rc::gen::inRange(1, 5000);
-  void apply(OperatorModel&) const override {}
-  void run(const OperatorModel&, Wr8Rig& rig) const override {
-    rig.car.executor.run_for(milliseconds(ms));
-  }
-  void show(std::ostream& os) const override { os << "advance " << ms << " ms"; }
-};
+using Advance = hil::test::AdvanceTime<Wr8Command, OperatorModel, Wr8Rig, 5000>;
 
 std::size_t attempts(const Wr8Rig& rig) {
   std::size_t n = 0;
@@ -617,32 +585,17 @@ struct CarMisbehaves : Wr8Command {
   int kind = *rc::gen::inRange(0, 5);
   int ms = *rc::gen::inRange(100, 6000);
   void apply(OperatorModel&) const override {}
+  using Kind = hil::test::Misbehaviour;
+  static constexpr Kind kKinds[] = {Kind::ignore_all, Kind::reject_next, Kind::mute_telemetry,
+                                    Kind::hang_up, Kind::reset};
   void run(const OperatorModel&, Wr8Rig& rig) const override {
-    mocks::Action action;
-    switch (kind) {
-      case 0:
-        action = mocks::Ignore{.match = "", .count = {}, .duration = milliseconds(ms)};
-        break;
-      case 1:
-        action = mocks::Reject{.match = "", .count = 1};
-        break;
-      case 2:
-        action = mocks::MuteTelemetry{milliseconds(ms)};
-        break;
-      case 3:
-        action = mocks::CloseConnection{link::CloseMode::graceful};
-        break;
-      default:
-        action = mocks::CloseConnection{link::CloseMode::reset};
-        break;
-    }
-    rig.car.firmware->arm({.name = "", .when = {}, .action = action});
+    rig.car.firmware->arm(hil::test::misbehaviour(kKinds[kind], milliseconds(ms)));
   }
   void show(std::ostream& os) const override {
     static const char* names[] = {"ignores everything for", "rejects the next command",
                                   "mutes DATA for", "hangs up", "resets the connection"};
     os << "vehicle " << names[kind];
-    if (kind == 0 || kind == 2) os << " " << ms << " ms";
+    if (hil::test::lasts(kKinds[kind])) os << " " << ms << " ms";
   }
 };
 
@@ -652,7 +605,10 @@ struct CarMisbehaves : Wr8Command {
 /// once), then 40 s for every answer, timeout and reconnect to play out;
 /// `check` reads the whole run.
 void after_a_random_session(void (*check)(const Wr8Rig&)) {
-  Wr8Rig rig(*gen_faults());
+  // Faults that keep the oracle sound. WR8 packets carry no checksum, so a
+  // corrupted COI or code would be a different valid packet that no client
+  // can tell from the real one: corruption and byte drops are left out.
+  Wr8Rig rig(*hil::test::gen_faults_without_corruption(25, 400, 4000));
   rig.acts.emplace_back(rig.now(), OperatorAct::connect);
   rig.session->connect();
   rc::state::check(

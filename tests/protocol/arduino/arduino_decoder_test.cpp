@@ -1,25 +1,17 @@
 #include <gtest/gtest.h>
 
 #include "protocol/arduino/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::arduino {
 namespace {
 
+using test::error_at;
+using test::message_at;
+
 std::vector<Item> decode_all(std::string_view stream, DecoderOptions options = {}) {
-  Decoder d(options);
-  std::vector<Item> out;
-  d.feed(to_bytes(stream), out);
-  d.finish(out);
-  return out;
-}
-
-const DecodeError& error_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<DecodeError>(items.at(i));
-}
-
-const Message& message_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<Frame<Message>>(items.at(i)).message;
+  return test::decode_whole<Decoder, Item>(Decoder(options), to_bytes(stream));
 }
 
 // The one error a single candidate frame produces.
@@ -41,16 +33,8 @@ TEST(ArduinoDecoder, StickyPacketsInOneReadGiveEveryFrame) {
 }
 
 TEST(ArduinoDecoder, SplitPacketIsReassembled) {
-  Decoder d;
-  std::vector<Item> out;
-  d.feed(to_bytes("^04|R"), out);
-  d.feed(to_bytes("|-9"), out);
-  EXPECT_TRUE(out.empty());
-  EXPECT_EQ(d.buffered(), 8u);
-  d.feed(to_bytes("0*72$^05"), out);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(message_at(out, 0), (Message{4, Rotate{-90}}));
-  EXPECT_EQ(d.buffered(), 3u);
+  test::expect_reassembled<Decoder>({to_bytes("^04|R"), to_bytes("|-9"), to_bytes("0*72$^05")}, 8u,
+                                    Message{4, Rotate{-90}}, 3u);
 }
 
 TEST(ArduinoDecoder, LineNoiseBetweenFramesIsReportedAsGarbage) {
@@ -196,13 +180,8 @@ TEST(ArduinoDecoder, GarbageIsNeverAnswered) {
 
 TEST(ArduinoDecoder, RunawayFrameIsBoundedByTheReceiveGuard) {
   const std::string stream = "^01|ACK|" + std::string(400, 'x') + "^02|V|160*63$";
-  Decoder d;
-  std::vector<Item> out;
-  for (const char c : stream) {
-    d.feed(to_bytes(std::string_view(&c, 1)), out);
-    EXPECT_LE(d.buffered(), kMaxFrameBytes);
-  }
-  d.finish(out);
+  const auto out =
+      test::decode_bytewise_within<Decoder, Item>(Decoder{}, to_bytes(stream), kMaxFrameBytes);
   EXPECT_EQ(test::count_errors(out, ErrorKind::oversized), 1u);
   EXPECT_EQ(test::messages_of(out), (std::vector<Message>{{2, SetSpeed{160}}}));
   EXPECT_EQ(nack_for(error_at(out, 0)), std::nullopt);

@@ -7,6 +7,7 @@
 
 #include "protocol/arduino/codec.hpp"
 #include "protocol/arduino/message.hpp"
+#include "tests/protocol/arbitrary_support.hpp"
 
 namespace hil::test::arduino {
 
@@ -22,12 +23,7 @@ inline rc::Gen<std::string> gen_field_text() {
 
 namespace rc {
 
-template <>
-struct Arbitrary<hil::protocol::arduino::NackCode> {
-  static Gen<hil::protocol::arduino::NackCode> arbitrary() {
-    return gen::elementOf(hil::protocol::arduino::kAllNackCodes);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::arduino::NackCode, hil::protocol::arduino::kAllNackCodes);
 
 template <>
 struct Arbitrary<hil::protocol::arduino::Nack> {

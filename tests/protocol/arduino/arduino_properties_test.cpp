@@ -3,14 +3,15 @@
 
 #include "protocol/arduino/codec.hpp"
 #include "tests/protocol/arduino/arduino_generators.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::arduino {
 namespace {
 
-using test::concat;
 using test::decode_chunked;
 using test::decode_whole;
+using test::frames_of;
 using test::messages_of;
 using test::raw_of_all;
 
@@ -36,21 +37,12 @@ RC_GTEST_PROP(ArduinoProperties, EnvelopeLayerRoundTripsAnyFieldText, (std::uint
 
 RC_GTEST_PROP(ArduinoProperties, AnyChunkingDecodesLikeTheWholeStream,
               (const std::vector<Message>& ms)) {
-  std::vector<Bytes> parts;
-  for (const auto& m : ms)
-    parts.push_back(encode(m));
+  const std::vector<Bytes> parts = frames_of(ms);
   // Noise made of the markers, so errors are part of the comparison too.
   const auto noise = *rc::gen::container<Bytes>(
       rc::gen::element<std::uint8_t>('^', '$', '*', '|', '0', 'V', '\n'));
-  parts.insert(parts.begin() + *rc::gen::inRange<std::ptrdiff_t>(
-                                   0, static_cast<std::ptrdiff_t>(parts.size()) + 1),
-               noise);
-  const Bytes stream = concat(parts);
-  const auto whole = decode_whole<Decoder, Item>(Decoder{}, stream);
-  const auto chunked = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
-  const auto bytewise = decode_chunked<Decoder, Item>(Decoder{}, stream, {1});
-  RC_ASSERT(chunked == whole);
-  RC_ASSERT(bytewise == whole);
+  const Bytes stream = test::with_noise_somewhere(parts, noise);
+  test::assert_any_chunking_decodes_alike<Decoder, Item>(Decoder{}, stream);
   const auto firmware_whole =
       decode_whole<Decoder, Item>(Decoder{DecoderOptions::firmware()}, stream);
   const auto firmware_bytewise =
@@ -59,13 +51,8 @@ RC_GTEST_PROP(ArduinoProperties, AnyChunkingDecodesLikeTheWholeStream,
 }
 
 RC_GTEST_PROP(ArduinoProperties, EveryByteIsAccountedForOnce, (const std::vector<Message>& ms)) {
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto frame = encode(m);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-    const auto noise = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-    stream.insert(stream.end(), noise.begin(), noise.end());
-  }
+  const Bytes stream = test::interleave(
+      frames_of(ms), [] { return *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>()); });
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
   RC_ASSERT(raw_of_all(items) == stream);
   const auto firmware = decode_chunked<Decoder, Item>(Decoder{DecoderOptions::firmware()}, stream,
@@ -77,14 +64,13 @@ RC_GTEST_PROP(ArduinoProperties, RandomGarbageBetweenFramesLosesNoFrame,
               (const std::vector<Message>& ms)) {
   // Garbage may hold '$', '*', '|' and anything else, but no '^': a '^'
   // would open a frame that overlaps the next real one.
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto garbage = *rc::gen::container<Bytes>(rc::gen::suchThat(
-        rc::gen::arbitrary<std::uint8_t>(), [](std::uint8_t b) { return b != kStart; }));
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto frame = encode(m);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-  }
+  const Bytes stream = test::interleave(
+      frames_of(ms),
+      [] {
+        return *rc::gen::container<Bytes>(rc::gen::suchThat(
+            rc::gen::arbitrary<std::uint8_t>(), [](std::uint8_t b) { return b != kStart; }));
+      },
+      /*noise_first=*/true);
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
   RC_ASSERT(messages_of(items) == ms);
 }
@@ -130,9 +116,7 @@ bool single_byte_change_detected(const Bytes& frame, std::size_t pos, std::uint8
 
 RC_GTEST_PROP(ArduinoProperties, EverySingleByteChangeIsDetected, (const Message& m)) {
   const Bytes frame = encode(m);
-  const auto pos = *rc::gen::inRange<std::size_t>(0, frame.size());
-  const auto value = *rc::gen::suchThat(rc::gen::arbitrary<std::uint8_t>(),
-                                        [&](std::uint8_t v) { return v != frame[pos]; });
+  const auto [pos, value] = test::gen_single_byte_change(frame);
   RC_ASSERT(single_byte_change_detected(frame, pos, value));
 }
 
@@ -144,17 +128,15 @@ TEST(ArduinoProperties, EverySingleByteChangeOfEverySeedFrameIsDetected) {
   std::size_t tolerated = 0;
   for (const char* text : seed_frames) {
     const Bytes frame = to_bytes(text);
-    for (std::size_t pos = 0; pos < frame.size(); ++pos) {
-      for (int v = 0; v < 256; ++v) {
-        if (v == frame[pos]) continue;
-        Bytes changed = frame;
-        changed[pos] = static_cast<std::uint8_t>(v);
-        ASSERT_TRUE(single_byte_change_detected(frame, pos, static_cast<std::uint8_t>(v)))
-            << text << " byte " << pos << " -> " << v;
-        if (!messages_of(decode_whole<Decoder, Item>(Decoder{}, changed)).empty()) ++tolerated;
-        ++checked;
-      }
-    }
+    test::for_each_single_byte_change(frame, [&](std::size_t pos, std::uint8_t v) {
+      Bytes changed = frame;
+      changed[pos] = v;
+      ASSERT_TRUE(single_byte_change_detected(frame, pos, v))
+          << text << " byte " << pos << " -> " << int{v};
+      if (!messages_of(decode_whole<Decoder, Item>(Decoder{}, changed)).empty()) ++tolerated;
+      ++checked;
+    });
+    ASSERT_FALSE(HasFatalFailure());
   }
   EXPECT_EQ(checked, (13u + 13 + 12 + 13 + 10 + 10 + 10 + 15) * 255);
   // Only "^06|I|*4F$" and "^08|STATUS|*1C$" have a checksum letter, so

@@ -36,23 +36,13 @@ TEST(ArduinoReplies, TheSketchsTextsAreTyped) {
 }
 
 TEST(ArduinoReplies, TheSketchsStatusInEachMotion) {
-  StatusReply idle;
-  idle.pwm = 160;
-  idle.dir = "stop";
+  const StatusReply idle{.pwm = 160, .dir = "stop"};
   EXPECT_EQ(sketch(StatusRequest{}, "STATUS:V=160,DIR=stop,MOT:IDLE"), Reply{idle});
 
-  StatusReply move;
-  move.pwm = 200;
-  move.dir = "rev";
-  move.motion = MotionKind::move;
-  move.time_left_ms = 342;
+  const StatusReply move{.pwm = 200, .motion = MotionKind::move, .time_left_ms = 342, .dir = "rev"};
   EXPECT_EQ(sketch(StatusRequest{}, "STATUS:V=200,DIR=rev,MOT:MOVE,tleft:342"), Reply{move});
 
-  StatusReply rot;
-  rot.pwm = 0;
-  rot.dir = "stop";
-  rot.motion = MotionKind::rotate;
-  rot.time_left_ms = 0;
+  const StatusReply rot{.pwm = 0, .motion = MotionKind::rotate, .time_left_ms = 0, .dir = "stop"};
   EXPECT_EQ(sketch(StatusRequest{}, "STATUS:V=0,DIR=stop,MOT:ROT,tleft:0"), Reply{rot});
 }
 
@@ -65,20 +55,16 @@ TEST(ArduinoReplies, TheReadmeBoardsTextsAreTheSameTypes) {
   EXPECT_EQ(readme(Help{}, "PING STATUS V<pwm> M<cm> R<deg> S B I HELP"),
             (Reply{HelpReply{{"PING", "STATUS", "V", "M", "R", "S", "B", "I", "HELP"}}}));
 
-  StatusReply moving;
-  moving.pwm = 160;
-  moving.motion = MotionKind::move;
-  moving.motion_arg = -20;
-  moving.time_left_ms = 15;
-  moving.uptime_ms = 4000;
-  moving.battery_mv = 7400;
+  const StatusReply moving{.pwm = 160,
+                           .motion = MotionKind::move,
+                           .time_left_ms = 15,
+                           .motion_arg = -20,
+                           .uptime_ms = 4000,
+                           .battery_mv = 7400};
   EXPECT_EQ(readme(StatusRequest{}, "MOVING M:-20 PWM=160 REM_MS=15 UP_MS=4000 BAT_MV=7400"),
             Reply{moving});
-  StatusReply fault;
-  fault.motion = MotionKind::fault;
-  fault.pwm = 0;
-  fault.uptime_ms = 1;
-  fault.battery_mv = 6000;
+  const StatusReply fault{
+      .pwm = 0, .motion = MotionKind::fault, .uptime_ms = 1, .battery_mv = 6000};
   EXPECT_EQ(readme(StatusRequest{}, "FAULT PWM=0 UP_MS=1 BAT_MV=6000"), Reply{fault});
 }
 

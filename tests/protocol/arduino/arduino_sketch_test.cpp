@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "protocol/arduino/codec.hpp"
@@ -18,6 +20,12 @@ namespace {
 
 SketchVerdict judge(std::string_view frame) {
   return judge_sketch_frame(frame);
+}
+
+// Expects each frame to be judged as its verdict says.
+void expect_verdicts(std::initializer_list<std::pair<std::string_view, SketchVerdict>> cases) {
+  for (const auto& [frame, verdict] : cases)
+    EXPECT_EQ(judge(frame), verdict) << frame;
 }
 
 std::vector<SketchFrame> receive(std::string_view stream) {
@@ -33,11 +41,13 @@ std::string text_of(const Bytes& raw) {
 
 TEST(ArduinoSketch, TheRealClientsFramesAreRequests) {
   // robot_client.py sends a one-space payload for commands without one.
-  EXPECT_EQ(judge("^01|PING| *31$"), (SketchVerdict{SketchRequest{"01", "PING", " "}}));
-  EXPECT_EQ(judge("^05|B| *67$"), (SketchVerdict{SketchRequest{"05", "B", " "}}));
-  EXPECT_EQ(judge("^02|V|160*63$"), (SketchVerdict{SketchRequest{"02", "V", "160"}}));
-  EXPECT_EQ(judge("^03|STATUS| *37$"), (SketchVerdict{SketchRequest{"03", "STATUS", " "}}));
-  EXPECT_EQ(judge("^09|R|-90*7F$"), (SketchVerdict{SketchRequest{"09", "R", "-90"}}));
+  expect_verdicts({
+      {"^01|PING| *31$", SketchRequest{"01", "PING", " "}},
+      {"^05|B| *67$", SketchRequest{"05", "B", " "}},
+      {"^02|V|160*63$", SketchRequest{"02", "V", "160"}},
+      {"^03|STATUS| *37$", SketchRequest{"03", "STATUS", " "}},
+      {"^09|R|-90*7F$", SketchRequest{"09", "R", "-90"}},
+  });
 }
 
 TEST(ArduinoSketch, AnEmptyPayloadIsBadFormatWithTheFramesSeq) {
@@ -49,8 +59,10 @@ TEST(ArduinoSketch, AnEmptyPayloadIsBadFormatWithTheFramesSeq) {
 }
 
 TEST(ArduinoSketch, EmptyFieldsMergeAndAFourthFieldIsIgnored) {
-  EXPECT_EQ(judge("^01||PING| *4D$"), (SketchVerdict{SketchRequest{"01", "PING", " "}}));
-  EXPECT_EQ(judge("^01|PING| |extra*37$"), (SketchVerdict{SketchRequest{"01", "PING", " "}}));
+  expect_verdicts({
+      {"^01||PING| *4D$", SketchRequest{"01", "PING", " "}},
+      {"^01|PING| |extra*37$", SketchRequest{"01", "PING", " "}},
+  });
 }
 
 TEST(ArduinoSketch, ABadChecksumEchoesTheFirstTwoContentBytes) {

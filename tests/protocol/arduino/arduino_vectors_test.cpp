@@ -6,14 +6,12 @@
 #include <gtest/gtest.h>
 
 #include "protocol/arduino/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 
 namespace hil::protocol::arduino {
 namespace {
 
-struct Vector {
-  const char* frame;
-  Message message;
-};
+using Vector = test::TextVector<Message>;
 
 const Vector kSeedRequests[] = {
     {"^01|PING|*11$", {0x01, Ping{}}},   {"^02|V|160*63$", {0x02, SetSpeed{160}}},
@@ -38,12 +36,7 @@ const Vector kResponses[] = {
 
 void expect_vector(const Vector& v) {
   EXPECT_EQ(encode_text(v.message), v.frame) << describe(v.message);
-  const auto item = decode_frame(to_bytes(v.frame));
-  const auto* frame = std::get_if<Frame<Message>>(&item);
-  ASSERT_NE(frame, nullptr) << v.frame << ": " << std::get<DecodeError>(item).detail;
-  EXPECT_EQ(frame->message, v.message) << v.frame;
-  EXPECT_EQ(to_string(frame->raw), v.frame);
-  EXPECT_FALSE(frame->tolerated);
+  test::expect_decoded_vector(decode_frame(to_bytes(v.frame)), v);
 }
 
 TEST(ArduinoVectors, SeedRequestFramesEncodeByteExactAndDecodeBack) {

@@ -127,6 +127,14 @@ void print(const char* title, const Table& t) {
   line("whole frame", t.total());
 }
 
+// The table of one frame's single-byte changes, printed under `title`.
+Table measured(const Bytes& frame, const char* title) {
+  Table t;
+  measure(frame, t);
+  print(title, t);
+  return t;
+}
+
 const Bytes kSeedBeltFrame =
     hex("2A 2B 2C 2D 64 15 00 33 00 00 15 01 66 00 00 15 02 99 00 00 15 03 CC 00 00 15 04 FF 00 00 "
         "15 05 00 00 00 15 06 00 33 00 15 07 00 66 00 15 08 00 99 00 15 09 00 CC 00 15 0A 00 FF 00 "
@@ -134,9 +142,7 @@ const Bytes kSeedBeltFrame =
         "15 11 00 FF 00 15 12 00 00 FF 15 13 FF FF FF A8");
 
 TEST(LekaChecksumStrength, InfoFrameDetectsEverySingleByteChange) {
-  Table t;
-  measure(hex("2A 2B 2C 2D 01 70 70"), t);
-  print("info frame", t);
+  const Table t = measured(hex("2A 2B 2C 2D 01 70 70"), "info frame");
   EXPECT_EQ(t.total().changes, 7u * 255u);
   EXPECT_EQ(t.total().escaped, 0u);
 }
@@ -144,9 +150,7 @@ TEST(LekaChecksumStrength, InfoFrameDetectsEverySingleByteChange) {
 TEST(LekaChecksumStrength, FiveByteSeedFrameLetsNineChangesThrough) {
   // Even a 5-byte group: a change 1, 3 or 4 bytes before its end can be
   // rotated into the dropped high byte.
-  Table t;
-  measure(hex("2A 2B 2C 2D 05 15 00 FF 00 00 41"), t);
-  print("belt LED 0 red frame", t);
+  const Table t = measured(hex("2A 2B 2C 2D 05 15 00 FF 00 00 41"), "belt LED 0 red frame");
   EXPECT_EQ(t.total().changes, 11u * 255u);
   EXPECT_EQ(t.group_total().checksum_matches, 23u);
   EXPECT_EQ(t.total().escaped, 9u);
@@ -155,9 +159,7 @@ TEST(LekaChecksumStrength, FiveByteSeedFrameLetsNineChangesThrough) {
 }
 
 TEST(LekaChecksumStrength, SeedBeltFrameExhaustive) {
-  Table t;
-  measure(kSeedBeltFrame, t);
-  print("106-byte seed frame (20 belt LEDs)", t);
+  const Table t = measured(kSeedBeltFrame, "106-byte seed frame (20 belt LEDs)");
   EXPECT_EQ(t.total().changes, 106u * 255u);
   EXPECT_EQ(t.rows[kStartRow].escaped, 0u);
   EXPECT_EQ(t.rows[kChecksumRow].escaped, 0u);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "protocol/leka/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
@@ -16,12 +17,8 @@ std::vector<Item> decode_all(ByteView stream, DecoderOptions options = {}) {
   return test::decode_whole<Decoder, Item>(Decoder(options), stream);
 }
 
-const DecodeError& error_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<DecodeError>(items.at(i));
-}
-const Frame<Message>& frame_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<Frame<Message>>(items.at(i));
-}
+using test::error_at;
+using test::frame_at;
 
 Bytes cat(std::initializer_list<Bytes> parts) {
   return test::concat(parts);
@@ -51,25 +48,15 @@ TEST(LekaDecoder, StickyPacketsInOneReadGiveEveryFrame) {
 }
 
 TEST(LekaDecoder, SplitPacketIsReassembled) {
-  Decoder d;
-  std::vector<Item> out;
-  d.feed(hex("2A 2B"), out);
-  d.feed(hex("2C 2D 05 15"), out);
-  d.feed(hex("00 FF 00"), out);
-  EXPECT_TRUE(out.empty());
-  EXPECT_EQ(d.buffered(), 9u);
-  d.feed(hex("00 41 2A 2B"), out);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(frame_at(out, 0).message, kBeltRedGroup);
-  EXPECT_EQ(d.buffered(), 2u);  // a start-sequence prefix waits for more
+  // The last read leaves a start-sequence prefix waiting for more.
+  test::expect_reassembled<Decoder>(
+      {hex("2A 2B"), hex("2C 2D 05 15"), hex("00 FF 00"), hex("00 41 2A 2B")}, 9u,
+      Message{kBeltRedGroup}, 2u);
 }
 
 TEST(LekaDecoder, GarbageBeforeAFrameIsReportedAndDiscarded) {
-  const auto items = decode_all(cat({hex("00 2A 2B FF 2C"), kInfo}));
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::garbage);
-  EXPECT_EQ(error_at(items, 0).raw, hex("00 2A 2B FF 2C"));
-  EXPECT_EQ(frame_at(items, 1).message, kInfoGroup);
+  test::expect_error_then_frame(decode_all(cat({hex("00 2A 2B FF 2C"), kInfo})), ErrorKind::garbage,
+                                hex("00 2A 2B FF 2C"), Message{kInfoGroup});
 }
 
 TEST(LekaDecoder, LongGarbageComesOutInBoundedChunks) {
@@ -86,14 +73,10 @@ TEST(LekaDecoder, BadChecksumIsReportedWithItsBytesAndTheStreamContinues) {
   Bytes bad = kBeltRed;
   bad.back() = 0x42;
   const auto items = decode_all(cat({bad, kInfo}));
-  ASSERT_EQ(items.size(), 2u);
-  const auto& e = error_at(items, 0);
-  EXPECT_EQ(e.kind, ErrorKind::bad_checksum);
-  EXPECT_EQ(e.raw, bad);
-  EXPECT_EQ(e.context, "led.belt.single");
-  EXPECT_NE(e.detail.find("0x42 at frame byte 10 does not match 0x41"), std::string::npos)
-      << e.detail;
-  EXPECT_EQ(frame_at(items, 1).message, kInfoGroup);
+  test::expect_error_then_frame(items, ErrorKind::bad_checksum, bad, Message{kInfoGroup});
+  test::expect_error_at(
+      items, 0,
+      {ErrorKind::bad_checksum, "led.belt.single", "0x42 at frame byte 10 does not match 0x41"});
 }
 
 TEST(LekaDecoder, HeaderLikeGarbageDoesNotSwallowTheNextFrame) {
@@ -131,20 +114,15 @@ TEST(LekaDecoder, StartSequenceInsideAValidGroupIsJustData) {
 }
 
 TEST(LekaDecoder, ZeroLengthIsBadFormatAndOnlyTheHeaderIsDropped) {
-  const auto items = decode_all(cat({hex("2A 2B 2C 2D 00"), kInfo}));
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_EQ(error_at(items, 0).raw, hex("2A 2B 2C 2D 00"));
-  EXPECT_EQ(frame_at(items, 1).message, kInfoGroup);
+  test::expect_error_then_frame(decode_all(cat({hex("2A 2B 2C 2D 00"), kInfo})),
+                                ErrorKind::bad_format, hex("2A 2B 2C 2D 00"), Message{kInfoGroup});
 }
 
 TEST(LekaDecoder, LengthOverTheRobotBufferIsOversizedAndDecodingResumesAfterIt) {
   const auto items = decode_all(cat({hex("2A 2B 2C 2D 7B"), kInfo}));  // 123 > 122
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::oversized);
-  EXPECT_EQ(error_at(items, 0).raw, hex("2A 2B 2C 2D 7B"));
-  EXPECT_NE(error_at(items, 0).detail.find("123-byte command group"), std::string::npos);
-  EXPECT_EQ(frame_at(items, 1).message, kInfoGroup);
+  test::expect_error_then_frame(items, ErrorKind::oversized, hex("2A 2B 2C 2D 7B"),
+                                Message{kInfoGroup});
+  test::expect_error_at(items, 0, {ErrorKind::oversized, std::nullopt, "123-byte command group"});
 
   // 122 is the largest group the robot takes.
   CommandGroup g;
@@ -165,29 +143,25 @@ TEST(LekaDecoder, LargerBoundIsConfigurable) {
   EXPECT_THROW(Decoder(with_bound(262)), std::invalid_argument);
 }
 
-TEST(LekaDecoder, UnknownCommandIdIsUnknownCodeWithTheWholeFrame) {
-  const Bytes frame = frame_group(hex("70 99 01"));
+// Expects the frame around `group` to decode to one error over the whole frame.
+void expect_one_error_over_the_frame(std::string_view group, const test::ExpectedError& want) {
+  const Bytes frame = frame_group(hex(group));
   const auto items = decode_all(frame);
   ASSERT_EQ(items.size(), 1u);
-  const auto& e = error_at(items, 0);
-  EXPECT_EQ(e.kind, ErrorKind::unknown_code);
-  EXPECT_EQ(e.raw, frame);
-  EXPECT_EQ(e.context, "0x99");
-  EXPECT_NE(e.detail.find("unknown command id 0x99 at group byte 1, frame byte 6 (command 2)"),
-            std::string::npos)
-      << e.detail;
+  test::expect_error_at(items, 0, want);
+  EXPECT_EQ(error_at(items, 0).raw, frame);
+}
+
+TEST(LekaDecoder, UnknownCommandIdIsUnknownCodeWithTheWholeFrame) {
+  expect_one_error_over_the_frame(
+      "70 99 01", {ErrorKind::unknown_code, "0x99",
+                   "unknown command id 0x99 at group byte 1, frame byte 6 (command 2)"});
 }
 
 TEST(LekaDecoder, CommandCutShortByTheGroupEndIsBadFormat) {
-  const Bytes frame = frame_group(hex("70 15 03 FF"));
-  const auto items = decode_all(frame);
-  ASSERT_EQ(items.size(), 1u);
-  const auto& e = error_at(items, 0);
-  EXPECT_EQ(e.kind, ErrorKind::bad_format);
-  EXPECT_EQ(e.raw, frame);
-  EXPECT_EQ(e.context, "led.belt.single");
-  EXPECT_NE(e.detail.find("needs 4 data byte(s), the group has only 2 left"), std::string::npos)
-      << e.detail;
+  expect_one_error_over_the_frame("70 15 03 FF",
+                                  {ErrorKind::bad_format, "led.belt.single",
+                                   "needs 4 data byte(s), the group has only 2 left"});
 }
 
 TEST(LekaDecoder, ValuesOutOfRangeAreBadValueUnlessTolerated) {
@@ -206,16 +180,10 @@ TEST(LekaDecoder, ValuesOutOfRangeAreBadValueUnlessTolerated) {
         Case{"23 FF 10", "motor.left", "spin 0xFF"}, Case{"24 02 10", "motor.right", "spin 0x02"},
         Case{"50 50", "motivator", "motivator id 0x50 outside 0x51..0x55"},
         Case{"40 50", "guidance", "guidance id 0x50 outside 0x41..0x4F"}}) {
-    const Bytes frame = frame_group(hex(c.group));
-    const auto strict = decode_all(frame);
-    ASSERT_EQ(strict.size(), 1u) << c.group;
-    const auto& e = error_at(strict, 0);
-    EXPECT_EQ(e.kind, ErrorKind::bad_value) << c.group;
-    EXPECT_EQ(e.raw, frame);
-    EXPECT_EQ(e.context, c.context);
-    EXPECT_NE(e.detail.find(c.says), std::string::npos) << e.detail;
+    SCOPED_TRACE(c.group);
+    expect_one_error_over_the_frame(c.group, {ErrorKind::bad_value, c.context, c.says});
 
-    const auto lenient = decode_all(frame, tolerant());
+    const auto lenient = decode_all(frame_group(hex(c.group)), tolerant());
     ASSERT_EQ(lenient.size(), 1u);
     const auto& f = frame_at(lenient, 0);
     EXPECT_EQ(f.tolerated, ErrorKind::bad_value) << c.group;
@@ -254,11 +222,9 @@ TEST(LekaDecoder, StreamEndingInsideAFrameIsTruncated) {
 
 TEST(LekaDecoder, FrameInsideATruncatedCandidateStillDecodes) {
   // Garbage announcing 100 bytes, then a real frame, then the stream ends.
-  const auto items = decode_all(cat({hex("2A 2B 2C 2D 64 00"), kInfo}));
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::truncated);
-  EXPECT_EQ(error_at(items, 0).raw, hex("2A 2B 2C 2D 64 00"));
-  EXPECT_EQ(frame_at(items, 1).message, kInfoGroup);
+  test::expect_error_then_frame(decode_all(cat({hex("2A 2B 2C 2D 64 00"), kInfo})),
+                                ErrorKind::truncated, hex("2A 2B 2C 2D 64 00"),
+                                Message{kInfoGroup});
 }
 
 TEST(LekaDecoder, PartialStartSequenceAtTheEndIsGarbage) {

@@ -6,10 +6,22 @@
 #include <rapidcheck.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "protocol/leka/codec.hpp"
 #include "protocol/leka/message.hpp"
+
+namespace hil::test::leka {
+
+/// Generates the command T from one generated value per field, in order.
+template <class T, class... Fields>
+rc::Gen<protocol::leka::Command> command_from(rc::Gen<Fields>... fields) {
+  return rc::gen::apply([](Fields... v) { return protocol::leka::Command{T{v...}}; },
+                        std::move(fields)...);
+}
+
+}  // namespace hil::test::leka
 
 namespace rc {
 
@@ -27,6 +39,7 @@ struct Arbitrary<hil::protocol::leka::Command> {
     namespace leka = hil::protocol::leka;
     using C = leka::Command;
     using Byte = std::uint8_t;
+    using hil::test::leka::command_from;
     const auto spin = gen::inRange<Byte>(0, 2);
     const auto speed = gen::arbitrary<Byte>();
     const auto belt = gen::inRange<Byte>(0, 0x14);
@@ -35,42 +48,16 @@ struct Arbitrary<hil::protocol::leka::Command> {
         gen::just(C{leka::Info{}}), gen::just(C{leka::StopLed{}}), gen::just(C{leka::StopMotor{}}),
         gen::just(C{leka::StopRobot{}}),
         gen::map(rgb, [](leka::Rgb c) { return C{leka::EarAll{c}}; }),
-        gen::apply(
-            [](Byte led, leka::Rgb c) {
-              return C{leka::EarSingle{led, c}};
-            },
-            gen::inRange<Byte>(0, 2), rgb),
+        command_from<leka::EarSingle>(gen::inRange<Byte>(0, 2), rgb),
         gen::map(rgb, [](leka::Rgb c) { return C{leka::BeltAll{c}}; }),
         gen::apply(
             [](Byte a, Byte b, leka::Rgb c) {
               return C{leka::BeltRange{std::min(a, b), std::max(a, b), c}};
             },
             belt, belt, rgb),
-        gen::apply(
-            [](Byte led, leka::Rgb c) {
-              return C{leka::BeltSingle{led, c}};
-            },
-            belt, rgb),
-        gen::apply(
-            [](Byte d, Byte s) {
-              return C{leka::MotorAll{d, s}};
-            },
-            spin, speed),
-        gen::apply(
-            [](Byte ls, Byte lv, Byte rs, Byte rv) {
-              return C{leka::MotorDuo{ls, lv, rs, rv}};
-            },
-            spin, speed, spin, speed),
-        gen::apply(
-            [](Byte s, Byte v) {
-              return C{leka::MotorLeft{s, v}};
-            },
-            spin, speed),
-        gen::apply(
-            [](Byte s, Byte v) {
-              return C{leka::MotorRight{s, v}};
-            },
-            spin, speed),
+        command_from<leka::BeltSingle>(belt, rgb), command_from<leka::MotorAll>(spin, speed),
+        command_from<leka::MotorDuo>(spin, speed, spin, speed),
+        command_from<leka::MotorLeft>(spin, speed), command_from<leka::MotorRight>(spin, speed),
         gen::map(gen::inRange<Byte>(0x51, 0x56), [](Byte id) { return C{leka::Motivator{id}}; }),
         gen::map(gen::inRange<Byte>(0x41, 0x50), [](Byte id) { return C{leka::Guidance{id}}; }));
   }

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "protocol/leka/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/protocol/leka/leka_generators.hpp"
 #include "tests/support/stream_support.hpp"
 
@@ -13,6 +14,7 @@ namespace {
 using test::concat;
 using test::decode_chunked;
 using test::decode_whole;
+using test::frames_of;
 using test::messages_of;
 using test::raw_of_all;
 
@@ -73,57 +75,26 @@ RC_GTEST_PROP(LekaProperties, ParseOfGroupBytesIsIdentity, (const CommandGroup& 
 
 RC_GTEST_PROP(LekaProperties, AnyChunkingDecodesLikeTheWholeStream,
               (const std::vector<CommandGroup>& gs)) {
-  std::vector<Bytes> parts;
-  for (const auto& g : gs)
-    parts.push_back(encode(g));
   // Header-like noise so that errors and resynchronisation are compared too.
   const auto noise = *header_like_garbage();
-  parts.insert(parts.begin() + *rc::gen::inRange<std::ptrdiff_t>(
-                                   0, static_cast<std::ptrdiff_t>(parts.size()) + 1),
-               noise);
-  const Bytes stream = concat(parts);
-  const auto whole = decode_whole<Decoder, Item>(Decoder{}, stream);
-  const auto chunked = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
-  const auto bytewise = decode_chunked<Decoder, Item>(Decoder{}, stream, {1});
-  RC_ASSERT(chunked == whole);
-  RC_ASSERT(bytewise == whole);
+  const Bytes stream = test::with_noise_somewhere(frames_of(gs), noise);
+  test::assert_any_chunking_decodes_alike<Decoder, Item>(Decoder{}, stream);
 }
 
 RC_GTEST_PROP(LekaProperties, EveryByteIsAccountedForOnce, (const std::vector<CommandGroup>& gs)) {
-  Bytes stream;
-  for (const auto& g : gs) {
-    const auto frame = encode(g);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-    const auto noise = *rc::gen::oneOf(
-        rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>()), header_like_garbage());
-    stream.insert(stream.end(), noise.begin(), noise.end());
-  }
+  const Bytes stream = test::interleave(frames_of(gs), [] {
+    return *rc::gen::oneOf(rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>()),
+                           header_like_garbage());
+  });
   Decoder d;
-  std::vector<Item> items;
-  const auto pieces = *test::gen_pieces();
-  std::size_t pos = 0;
-  for (std::size_t i = 0; pos < stream.size(); ++i) {
-    const std::size_t n =
-        std::min(std::max<std::size_t>(1, pieces[i % pieces.size()]), stream.size() - pos);
-    d.feed(ByteView(stream).subspan(pos, n), items);
-    pos += n;
-    RC_ASSERT(d.buffered() <= kMaxFrameBytes);
-  }
-  d.finish(items);
-  RC_ASSERT(d.buffered() == 0u);
+  const auto items = test::decode_within<Decoder, Item>(d, stream, kMaxFrameBytes);
   RC_ASSERT(raw_of_all(items) == stream);
 }
 
 RC_GTEST_PROP(LekaProperties, RandomGarbageBetweenFramesLosesNoFrame,
               (const std::vector<CommandGroup>& gs)) {
-  Bytes stream;
-  for (const auto& g : gs) {
-    const auto garbage = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-    RC_PRE(!contains_start(garbage));
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto frame = encode(g);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-  }
+  const Bytes stream = test::interleave(frames_of(gs), test::noise_without(contains_start),
+                                        /*noise_first=*/true);
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
   RC_ASSERT(messages_of(items) == std::vector<Message>(gs.begin(), gs.end()));
 }

@@ -1,22 +1,18 @@
 #include <gtest/gtest.h>
 
 #include "protocol/logi/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::logi {
 namespace {
 
 std::vector<Item> decode_all(std::string_view stream, DecoderOptions options = {}) {
-  Decoder d(options);
-  std::vector<Item> out;
-  d.feed(to_bytes(stream), out);
-  d.finish(out);
-  return out;
+  return test::decode_whole<Decoder, Item>(Decoder(options), to_bytes(stream));
 }
 
-const DecodeError& error_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<DecodeError>(items.at(i));
-}
+using test::error_at;
+using test::message_at;
 
 TEST(LogiDecoder, StickyPacketsInOneReadGiveEveryFrame) {
   const auto items = decode_all("LOGI:FB:SP:1:35#LOGI:FB:MD:1:23#LOGI:FB:MV:0:34#");
@@ -27,23 +23,13 @@ TEST(LogiDecoder, StickyPacketsInOneReadGiveEveryFrame) {
 }
 
 TEST(LogiDecoder, SplitPacketIsReassembled) {
-  Decoder d;
-  std::vector<Item> out;
-  d.feed(to_bytes("LOG"), out);
-  d.feed(to_bytes("I:SP:0"), out);
-  EXPECT_TRUE(out.empty());
-  d.feed(to_bytes("50:D7#LOGI:"), out);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(std::get<Frame<Message>>(out[0]).message, Message{SetSpeed{50}});
-  EXPECT_EQ(d.buffered(), 5u);
+  test::expect_reassembled<Decoder>({to_bytes("LOG"), to_bytes("I:SP:0"), to_bytes("50:D7#LOGI:")},
+                                    std::nullopt, Message{SetSpeed{50}}, 5u);
 }
 
 TEST(LogiDecoder, GarbageBeforeHeaderIsReportedAndDiscarded) {
-  const auto items = decode_all("\r\nOK>LOGI:SP:050:D7#");
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::garbage);
-  EXPECT_EQ(to_string(error_at(items, 0).raw), "\r\nOK>");
-  EXPECT_EQ(std::get<Frame<Message>>(items[1]).message, Message{SetSpeed{50}});
+  test::expect_error_then_frame(decode_all("\r\nOK>LOGI:SP:050:D7#"), ErrorKind::garbage,
+                                to_bytes("\r\nOK>"), Message{SetSpeed{50}});
 }
 
 TEST(LogiDecoder, BadChecksumIsDroppedWithRawTextAndStreamContinues) {
@@ -53,7 +39,7 @@ TEST(LogiDecoder, BadChecksumIsDroppedWithRawTextAndStreamContinues) {
   EXPECT_EQ(to_string(error_at(items, 0).raw), "LOGI:SP:050:D8#");
   EXPECT_EQ(error_at(items, 0).context, "SP");
   EXPECT_NE(error_at(items, 0).detail.find("computed D7"), std::string::npos);
-  EXPECT_EQ(std::get<Frame<Message>>(items[1]).message, Message{SetSpeed{30}});
+  EXPECT_EQ(message_at(items, 1), Message{SetSpeed{30}});
 }
 
 TEST(LogiDecoder, LowercaseChecksumIsADistinctViolation) {
@@ -131,22 +117,14 @@ TEST(LogiDecoder, MalformedCommandsCarryTheirCommandCode) {
 }
 
 TEST(LogiDecoder, GarbageThatLooksLikeAHeaderDoesNotSwallowTheNextFrame) {
-  const auto items = decode_all("LOGI:SP:0LOGI:SP:050:D7#");
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_EQ(to_string(error_at(items, 0).raw), "LOGI:SP:0");
-  EXPECT_EQ(std::get<Frame<Message>>(items[1]).message, Message{SetSpeed{50}});
+  test::expect_error_then_frame(decode_all("LOGI:SP:0LOGI:SP:050:D7#"), ErrorKind::bad_format,
+                                to_bytes("LOGI:SP:0"), Message{SetSpeed{50}});
 }
 
 TEST(LogiDecoder, OversizedFrameIsBoundedAndReported) {
   std::string stream = "LOGI:" + std::string(400, 'A') + "LOGI:SP:050:D7#";
-  Decoder d;
-  std::vector<Item> out;
-  for (const char c : stream) {
-    d.feed(to_bytes(std::string_view(&c, 1)), out);
-    EXPECT_LE(d.buffered(), kDefaultMaxFrameBytes);
-  }
-  d.finish(out);
+  const auto out = test::decode_bytewise_within<Decoder, Item>(Decoder{}, to_bytes(stream),
+                                                               kDefaultMaxFrameBytes);
   EXPECT_EQ(test::count_errors(out, ErrorKind::oversized), 1u);
   EXPECT_EQ(test::messages_of(out), std::vector<Message>{SetSpeed{50}});
 }

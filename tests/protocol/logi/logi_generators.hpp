@@ -4,15 +4,11 @@
 #include <rapidcheck.h>
 
 #include "protocol/logi/message.hpp"
+#include "tests/protocol/arbitrary_support.hpp"
 
 namespace rc {
 
-template <>
-struct Arbitrary<hil::protocol::logi::Direction> {
-  static Gen<hil::protocol::logi::Direction> arbitrary() {
-    return gen::elementOf(hil::protocol::logi::kAllDirections);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::logi::Direction, hil::protocol::logi::kAllDirections);
 
 template <>
 struct Arbitrary<hil::protocol::logi::Mode> {
@@ -21,12 +17,7 @@ struct Arbitrary<hil::protocol::logi::Mode> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::logi::Command> {
-  static Gen<hil::protocol::logi::Command> arbitrary() {
-    return gen::elementOf(hil::protocol::logi::kAllCommands);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::logi::Command, hil::protocol::logi::kAllCommands);
 
 template <>
 struct Arbitrary<hil::protocol::logi::Status> {

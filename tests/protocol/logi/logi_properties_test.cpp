@@ -2,17 +2,16 @@
 #include <rapidcheck/gtest.h>
 
 #include "protocol/logi/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/protocol/logi/logi_generators.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::logi {
 namespace {
 
-using test::concat;
 using test::decode_chunked;
-using test::decode_whole;
+using test::frames_of;
 using test::messages_of;
-using test::raw_of_all;
 
 bool contains_header(const Bytes& b) {
   return to_string(b).find(kHeader) != std::string::npos;
@@ -28,46 +27,24 @@ RC_GTEST_PROP(LogiProperties, DecodeOfEncodeIsIdentity, (const Message& m)) {
 
 RC_GTEST_PROP(LogiProperties, AnyChunkingDecodesLikeTheWholeStream,
               (const std::vector<Message>& ms)) {
-  std::vector<Bytes> frames;
-  for (const auto& m : ms)
-    frames.push_back(encode(m));
   // Some noise so errors are part of the comparison too.
   const auto noise =
       *rc::gen::container<Bytes>(rc::gen::element<std::uint8_t>('L', 'O', 'G', 'I', ':', '#', 'x'));
-  frames.insert(frames.begin() + *rc::gen::inRange<std::ptrdiff_t>(
-                                     0, static_cast<std::ptrdiff_t>(frames.size()) + 1),
-                noise);
-  const Bytes stream = concat(frames);
-  const auto pieces = *test::gen_pieces();
-  const auto whole = decode_whole<Decoder, Item>(Decoder{}, stream);
-  const auto chunked = decode_chunked<Decoder, Item>(Decoder{}, stream, pieces);
-  const auto bytewise = decode_chunked<Decoder, Item>(Decoder{}, stream, {1});
-  RC_ASSERT(chunked == whole);
-  RC_ASSERT(bytewise == whole);
+  const Bytes stream = test::with_noise_somewhere(frames_of(ms), noise);
+  test::assert_any_chunking_decodes_alike<Decoder, Item>(Decoder{}, stream);
 }
 
 RC_GTEST_PROP(LogiProperties, EveryByteIsAccountedForOnce, (const std::vector<Message>& ms)) {
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto frame = encode(m);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-    const auto noise = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-    stream.insert(stream.end(), noise.begin(), noise.end());
-  }
+  const Bytes stream = test::interleave(
+      frames_of(ms), [] { return *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>()); });
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
-  RC_ASSERT(raw_of_all(items) == stream);
+  RC_ASSERT(test::raw_of_all(items) == stream);
 }
 
 RC_GTEST_PROP(LogiProperties, RandomGarbageBetweenFramesLosesNoFrame,
               (const std::vector<Message>& ms)) {
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto garbage = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-    RC_PRE(!contains_header(garbage));
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto frame = encode(m);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-  }
+  const Bytes stream = test::interleave(frames_of(ms), test::noise_without(contains_header),
+                                        /*noise_first=*/true);
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
   RC_ASSERT(messages_of(items) == ms);
 }
@@ -75,14 +52,11 @@ RC_GTEST_PROP(LogiProperties, RandomGarbageBetweenFramesLosesNoFrame,
 RC_GTEST_PROP(LogiProperties, HeaderLikeGarbageLosesNoFrame, (const std::vector<Message>& ms)) {
   // Garbage made of the header's own letters (even whole headers), but no
   // tail: the decoder must resynchronise on the real header each time.
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto garbage = *rc::gen::container<Bytes>(
+  const auto header_letters = [] {
+    return *rc::gen::container<Bytes>(
         rc::gen::element<std::uint8_t>('L', 'O', 'G', 'I', ':', 'S', 'P', '0', 0x00, 0xFF));
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto frame = encode(m);
-    stream.insert(stream.end(), frame.begin(), frame.end());
-  }
+  };
+  const Bytes stream = test::interleave(frames_of(ms), header_letters, /*noise_first=*/true);
   const auto items = decode_chunked<Decoder, Item>(Decoder{}, stream, *test::gen_pieces());
   RC_ASSERT(messages_of(items) == ms);
 }
@@ -91,15 +65,13 @@ RC_GTEST_PROP(LogiProperties, HeaderLikeGarbageLosesNoFrame, (const std::vector<
 bool single_byte_change_detected(const Bytes& frame, std::size_t pos, std::uint8_t value) {
   Bytes changed = frame;
   changed[pos] = value;
-  const auto items = decode_whole<Decoder, Item>(Decoder{}, changed);
+  const auto items = test::decode_whole<Decoder, Item>(Decoder{}, changed);
   return messages_of(items).empty();
 }
 
 RC_GTEST_PROP(LogiProperties, EverySingleByteChangeIsDetected, (const Message& m)) {
   const Bytes frame = encode(m);
-  const auto pos = *rc::gen::inRange<std::size_t>(0, frame.size());
-  const auto value = *rc::gen::suchThat(rc::gen::arbitrary<std::uint8_t>(),
-                                        [&](std::uint8_t v) { return v != frame[pos]; });
+  const auto [pos, value] = test::gen_single_byte_change(frame);
   RC_ASSERT(single_byte_change_detected(frame, pos, value));
 }
 
@@ -113,14 +85,12 @@ TEST(LogiProperties, EverySingleByteChangeOfEverySpecCommandIsDetected) {
   std::size_t checked = 0;
   for (const auto& m : commands) {
     const Bytes frame = encode(m);
-    for (std::size_t pos = 0; pos < frame.size(); ++pos) {
-      for (int v = 0; v < 256; ++v) {
-        if (v == frame[pos]) continue;
-        ASSERT_TRUE(single_byte_change_detected(frame, pos, static_cast<std::uint8_t>(v)))
-            << to_string(frame) << " byte " << pos << " -> " << v;
-        ++checked;
-      }
-    }
+    test::for_each_single_byte_change(frame, [&](std::size_t pos, std::uint8_t v) {
+      ASSERT_TRUE(single_byte_change_detected(frame, pos, v))
+          << to_string(frame) << " byte " << pos << " -> " << int{v};
+      ++checked;
+    });
+    ASSERT_FALSE(HasFatalFailure());
   }
   EXPECT_GT(checked, 50000u);
 }

@@ -6,14 +6,12 @@
 
 #include "protocol/common/car_profile.hpp"
 #include "protocol/logi/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 
 namespace hil::protocol::logi {
 namespace {
 
-struct Vector {
-  const char* frame;
-  Message message;
-};
+using Vector = test::TextVector<Message>;
 
 const Vector kSpecFrames[] = {
     {"LOGI:MD:MAN:0C#", SetMode{Mode::manual}},
@@ -49,12 +47,8 @@ TEST(LogiVectors, EncodeReproducesEverySpecFrame) {
 
 TEST(LogiVectors, DecodeGivesBackEverySpecMessage) {
   for (const auto& v : kSpecFrames) {
-    const auto item = decode_frame(to_bytes(v.frame));
-    const auto* frame = std::get_if<Frame<Message>>(&item);
-    ASSERT_NE(frame, nullptr) << v.frame << ": " << std::get<DecodeError>(item).detail;
-    EXPECT_EQ(frame->message, v.message) << v.frame;
-    EXPECT_EQ(to_string(frame->raw), v.frame);
-    EXPECT_FALSE(frame->tolerated);
+    SCOPED_TRACE(v.frame);
+    test::expect_decoded_vector(decode_frame(to_bytes(v.frame)), v);
   }
 }
 
@@ -65,17 +59,16 @@ TEST(LogiVectors, ChecksumIsLowByteOfAsciiSum) {
 }
 
 TEST(LogiVectors, StatusRoundTripsWithEveryField) {
-  Status s;
-  s.speed_percent = 50;
-  s.station = 2;
-  s.running = true;
-  s.mode = Mode::automatic;
-  s.manual = Direction::stop;
-  s.distance_cm = 123;
-  s.track_mask = 0b0110;
-  s.deviation = -3;
-  s.obstacle = false;
-  s.rpm = {120, 121, -119, 0};
+  Status s{.speed_percent = 50,
+           .station = 2,
+           .running = true,
+           .mode = Mode::automatic,
+           .manual = Direction::stop,
+           .distance_cm = 123,
+           .track_mask = 0b0110,
+           .deviation = -3,
+           .obstacle = false,
+           .rpm = {120, 121, -119, 0}};
   const std::string text = encode_text(s);
   EXPECT_EQ(text.substr(0, text.size() - 4),
             "LOGI:STAT:SP:050,STA:002,RUN:1,MODE:AUTO,MAN:STOP,DIS:123,TRK:0110,DEV:-3,OBS:0,"

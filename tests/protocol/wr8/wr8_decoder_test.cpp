@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "protocol/wr8/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
@@ -15,17 +16,9 @@ std::vector<Item> decode_all(std::string_view hex_stream, DecoderOptions options
   return test::decode_whole<Decoder, Item>(Decoder(std::move(options)), hex(hex_stream));
 }
 
-const DecodeError& error_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<DecodeError>(items.at(i));
-}
-
-const Message& message_at(const std::vector<Item>& items, std::size_t i) {
-  return std::get<Frame<Message>>(items.at(i)).message;
-}
-
-bool mentions(const DecodeError& e, std::string_view text) {
-  return e.detail.find(text) != std::string::npos;
-}
+using test::error_at;
+using test::expect_error_at;
+using test::message_at;
 
 const Message kDrive100 = Task{1, TaskCode::drive, {Word::from_i32(100)}};
 
@@ -38,24 +31,16 @@ TEST(Wr8Decoder, StickyPacketsInOneReadGiveEveryPacket) {
 }
 
 TEST(Wr8Decoder, SplitPacketIsReassembledAcrossReads) {
-  Decoder d;
-  std::vector<Item> out;
-  d.feed(hex("03 01"), out);
-  d.feed(hex("01 04 64"), out);
-  EXPECT_TRUE(out.empty());
-  EXPECT_EQ(d.buffered(), 5u);
-  d.feed(hex("00 00 00 06 01"), out);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(message_at(out, 0), kDrive100);
-  EXPECT_EQ(d.buffered(), 2u);  // the start of a DATA packet waits for its header
+  // The last read leaves the start of a DATA packet waiting for its header.
+  test::expect_reassembled<Decoder>({hex("03 01"), hex("01 04 64"), hex("00 00 00 06 01")}, 5u,
+                                    kDrive100, 2u);
 }
 
 TEST(Wr8Decoder, GarbageRunIsOneItemAndTheNextPacketDecodes) {
   const auto items = decode_all("FF 41 42 0D 0A 05 01 02");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::garbage);
+  expect_error_at(items, 0, {ErrorKind::garbage, std::nullopt, "5 bytes"});
   EXPECT_EQ(to_hex(error_at(items, 0).raw), "FF 41 42 0D 0A");
-  EXPECT_TRUE(mentions(error_at(items, 0), "5 bytes")) << error_at(items, 0).detail;
   EXPECT_EQ(message_at(items, 1), (Message{Response{1, ResponseCode::completed}}));
 }
 
@@ -102,13 +87,10 @@ TEST(Wr8Decoder, OversizedPacketIsPassedOnInPiecesThenTheStreamContinues) {
   stream.insert(stream.end(), next.begin(), next.end());
   const auto items = test::decode_chunked<Decoder, Item>(Decoder(options), stream, {3});
   ASSERT_EQ(items.size(), 3u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::oversized);
-  EXPECT_EQ(error_at(items, 0).context, "TASK");
+  expect_error_at(items, 0, {ErrorKind::oversized, "TASK", "declares 104 bytes"});
   EXPECT_EQ(error_at(items, 0).raw.size(), 64u);
-  EXPECT_TRUE(mentions(error_at(items, 0), "declares 104 bytes")) << error_at(items, 0).detail;
-  EXPECT_EQ(error_at(items, 1).kind, ErrorKind::oversized);
+  expect_error_at(items, 1, {ErrorKind::oversized, std::nullopt, "bytes 65..104 (the end)"});
   EXPECT_EQ(error_at(items, 1).raw.size(), 40u);
-  EXPECT_TRUE(mentions(error_at(items, 1), "bytes 65..104 (the end)")) << error_at(items, 1).detail;
   EXPECT_EQ(message_at(items, 2), (Message{Response{9, ResponseCode::completed}}));
 }
 
@@ -128,17 +110,14 @@ TEST(Wr8Decoder, PacketOfExactlyTheLimitIsAccepted) {
 TEST(Wr8Decoder, StreamEndingInsideAPacketIsTruncated) {
   const auto items = decode_all("05 01 02 06 01 DC 05");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 1).kind, ErrorKind::truncated);
-  EXPECT_EQ(error_at(items, 1).context, "DATA");
+  expect_error_at(items, 1, {ErrorKind::truncated, "DATA"});
   EXPECT_EQ(to_hex(error_at(items, 1).raw), "06 01 DC 05");
 }
 
 TEST(Wr8Decoder, TaskSizeNotAMultipleOfFourIsBadFormat) {
   const auto items = decode_all("03 01 01 06 01 02 03 04 05 06 05 01 02");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_EQ(error_at(items, 0).context, "TASK");
-  EXPECT_TRUE(mentions(error_at(items, 0), "multiple of 4")) << error_at(items, 0).detail;
+  expect_error_at(items, 0, {ErrorKind::bad_format, "TASK", "multiple of 4"});
   EXPECT_EQ(error_at(items, 0).raw.size(), 10u);  // the declared length is skipped as one
   EXPECT_EQ(message_at(items, 1), (Message{Response{1, ResponseCode::completed}}));
 }
@@ -146,27 +125,20 @@ TEST(Wr8Decoder, TaskSizeNotAMultipleOfFourIsBadFormat) {
 TEST(Wr8Decoder, SettingsSizeNotAMultipleOfFiveIsBadFormat) {
   const auto items = decode_all("04 01 04 00 00 00 00");
   ASSERT_EQ(items.size(), 1u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_EQ(error_at(items, 0).context, "SETTINGS");
-  EXPECT_TRUE(mentions(error_at(items, 0), "multiple of 5")) << error_at(items, 0).detail;
+  expect_error_at(items, 0, {ErrorKind::bad_format, "SETTINGS", "multiple of 5"});
 }
 
 TEST(Wr8Decoder, TaskWithTheWrongParameterCountIsBadFormat) {
   const auto items = decode_all("03 01 01 00 03 01 03 04 00 00 00 00");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_TRUE(mentions(error_at(items, 0), "drive takes 1 parameter")) << error_at(items, 0).detail;
-  EXPECT_EQ(error_at(items, 1).kind, ErrorKind::bad_format);
-  EXPECT_TRUE(mentions(error_at(items, 1), "blink takes 0 parameters"))
-      << error_at(items, 1).detail;
+  expect_error_at(items, 0, {ErrorKind::bad_format, std::nullopt, "drive takes 1 parameter"});
+  expect_error_at(items, 1, {ErrorKind::bad_format, std::nullopt, "blink takes 0 parameters"});
 }
 
 TEST(Wr8Decoder, UnknownTaskCodeIsSkippedAsAWholePacket) {
   const auto items = decode_all("03 01 09 04 01 02 03 04 05 01 02");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::unknown_code);
-  EXPECT_EQ(error_at(items, 0).context, "TASK");
-  EXPECT_TRUE(mentions(error_at(items, 0), "task code 9")) << error_at(items, 0).detail;
+  expect_error_at(items, 0, {ErrorKind::unknown_code, "TASK", "task code 9"});
   EXPECT_EQ(error_at(items, 0).raw.size(), 8u);
   EXPECT_EQ(message_at(items, 1), (Message{Response{1, ResponseCode::completed}}));
 }
@@ -174,28 +146,22 @@ TEST(Wr8Decoder, UnknownTaskCodeIsSkippedAsAWholePacket) {
 TEST(Wr8Decoder, UnknownSettingTypeAndResponseCodeAreUnknownCode) {
   const auto items = decode_all("04 01 05 07 00 00 00 00 05 02 03");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::unknown_code);
-  EXPECT_TRUE(mentions(error_at(items, 0), "setting type 7")) << error_at(items, 0).detail;
-  EXPECT_EQ(error_at(items, 1).kind, ErrorKind::unknown_code);
-  EXPECT_EQ(error_at(items, 1).context, "RESPONSE");
+  expect_error_at(items, 0, {ErrorKind::unknown_code, std::nullopt, "setting type 7"});
+  expect_error_at(items, 1, {ErrorKind::unknown_code, "RESPONSE"});
 }
 
 TEST(Wr8Decoder, StateOutsideTheTableIsBadValue) {
   const auto items = decode_all("02 01 01 04 06 09 00 00 00 00 00");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_value);
-  EXPECT_EQ(error_at(items, 0).context, "AUTH-REPLY");
-  EXPECT_EQ(error_at(items, 1).kind, ErrorKind::bad_value);
-  EXPECT_EQ(error_at(items, 1).context, "DATA");
-  EXPECT_TRUE(mentions(error_at(items, 1), "state code 9")) << error_at(items, 1).detail;
+  expect_error_at(items, 0, {ErrorKind::bad_value, "AUTH-REPLY"});
+  expect_error_at(items, 1, {ErrorKind::bad_value, "DATA", "state code 9"});
 }
 
 TEST(Wr8Decoder, DataEntryRunningPastItsBlockIsBadFormat) {
   // Block of 3 bytes: odometry code then only 2 of its 4 value bytes.
   const auto items = decode_all("06 01 00 00 00 00 03 00 01 02 05 01 02");
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_TRUE(mentions(error_at(items, 0), "needs 4 value bytes")) << error_at(items, 0).detail;
+  expect_error_at(items, 0, {ErrorKind::bad_format, std::nullopt, "needs 4 value bytes"});
   EXPECT_EQ(message_at(items, 1), (Message{Response{1, ResponseCode::completed}}));
 }
 
@@ -228,9 +194,8 @@ TEST(Wr8Decoder, EntriesModeUnknownDataCodeCutsThePacketThere) {
   // Two entries declared; the second has code 9, which cannot be sized.
   const auto items = decode_all("06 01 00 00 00 00 02 03 4B 09 05 01 02", options);
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::unknown_code);
+  expect_error_at(items, 0, {ErrorKind::unknown_code, std::nullopt, "resumes after this byte"});
   EXPECT_EQ(to_hex(error_at(items, 0).raw), "06 01 00 00 00 00 02 03 4B 09");
-  EXPECT_TRUE(mentions(error_at(items, 0), "resumes after this byte")) << error_at(items, 0).detail;
   // The byte after the cut happens to start a packet here; in general it may not.
   EXPECT_EQ(message_at(items, 1), (Message{Response{1, ResponseCode::completed}}));
 }
@@ -240,10 +205,8 @@ TEST(Wr8Decoder, VehicleSideDecoderTreatsVehiclePacketsAsUnknownCodes) {
   options.sender = Sender::gui;  // decoding what the GUI sends
   const auto items = decode_all("06 05 02 03 01 01 04 64 00 00 00", options);
   ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::unknown_code);
+  expect_error_at(items, 0, {ErrorKind::unknown_code, "DATA", "GUI does not send"});
   EXPECT_EQ(to_hex(error_at(items, 0).raw), "06 05 02");  // one item for the run
-  EXPECT_EQ(error_at(items, 0).context, "DATA");
-  EXPECT_TRUE(mentions(error_at(items, 0), "GUI does not send")) << error_at(items, 0).detail;
   EXPECT_EQ(message_at(items, 1), kDrive100);
 }
 

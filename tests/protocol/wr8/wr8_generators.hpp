@@ -6,6 +6,7 @@
 #include <rapidcheck.h>
 
 #include "protocol/wr8/codec.hpp"
+#include "tests/protocol/arbitrary_support.hpp"
 
 namespace rc {
 
@@ -22,26 +23,11 @@ struct Arbitrary<hil::protocol::wr8::Word> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::wr8::State> {
-  static Gen<hil::protocol::wr8::State> arbitrary() {
-    return gen::elementOf(hil::protocol::wr8::kAllStates);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::wr8::State, hil::protocol::wr8::kAllStates);
 
-template <>
-struct Arbitrary<hil::protocol::wr8::SettingCode> {
-  static Gen<hil::protocol::wr8::SettingCode> arbitrary() {
-    return gen::elementOf(hil::protocol::wr8::kAllSettingCodes);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::wr8::SettingCode, hil::protocol::wr8::kAllSettingCodes);
 
-template <>
-struct Arbitrary<hil::protocol::wr8::ResponseCode> {
-  static Gen<hil::protocol::wr8::ResponseCode> arbitrary() {
-    return gen::elementOf(hil::protocol::wr8::kAllResponseCodes);
-  }
-};
+HIL_ARBITRARY_ELEMENT_OF(hil::protocol::wr8::ResponseCode, hil::protocol::wr8::kAllResponseCodes);
 
 template <>
 struct Arbitrary<hil::protocol::wr8::Auth> {
@@ -93,8 +79,7 @@ struct Arbitrary<hil::protocol::wr8::Settings> {
     namespace wr8 = hil::protocol::wr8;
     return gen::build<wr8::Settings>(
         gen::set(&wr8::Settings::coi),
-        gen::set(&wr8::Settings::params, gen::resize(12, gen::container<std::vector<wr8::Setting>>(
-                                                             gen::arbitrary<wr8::Setting>()))));
+        gen::set(&wr8::Settings::params, hil::test::up_to<wr8::Setting>(12)));
   }
 };
 
@@ -135,11 +120,9 @@ struct Arbitrary<hil::protocol::wr8::Data> {
                               v.second.insert(v.second.begin(), v.first);
                               return v.second;
                             }));
-    return gen::build<wr8::Data>(
-        gen::set(&wr8::Data::state), gen::set(&wr8::Data::timestamp_ms),
-        gen::set(&wr8::Data::values, gen::resize(20, gen::container<std::vector<wr8::DataValue>>(
-                                                         gen::arbitrary<wr8::DataValue>()))),
-        gen::set(&wr8::Data::unparsed, unparsed));
+    return gen::build<wr8::Data>(gen::set(&wr8::Data::state), gen::set(&wr8::Data::timestamp_ms),
+                                 gen::set(&wr8::Data::values, hil::test::up_to<wr8::DataValue>(20)),
+                                 gen::set(&wr8::Data::unparsed, unparsed));
   }
 };
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "protocol/wr8/length_prefix.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/support/hex.hpp"
 #include "tests/support/stream_support.hpp"
 
@@ -27,13 +28,8 @@ std::vector<PrefixedItem> split_whole(ByteView stream) {
   return test::decode_whole<LengthPrefixSplitter, PrefixedItem>(LengthPrefixSplitter{}, stream);
 }
 
-const Frame<Bytes>& frame_at(const std::vector<PrefixedItem>& items, std::size_t i) {
-  return std::get<Frame<Bytes>>(items.at(i));
-}
-
-const DecodeError& error_at(const std::vector<PrefixedItem>& items, std::size_t i) {
-  return std::get<DecodeError>(items.at(i));
-}
+using test::error_at;
+using test::frame_at;
 
 TEST(Wr8LengthPrefix, TheGuisAuthPacketsAreOnePacketEach) {
   const auto v2019 = split_whole(auth_2019());
@@ -79,20 +75,15 @@ TEST(Wr8LengthPrefix, APacketSplitAcrossReadsWaitsForItsLastByte) {
 TEST(Wr8LengthPrefix, ALengthOf128OrMoreIsATypedErrorOfThatByte) {
   // 0x80 declares 128 bytes; the real receiver reads it as -128.
   const auto items = split_whole(hex("80 04 02 01 02 03"));
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::oversized);
-  EXPECT_EQ(error_at(items, 0).raw, hex("80"));
+  test::expect_error_then_frame(items, ErrorKind::oversized, hex("80"), hex("02 01 02 03"));
   EXPECT_THAT(error_at(items, 0).detail, testing::HasSubstr("0x80"));
-  EXPECT_EQ(frame_at(items, 1).message, hex("02 01 02 03"));
 
   EXPECT_EQ(error_at(split_whole(hex("FF")), 0).kind, ErrorKind::oversized);
 }
 
 TEST(Wr8LengthPrefix, ALengthOfZeroFramesNothing) {
   const auto items = split_whole(hex("00 04 02 01 02 03"));
-  ASSERT_EQ(items.size(), 2u);
-  EXPECT_EQ(error_at(items, 0).kind, ErrorKind::bad_format);
-  EXPECT_EQ(error_at(items, 0).raw, hex("00"));
+  test::expect_error_then_frame(items, ErrorKind::bad_format, hex("00"), hex("02 01 02 03"));
   EXPECT_EQ(frame_at(items, 1).raw, auth_reply());
 }
 

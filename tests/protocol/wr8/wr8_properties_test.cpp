@@ -2,13 +2,13 @@
 #include <rapidcheck/gtest.h>
 
 #include "protocol/wr8/codec.hpp"
+#include "tests/protocol/decoder_test_support.hpp"
 #include "tests/protocol/wr8/wr8_generators.hpp"
 #include "tests/support/stream_support.hpp"
 
 namespace hil::protocol::wr8 {
 namespace {
 
-using test::concat;
 using test::decode_chunked;
 using test::decode_whole;
 using test::fit;
@@ -19,6 +19,14 @@ std::vector<Message> fitted(std::vector<Message> ms, const Profile& profile) {
   for (auto& m : ms)
     m = fit(std::move(m), profile);
   return ms;
+}
+
+std::vector<Bytes> packets_of(const std::vector<Message>& ms,
+                              const Profile& profile = default_profile()) {
+  std::vector<Bytes> packets;
+  for (const auto& m : ms)
+    packets.push_back(encode(m, profile));
+  return packets;
 }
 
 // Bytes that are no packet code: the garbage the decoder can always skip.
@@ -43,61 +51,31 @@ RC_GTEST_PROP(Wr8Properties, DecodeOfEncodeIsIdentity,
 
 RC_GTEST_PROP(Wr8Properties, AnyChunkingDecodesLikeTheWholeStream,
               (const std::vector<Message>& any, const Profile& profile)) {
-  std::vector<Bytes> parts;
-  for (const auto& m : fitted(any, profile))
-    parts.push_back(encode(m, profile));
   // Arbitrary noise so errors and resynchronisation are compared too.
   const auto noise = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-  parts.insert(parts.begin() + *rc::gen::inRange<std::ptrdiff_t>(
-                                   0, static_cast<std::ptrdiff_t>(parts.size()) + 1),
-               noise);
-  const Bytes stream = concat(parts);
+  const Bytes stream = test::with_noise_somewhere(packets_of(fitted(any, profile), profile), noise);
   DecoderOptions options{profile};
   options.max_packet_bytes = *rc::gen::element<std::size_t>(0, 16, 40, 300);
-  const auto whole = decode_whole<Decoder, Item>(Decoder(options), stream);
-  const auto chunked = decode_chunked<Decoder, Item>(Decoder(options), stream, *test::gen_pieces());
-  const auto bytewise = decode_chunked<Decoder, Item>(Decoder(options), stream, {1});
-  RC_ASSERT(chunked == whole);
-  RC_ASSERT(bytewise == whole);
+  test::assert_any_chunking_decodes_alike<Decoder, Item>(Decoder(options), stream);
 }
 
 RC_GTEST_PROP(Wr8Properties, EveryByteIsAccountedForOnce,
               (const std::vector<Message>& any, const Profile& profile)) {
-  Bytes stream;
-  for (const auto& m : fitted(any, profile)) {
-    const auto packet = encode(m, profile);
-    stream.insert(stream.end(), packet.begin(), packet.end());
-    const auto noise = *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
-    stream.insert(stream.end(), noise.begin(), noise.end());
-  }
+  const Bytes stream = test::interleave(packets_of(fitted(any, profile), profile), [] {
+    return *rc::gen::container<Bytes>(rc::gen::arbitrary<std::uint8_t>());
+  });
   DecoderOptions options{profile};
   options.max_packet_bytes = *rc::gen::element<std::size_t>(0, 16, 40, 300);
   Decoder decoder(options);
-  std::vector<Item> items;
-  const auto pieces = *test::gen_pieces();
-  std::size_t pos = 0;
-  for (std::size_t i = 0; pos < stream.size(); ++i) {
-    const std::size_t n =
-        std::min(std::max<std::size_t>(1, pieces[i % pieces.size()]), stream.size() - pos);
-    decoder.feed(ByteView(stream).subspan(pos, n), items);
-    pos += n;
-    RC_ASSERT(decoder.buffered() <= decoder.max_buffered());
-  }
-  decoder.finish(items);
-  RC_ASSERT(decoder.buffered() == 0u);
+  const auto items = test::decode_within<Decoder, Item>(decoder, stream, decoder.max_buffered());
   RC_ASSERT(raw_of_all(items) == stream);
 }
 
 RC_GTEST_PROP(Wr8Properties, GarbageOfNonCodeBytesBetweenPacketsLosesNoPacket,
               (const std::vector<Message>& any, const Profile& profile)) {
   const auto ms = fitted(any, profile);
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto garbage = *non_code_garbage();
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto packet = encode(m, profile);
-    stream.insert(stream.end(), packet.begin(), packet.end());
-  }
+  const Bytes stream = test::interleave(
+      packets_of(ms, profile), [] { return *non_code_garbage(); }, /*noise_first=*/true);
   const auto items =
       decode_chunked<Decoder, Item>(Decoder(DecoderOptions{profile}), stream, *test::gen_pieces());
   RC_ASSERT(messages_of(items) == ms);
@@ -111,15 +89,13 @@ RC_GTEST_PROP(Wr8Properties, GuiSideDecoderAlsoSkipsGuiPacketCodes,
   for (const auto& m : any) {
     if (sends(Sender::vehicle, static_cast<std::uint8_t>(code_of(m)))) ms.push_back(m);
   }
-  Bytes stream;
-  for (const auto& m : ms) {
-    const auto garbage = *rc::gen::container<Bytes>(
+  const auto gui_codes_and_garbage = [] {
+    return *rc::gen::container<Bytes>(
         rc::gen::oneOf(rc::gen::element<std::uint8_t>(1, 3),
                        rc::gen::inRange<std::uint8_t>(kPacketCodeCount, 255)));
-    stream.insert(stream.end(), garbage.begin(), garbage.end());
-    const auto packet = encode(m);
-    stream.insert(stream.end(), packet.begin(), packet.end());
-  }
+  };
+  const Bytes stream =
+      test::interleave(packets_of(ms), gui_codes_and_garbage, /*noise_first=*/true);
   DecoderOptions options;
   options.sender = Sender::vehicle;
   const auto items = decode_chunked<Decoder, Item>(Decoder(options), stream, *test::gen_pieces());

@@ -33,6 +33,17 @@ Auth auth_of(std::string_view text) {
   return a;
 }
 
+// A running car's report with odometry, speed, wheel angle and battery.
+Data all_four_parameters() {
+  return Data{State::run,
+              1500,
+              {{data_code::odometry, Word::from_i32(120)},
+               {data_code::speed, Word::from_f32(0.5f)},
+               {data_code::wheel_angle, Word::from_f32(-10.0f)},
+               {data_code::battery, Word{87}}},
+              {}};
+}
+
 struct Vector {
   const char* name;
   const char* packet;
@@ -83,13 +94,7 @@ std::vector<Vector> vectors() {
       {"response error", "05 07 00", Response{7, ResponseCode::error}, defaults, {}},
       {"data with all four parameters",
        "06 01 DC 05 00 00 11 00 78 00 00 00 01 00 00 00 3F 02 00 00 20 C1 03 57",
-       Data{State::run,
-            1500,
-            {{data_code::odometry, Word::from_i32(120)},
-             {data_code::speed, Word::from_f32(0.5f)},
-             {data_code::wheel_angle, Word::from_f32(-10.0f)},
-             {data_code::battery, Word{87}}},
-            {}},
+       all_four_parameters(),
        defaults,
        {}},
       {"data without parameters",
@@ -122,13 +127,7 @@ std::vector<Vector> vectors() {
        {}},
       {"entries data with all four parameters",
        "06 01 DC 05 00 00 04 00 78 00 00 00 01 00 00 00 3F 02 00 00 20 C1 03 57",
-       Data{State::run,
-            1500,
-            {{data_code::odometry, Word::from_i32(120)},
-             {data_code::speed, Word::from_f32(0.5f)},
-             {data_code::wheel_angle, Word::from_f32(-10.0f)},
-             {data_code::battery, Word{87}}},
-            {}},
+       all_four_parameters(),
        entries(),
        {}},
   };
