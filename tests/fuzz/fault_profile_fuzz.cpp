@@ -4,6 +4,7 @@
 // and validate() must agree on what a sound profile is).
 
 #include <stdexcept>
+#include "base/duration.hpp"
 #include "link/faults/profile_yaml.hpp"
 
 #include "tests/fuzz/loader_support.hpp"
@@ -20,6 +21,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   });
   // Durations come from the same files and from command lines.
-  if (size < 64) (void)hil::hil::parse_duration(text);
+  if (size < 64) (void)hil::parse_duration(text);
   return 0;
 }
