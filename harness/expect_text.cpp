@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "base/duration.hpp"
+#include "base/enum_names.hpp"
 #include "harness/expect_parts.hpp"
 
 namespace hil::harness::expect_parts {
@@ -36,28 +37,15 @@ std::string ordinal(int n) {
   return std::to_string(n) + suffix;
 }
 
+constexpr auto kFieldTestOpTexts = base::enum_names<FieldTest::Op>(
+    {FieldTest::Op::equals, "="}, {FieldTest::Op::not_equals, "!="},
+    {FieldTest::Op::kind_prefix, "starts with"}, {FieldTest::Op::contains, "contains"},
+    {FieldTest::Op::less, "<"}, {FieldTest::Op::less_equal, "<="}, {FieldTest::Op::greater, ">"},
+    {FieldTest::Op::greater_equal, ">="},
+    {FieldTest::Op::kind_either_prefix, "starts with, or is cut short of,"});
+
 std::string op_text(FieldTest::Op op) {
-  switch (op) {
-    case FieldTest::Op::equals:
-      return "=";
-    case FieldTest::Op::not_equals:
-      return "!=";
-    case FieldTest::Op::kind_prefix:
-      return "starts with";
-    case FieldTest::Op::contains:
-      return "contains";
-    case FieldTest::Op::less:
-      return "<";
-    case FieldTest::Op::less_equal:
-      return "<=";
-    case FieldTest::Op::greater:
-      return ">";
-    case FieldTest::Op::greater_equal:
-      return ">=";
-    case FieldTest::Op::kind_either_prefix:
-      return "starts with, or is cut short of,";
-  }
-  return "?";
+  return std::string(kFieldTestOpTexts.name(op));
 }
 
 std::string test_text(const FieldTest& test) {

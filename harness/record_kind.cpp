@@ -1,56 +1,53 @@
 #include "harness/record_kind.hpp"
 
-#include <array>
 #include <ostream>
+
+#include "base/enum_names.hpp"
 
 namespace hil::harness {
 namespace {
 
-constexpr std::array kSources = {"wire", "fault", "client", "sim", "step", "car"};
-constexpr std::array kWire = {"frame", "open", "close"};
-constexpr std::array kClient = {"connection", "command", "stale", "fresh",
-                                "notice",     "action",  "login", "parse_error",
-                                "movement",   "output",  "exit",  "start"};
-constexpr std::array kSim = {"sample", "station", "collision", "at_rest", "moving"};
-constexpr std::array kStep = {"start", "end"};
-constexpr std::array kCar = {"behaviour", "fault_state"};
-
-template <typename Names, typename E>
-std::string_view name_of(const Names& names, E e) {
-  const auto i = static_cast<std::size_t>(e);
-  return i < names.size() ? names[i] : "?";
-}
-
-template <typename E, typename Names>
-std::optional<E> find(const Names& names, std::string_view word) {
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (names[i] == word) return static_cast<E>(i);
-  }
-  return std::nullopt;
-}
+constexpr auto kSourceNames = base::enum_names<Source>(
+    {Source::wire, "wire"}, {Source::fault, "fault"}, {Source::client, "client"},
+    {Source::sim, "sim"}, {Source::step, "step"}, {Source::car, "car"});
+constexpr auto kWireKindNames = base::enum_names<WireKind>(
+    {WireKind::frame, "frame"}, {WireKind::open, "open"}, {WireKind::close, "close"});
+constexpr auto kClientKindNames = base::enum_names<ClientKind>(
+    {ClientKind::connection, "connection"}, {ClientKind::command, "command"},
+    {ClientKind::stale, "stale"}, {ClientKind::fresh, "fresh"}, {ClientKind::notice, "notice"},
+    {ClientKind::action, "action"}, {ClientKind::login, "login"},
+    {ClientKind::parse_error, "parse_error"}, {ClientKind::movement, "movement"},
+    {ClientKind::output, "output"}, {ClientKind::exit, "exit"}, {ClientKind::start, "start"});
+constexpr auto kSimKindNames = base::enum_names<SimKind>(
+    {SimKind::sample, "sample"}, {SimKind::station, "station"}, {SimKind::collision, "collision"},
+    {SimKind::at_rest, "at_rest"}, {SimKind::moving, "moving"});
+constexpr auto kStepKindNames =
+    base::enum_names<StepKind>({StepKind::start, "start"}, {StepKind::end, "end"});
+constexpr auto kCarEventKindNames = base::enum_names<CarEventKind>(
+    {CarEventKind::behaviour, "behaviour"}, {CarEventKind::fault_state, "fault_state"});
 
 }  // namespace
 
 std::string_view to_string(Source source) {
-  return name_of(kSources, source);
+  return kSourceNames.name(source);
 }
 std::optional<Source> parse_source(std::string_view text) {
-  return find<Source>(kSources, text);
+  return kSourceNames.parse(text);
 }
 std::string_view to_string(WireKind kind) {
-  return name_of(kWire, kind);
+  return kWireKindNames.name(kind);
 }
 std::string_view to_string(ClientKind kind) {
-  return name_of(kClient, kind);
+  return kClientKindNames.name(kind);
 }
 std::string_view to_string(SimKind kind) {
-  return name_of(kSim, kind);
+  return kSimKindNames.name(kind);
 }
 std::string_view to_string(StepKind kind) {
-  return name_of(kStep, kind);
+  return kStepKindNames.name(kind);
 }
 std::string_view to_string(CarEventKind kind) {
-  return name_of(kCar, kind);
+  return kCarEventKindNames.name(kind);
 }
 
 std::string_view RecordKind::name() const {
@@ -82,17 +79,17 @@ std::optional<RecordKind> parse_record_kind(Source source, std::string_view name
   };
   switch (source) {
     case Source::wire:
-      return of(find<WireKind>(kWire, name));
+      return of(kWireKindNames.parse(name));
     case Source::fault:
       return of(link::parse_fault_kind(name));
     case Source::client:
-      return of(find<ClientKind>(kClient, name));
+      return of(kClientKindNames.parse(name));
     case Source::sim:
-      return of(find<SimKind>(kSim, name));
+      return of(kSimKindNames.parse(name));
     case Source::step:
-      return of(find<StepKind>(kStep, name));
+      return of(kStepKindNames.parse(name));
     case Source::car:
-      return of(find<CarEventKind>(kCar, name));
+      return of(kCarEventKindNames.parse(name));
   }
   return std::nullopt;
 }

@@ -12,6 +12,8 @@
 #include <map>
 #include <sstream>
 
+#include "base/enum_names.hpp"
+
 namespace hil::harness {
 namespace {
 
@@ -283,16 +285,11 @@ void append_evidence(std::string& out, const std::vector<Record>& records) {
 
 }  // namespace
 
+constexpr auto kVerdictNames = base::enum_names<Verdict>(
+    {Verdict::pass, "PASS"}, {Verdict::fail, "FAIL"}, {Verdict::flaky, "FLAKY"});
+
 const char* to_string(Verdict verdict) {
-  switch (verdict) {
-    case Verdict::pass:
-      return "PASS";
-    case Verdict::fail:
-      return "FAIL";
-    case Verdict::flaky:
-      return "FLAKY";
-  }
-  return "?";
+  return kVerdictNames.name(verdict).data();  // every name is a literal, so it ends in a NUL
 }
 
 std::vector<ScenarioSummary> summarize(const std::vector<ReportEntry>& entries) {

@@ -1,10 +1,12 @@
 #include "harness/scenario_parts.hpp"
 
+#include "client/common/connection.hpp"
+#include "link/faults/profile.hpp"
+
 namespace hil::harness::scenario_parts {
 namespace {
 // "degraded" and "down" are the Arduino link's own states.
-const Keys kClientStates = {"connected",    "disconnected", "connecting", "authenticating",
-                            "reconnecting", "degraded",     "down"};
+const Keys kClientStates = client::kConnectionStateNames.names();
 
 /// Matchers of what the client, the simulation, the fault injector, the car and the steps report.
 class EventMatcherReader : public config::Reader {
@@ -214,14 +216,12 @@ class EventMatcherReader : public config::Reader {
 
   /// A fault rule's kind: drop, corrupt, ...
   RecordKind fault_kind(const YAML::Node& n, const std::string& where) const {
-    static const Keys kKinds = {"fragment",  "coalesce",   "corrupt", "drop",
-                                "duplicate", "garbage",    "delay",   "stall",
-                                "bandwidth", "disconnect", "reset",   "refuse"};
     const std::string word = scalar(n, where);
     const auto kind = link::parse_fault_kind(word);
     if (!kind) {
-      fail(n, where + ": unknown fault kind '" + word + "' (known: " + join(kKinds) + ")" +
-                  config::did_you_mean(word, kKinds));
+      fail(n, where + ": unknown fault kind '" + word +
+                  "' (known: " + link::kFaultKindNames.list() + ")" +
+                  config::did_you_mean(word, link::kFaultKindNames.names()));
     }
     return *kind;
   }

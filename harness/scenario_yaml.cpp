@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <utility>
 
+#include "base/enum_names.hpp"
 #include "harness/scenario_parts.hpp"
 #include "protocol/common/car_profile.hpp"
 
@@ -21,18 +22,12 @@ std::string trim(std::string_view text) {
   return std::string(text.substr(first, last - first + 1));
 }
 
+constexpr auto kCarTitles = base::enum_names<mocks::CarKind>(
+    {mocks::CarKind::logi, "LOGI"}, {mocks::CarKind::wr8, "WR8"},
+    {mocks::CarKind::arduino, "Arduino"}, {mocks::CarKind::leka, "Leka"});
+
 std::string car_title(mocks::CarKind car) {
-  switch (car) {
-    case mocks::CarKind::logi:
-      return "LOGI";
-    case mocks::CarKind::wr8:
-      return "WR8";
-    case mocks::CarKind::arduino:
-      return "Arduino";
-    case mocks::CarKind::leka:
-      return "Leka";
-  }
-  return "car";
+  return std::string(kCarTitles.name(car, "car"));
 }
 
 }  // namespace scenario_parts
@@ -97,9 +92,8 @@ class ScenarioReader : public config::Reader {
     const std::string car_text = scalar(car, "'car'");
     const auto kind = mocks::parse_car_kind(car_text);
     if (!kind) {
-      const Keys cars = {"logi", "wr8", "arduino", "leka"};
-      fail(car, "unknown car '" + car_text + "' (expected logi, wr8, arduino or leka)" +
-                    config::did_you_mean(car_text, cars));
+      fail(car, "unknown car '" + car_text + "' (expected " + mocks::kCarKindNames.list(" or ") +
+                    ")" + config::did_you_mean(car_text, mocks::kCarKindNames.names()));
     }
     scenario.car = facts_.car = *kind;
     if (auto n = root["profile"]) {

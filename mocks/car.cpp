@@ -1,5 +1,6 @@
 #include "mocks/car.hpp"
 
+#include "base/enum_names.hpp"
 #include "protocol/common/car_profile.hpp"
 
 #include <stdexcept>
@@ -9,25 +10,16 @@
 
 namespace hil::mocks {
 
+constexpr base::EnumNames<CarKind, 4> kCarKindNames =
+    base::enum_names<CarKind>({CarKind::logi, "logi"}, {CarKind::wr8, "wr8"},
+                              {CarKind::arduino, "arduino"}, {CarKind::leka, "leka"});
+
 std::string_view to_string(CarKind kind) {
-  switch (kind) {
-    case CarKind::logi:
-      return "logi";
-    case CarKind::wr8:
-      return "wr8";
-    case CarKind::arduino:
-      return "arduino";
-    case CarKind::leka:
-      return "leka";
-  }
-  return "?";
+  return kCarKindNames.name(kind);
 }
 
 std::optional<CarKind> parse_car_kind(std::string_view text) {
-  for (const auto kind : {CarKind::logi, CarKind::wr8, CarKind::arduino, CarKind::leka}) {
-    if (text == to_string(kind)) return kind;
-  }
-  return std::nullopt;
+  return kCarKindNames.parse(text);
 }
 
 sim::VehicleDef vehicle_preset(CarKind kind) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "base/enum_names.hpp"
 #include "link/endpoint.hpp"
 #include "mocks/arduino.hpp"
 #include "mocks/firmware.hpp"
@@ -26,6 +27,8 @@ enum class CarKind : std::uint8_t { logi, wr8, arduino, leka };
 /// "logi", "wr8", "arduino", "leka".
 std::string_view to_string(CarKind kind);
 std::optional<CarKind> parse_car_kind(std::string_view text);
+/// The same words, for listing the cars.
+extern const base::EnumNames<CarKind, 4> kCarKindNames;
 
 /// The car's vehicle preset (sim/presets.hpp).
 sim::VehicleDef vehicle_preset(CarKind kind);

@@ -74,10 +74,7 @@ std::string arena_symbol(const std::string& kind, Px c) {
 
 /// The symbol of a mark, of a vehicle's parts or of a vehicle ("vehicle:<index>").
 std::string run_symbol(const std::string& kind, Px c) {
-  if (kind == "collision") return mark_symbol(MarkKind::collision, c, kSymbol);
-  if (kind == "stop") return mark_symbol(MarkKind::stop, c, kSymbol);
-  if (kind == "station") return mark_symbol(MarkKind::station, c, kSymbol);
-  if (kind == "note") return mark_symbol(MarkKind::note, c, kSymbol);
+  if (const auto mark = parse_mark_kind(kind)) return mark_symbol(*mark, c, kSymbol);
   if (kind == "footprint") {
     const std::vector<Px> box = {
         {c.x - 11, c.y - 6}, {c.x + 5, c.y - 6}, {c.x + 5, c.y + 6}, {c.x - 11, c.y + 6}};

@@ -11,6 +11,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -101,6 +102,8 @@ std::vector<Px> arrow_polygon(Px from, Px to, double shaft_px, double head_len_p
 
 /// "collision", "stop", "station", "note".
 std::string_view kind_name(MarkKind kind);
+/// The kind `kind_name` names; nullopt for another word.
+std::optional<MarkKind> parse_mark_kind(std::string_view name);
 
 /// The symbol of a mark centred on `c`: a red cross for a collision whoever
 /// had it, `colour` (the vehicle's) for the rest.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "base/enum_names.hpp"
 #include "sim/svg_parts.hpp"
 
 namespace hil::sim::svg_parts {
@@ -86,18 +87,16 @@ std::vector<Px> arrow_polygon(Px from, Px to, double shaft_px, double head_len_p
           {from.x - nx * s, from.y - ny * s}};
 }
 
+constexpr auto kMarkKindNames =
+    base::enum_names<MarkKind>({MarkKind::collision, "collision"}, {MarkKind::stop, "stop"},
+                               {MarkKind::station, "station"}, {MarkKind::note, "note"});
+
 std::string_view kind_name(MarkKind kind) {
-  switch (kind) {
-    case MarkKind::collision:
-      return "collision";
-    case MarkKind::stop:
-      return "stop";
-    case MarkKind::station:
-      return "station";
-    case MarkKind::note:
-      return "note";
-  }
-  return "note";
+  return kMarkKindNames.name(kind, "note");
+}
+
+std::optional<MarkKind> parse_mark_kind(std::string_view name) {
+  return kMarkKindNames.parse(name);
 }
 
 std::string mark_symbol(MarkKind kind, Px c, std::string_view colour) {

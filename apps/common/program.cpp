@@ -1,5 +1,6 @@
 #include "apps/common/program.hpp"
 
+#include "base/enum_names.hpp"
 #include "protocol/common/car_profile.hpp"
 
 #include <CLI/CLI.hpp>
@@ -83,17 +84,12 @@ std::string seconds_stamp(link::Time at, int width) {
   return buf;
 }
 
+constexpr auto kStopSignalNames =
+    base::enum_names<int>({SIGINT, "SIGINT"}, {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"});
+
 std::string signal_name(int signal) {
-  switch (signal) {
-    case SIGINT:
-      return "SIGINT";
-    case SIGTERM:
-      return "SIGTERM";
-    case SIGHUP:
-      return "SIGHUP";
-    default:
-      return "signal " + std::to_string(signal);
-  }
+  if (const auto name = kStopSignalNames.find(signal)) return std::string(*name);
+  return "signal " + std::to_string(signal);
 }
 
 ProgramLoop::ProgramLoop(std::initializer_list<int> stop_signals) : signals_(io_) {

@@ -1,5 +1,7 @@
 #include "apps/logi-client/stdin_actions.hpp"
 
+#include <algorithm>
+#include <array>
 #include <deque>
 #include <memory>
 #include <ostream>
@@ -29,19 +31,12 @@ std::string one_line(std::string text) {
 
 std::optional<std::string> contract_event_line(const logi::Event& event) {
   if (const auto* c = std::get_if<logi::ConnectionEvent>(&event)) {
-    switch (c->state) {
-      case ConnectionState::disconnected:
-        return "event connection disconnected";
-      case ConnectionState::connecting:
-        return "event connection connecting";
-      case ConnectionState::connected:
-        return "event connection connected";
-      case ConnectionState::reconnecting:
-        return "event connection reconnecting";
-      default:  // authenticating, degraded, down: LOGI never reaches them
-        break;
-    }
-    return std::nullopt;
+    // LOGI never reaches authenticating, degraded or down.
+    constexpr std::array kLogiStates = {ConnectionState::disconnected, ConnectionState::connecting,
+                                        ConnectionState::connected, ConnectionState::reconnecting};
+    if (std::find(kLogiStates.begin(), kLogiStates.end(), c->state) == kLogiStates.end())
+      return std::nullopt;
+    return "event connection " + std::string(client::to_string(c->state));
   }
   if (const auto* c = std::get_if<logi::CommandEvent>(&event)) {
     return "event command " + proto::kind_of(c->command) + " " +

@@ -10,6 +10,7 @@
 #include <variant>
 
 #include "base/duration.hpp"
+#include "base/enum_names.hpp"
 #include "protocol/logi/codec.hpp"
 
 namespace hil::apps::logi_client {
@@ -32,38 +33,27 @@ std::string payload(const proto::Message& m) {
   return proto::payload_of(m);
 }
 
+// LOGI never reaches authenticating, degraded or down.
+constexpr auto kLogiConnectionTexts = base::enum_names<ConnectionState>(
+    {ConnectionState::disconnected, "Disconnected"}, {ConnectionState::connecting, "Connecting"},
+    {ConnectionState::connected, "Connected"},
+    {ConnectionState::reconnecting, "Connection lost, reconnecting"});
+
+constexpr auto kLogiRefusalShortTexts = base::enum_names<logi::Refusal>(
+    {logi::Refusal::none, ""}, {logi::Refusal::not_connected, "not connected"},
+    {logi::Refusal::mode_speed_unconfirmed, "needs MD (m) + SP (Enter) on this connection"},
+    {logi::Refusal::not_held, "no direction held"},
+    {logi::Refusal::unknown_request, "nothing awaits confirmation"},
+    {logi::Refusal::not_a_command, "not a command"});
+
 std::string connection_text(ConnectionState s, int attempt) {
-  switch (s) {
-    case ConnectionState::disconnected:
-      return "Disconnected";
-    case ConnectionState::connecting:
-      return attempt > 0 ? "Connecting (attempt " + std::to_string(attempt) + ")" : "Connecting";
-    case ConnectionState::connected:
-      return "Connected";
-    case ConnectionState::reconnecting:
-      return "Connection lost, reconnecting";
-    default:  // authenticating, degraded, down: LOGI never reaches them
-      break;
-  }
-  return "?";
+  if (s == ConnectionState::connecting && attempt > 0)
+    return "Connecting (attempt " + std::to_string(attempt) + ")";
+  return std::string(kLogiConnectionTexts.name(s));
 }
 
 std::string refusal_text(logi::Refusal r) {
-  switch (r) {
-    case logi::Refusal::none:
-      return "";
-    case logi::Refusal::not_connected:
-      return "not connected";
-    case logi::Refusal::mode_speed_unconfirmed:
-      return "needs MD (m) + SP (Enter) on this connection";
-    case logi::Refusal::not_held:
-      return "no direction held";
-    case logi::Refusal::unknown_request:
-      return "nothing awaits confirmation";
-    case logi::Refusal::not_a_command:
-      return "not a command";
-  }
-  return "?";
+  return std::string(kLogiRefusalShortTexts.name(r));
 }
 
 std::string track_text(std::uint8_t mask) {

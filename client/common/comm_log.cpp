@@ -4,6 +4,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "base/enum_names.hpp"
+
 namespace hil::client {
 
 LogFormat log_format_for(std::string_view path) {
@@ -28,18 +30,12 @@ std::string csv_field(std::string_view text) {
   return out + "\"";
 }
 
+constexpr auto kLogKindNames =
+    base::enum_names<LogKind>({LogKind::tx, "TX"}, {LogKind::rx, "RX"},
+                              {LogKind::parse_error, "ERR"}, {LogKind::note, "NOTE"});
+
 std::string_view to_string(LogKind kind) {
-  switch (kind) {
-    case LogKind::tx:
-      return "TX";
-    case LogKind::rx:
-      return "RX";
-    case LogKind::parse_error:
-      return "ERR";
-    case LogKind::note:
-      return "NOTE";
-  }
-  return "?";
+  return kLogKindNames.name(kind);
 }
 
 namespace {

@@ -7,24 +7,17 @@
 
 namespace hil::client {
 
+// In the order the scenario language lists them.
+constexpr base::EnumNames<ConnectionState, 7> kConnectionStateNames =
+    base::enum_names<ConnectionState>(
+        {ConnectionState::connected, "connected"}, {ConnectionState::disconnected, "disconnected"},
+        {ConnectionState::connecting, "connecting"},
+        {ConnectionState::authenticating, "authenticating"},
+        {ConnectionState::reconnecting, "reconnecting"}, {ConnectionState::degraded, "degraded"},
+        {ConnectionState::down, "down"});
+
 std::string_view to_string(ConnectionState s) {
-  switch (s) {
-    case ConnectionState::disconnected:
-      return "disconnected";
-    case ConnectionState::connecting:
-      return "connecting";
-    case ConnectionState::authenticating:
-      return "authenticating";
-    case ConnectionState::connected:
-      return "connected";
-    case ConnectionState::degraded:
-      return "degraded";
-    case ConnectionState::reconnecting:
-      return "reconnecting";
-    case ConnectionState::down:
-      return "down";
-  }
-  return "?";
+  return kConnectionStateNames.name(s);
 }
 
 Backoff Backoff::ladder(std::vector<link::Duration> delays) {

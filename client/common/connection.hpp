@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/enum_names.hpp"
 #include "link/time.hpp"
 
 namespace hil::client {
@@ -30,6 +31,8 @@ enum class ConnectionState : std::uint8_t {
 /// "disconnected", "connecting", "authenticating", "connected", "degraded",
 /// "reconnecting", "down": the words a run's timeline records.
 std::string_view to_string(ConnectionState s);
+/// The same words, for reading a state back and listing the states.
+extern const base::EnumNames<ConnectionState, 7> kConnectionStateNames;
 
 /// The connection changed state (LOGI and WR8 report it as an event).
 struct ConnectionEvent {

@@ -1,16 +1,31 @@
 #include "link/faults/profile.hpp"
 
-#include <array>
 #include <stdexcept>
 #include <type_traits>
 
+#include "base/enum_names.hpp"
+
 namespace hil::link {
+
+constexpr base::EnumNames<FaultKind, 12> kFaultKindNames = base::enum_names<FaultKind>(
+    {FaultKind::fragment, "fragment"}, {FaultKind::coalesce, "coalesce"},
+    {FaultKind::corrupt, "corrupt"}, {FaultKind::drop, "drop"}, {FaultKind::duplicate, "duplicate"},
+    {FaultKind::garbage, "garbage"}, {FaultKind::delay, "delay"}, {FaultKind::stall, "stall"},
+    {FaultKind::bandwidth, "bandwidth"}, {FaultKind::disconnect, "disconnect"},
+    {FaultKind::reset, "reset"}, {FaultKind::refuse, "refuse"});
+
+constexpr base::EnumNames<DirectionFilter, 3> kDirectionFilterNames =
+    base::enum_names<DirectionFilter>({DirectionFilter::to_car, "to_car"},
+                                      {DirectionFilter::to_client, "to_client"},
+                                      {DirectionFilter::both, "both"});
+
+constexpr base::EnumNames<CorruptTarget, 3> kCorruptTargetNames = base::enum_names<CorruptTarget>(
+    {CorruptTarget::checksum, "checksum"}, {CorruptTarget::field, "field"},
+    {CorruptTarget::random, "random"});
+
 namespace {
 
-constexpr std::array<std::string_view, 12> kKindNames = {
-    "fragment", "coalesce", "corrupt",   "drop",       "duplicate", "garbage",
-    "delay",    "stall",    "bandwidth", "disconnect", "reset",     "refuse"};
-static_assert(kKindNames.size() == std::variant_size_v<FaultAction>);
+static_assert(kFaultKindNames.size() == std::variant_size_v<FaultAction>);
 
 bool frame_kind(FaultKind k) {
   switch (k) {
@@ -41,15 +56,7 @@ std::string_view to_string(Direction d) {
 }
 
 std::string_view to_string(DirectionFilter d) {
-  switch (d) {
-    case DirectionFilter::to_car:
-      return "to_car";
-    case DirectionFilter::to_client:
-      return "to_client";
-    case DirectionFilter::both:
-      break;
-  }
-  return "both";
+  return kDirectionFilterNames.name(d, "both");
 }
 
 bool applies_to(DirectionFilter filter, Direction d) {
@@ -58,26 +65,15 @@ bool applies_to(DirectionFilter filter, Direction d) {
 }
 
 std::string_view to_string(CorruptTarget t) {
-  switch (t) {
-    case CorruptTarget::checksum:
-      return "checksum";
-    case CorruptTarget::field:
-      return "field";
-    case CorruptTarget::random:
-      break;
-  }
-  return "random";
+  return kCorruptTargetNames.name(t, "random");
 }
 
 std::string_view to_string(FaultKind k) {
-  return kKindNames[static_cast<std::size_t>(k)];
+  return kFaultKindNames.name(k);
 }
 
 std::optional<FaultKind> parse_fault_kind(std::string_view text) {
-  for (std::size_t i = 0; i < kKindNames.size(); ++i) {
-    if (kKindNames[i] == text) return static_cast<FaultKind>(i);
-  }
-  return std::nullopt;
+  return kFaultKindNames.parse(text);
 }
 
 FaultKind kind_of(const FaultAction& action) {

@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "base/enum_names.hpp"
 #include "link/time.hpp"
 #include "protocol/common/bytes.hpp"
 
@@ -22,6 +23,8 @@ std::string_view to_string(Direction d);  ///< "to_car" or "to_client"
 /// The directions a rule applies to.
 enum class DirectionFilter : std::uint8_t { both, to_car, to_client };
 std::string_view to_string(DirectionFilter d);
+/// "to_car", "to_client", "both": the words of a rule's 'direction'.
+extern const base::EnumNames<DirectionFilter, 3> kDirectionFilterNames;
 bool applies_to(DirectionFilter filter, Direction d);
 
 /// Inclusive [min, max] range of byte counts.
@@ -63,6 +66,8 @@ enum class CorruptTarget : std::uint8_t {
   random,    ///< `bits` random bits anywhere in the frame
 };
 std::string_view to_string(CorruptTarget t);
+/// "checksum", "field", "random": the words of a corrupt rule's 'target'.
+extern const base::EnumNames<CorruptTarget, 3> kCorruptTargetNames;
 
 /// Changes `bits` positions of the target (distinct bytes for checksum and
 /// field, distinct bits for random). Text stays text: a hex digit becomes
@@ -155,6 +160,8 @@ enum class FaultKind : std::uint8_t {
 };
 std::string_view to_string(FaultKind k);  ///< "fragment", "coalesce", ...
 std::optional<FaultKind> parse_fault_kind(std::string_view text);
+/// The same words, in FaultKind order, for listing the kinds.
+extern const base::EnumNames<FaultKind, 12> kFaultKindNames;
 FaultKind kind_of(const FaultAction& action);
 
 /// Which frames a rule acts on (or, with `at`, when it fires). Every

@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
@@ -225,18 +226,12 @@ std::optional<Reply> readme_reply(const Body& request, std::string_view info) {
 
 }  // namespace
 
+constexpr auto kMotionKindNames =
+    base::enum_names<MotionKind>({MotionKind::idle, "idle"}, {MotionKind::move, "move"},
+                                 {MotionKind::rotate, "rotate"}, {MotionKind::fault, "fault"});
+
 std::string_view to_string(MotionKind kind) {
-  switch (kind) {
-    case MotionKind::idle:
-      return "idle";
-    case MotionKind::move:
-      return "move";
-    case MotionKind::rotate:
-      return "rotate";
-    case MotionKind::fault:
-      return "fault";
-  }
-  return "?";
+  return kMotionKindNames.name(kind);
 }
 
 std::optional<Reply> parse_reply(Dialect dialect, const Body& request, std::string_view info) {

@@ -1,27 +1,17 @@
 #include "protocol/common/decode.hpp"
 
+#include "base/enum_names.hpp"
+
 namespace hil::protocol {
 
+constexpr auto kErrorKindNames = base::enum_names<ErrorKind>(
+    {ErrorKind::garbage, "garbage"}, {ErrorKind::bad_checksum, "bad_checksum"},
+    {ErrorKind::lowercase_checksum, "lowercase_checksum"}, {ErrorKind::bad_format, "bad_format"},
+    {ErrorKind::bad_value, "bad_value"}, {ErrorKind::oversized, "oversized"},
+    {ErrorKind::unknown_code, "unknown_code"}, {ErrorKind::truncated, "truncated"});
+
 std::string_view to_string(ErrorKind kind) {
-  switch (kind) {
-    case ErrorKind::garbage:
-      return "garbage";
-    case ErrorKind::bad_checksum:
-      return "bad_checksum";
-    case ErrorKind::lowercase_checksum:
-      return "lowercase_checksum";
-    case ErrorKind::bad_format:
-      return "bad_format";
-    case ErrorKind::bad_value:
-      return "bad_value";
-    case ErrorKind::oversized:
-      return "oversized";
-    case ErrorKind::unknown_code:
-      return "unknown_code";
-    case ErrorKind::truncated:
-      return "truncated";
-  }
-  return "unknown";
+  return kErrorKindNames.name(kind, "unknown");
 }
 
 SequenceMatcher::SequenceMatcher(std::string_view sequence)

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/car_profile.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/wr8/length_prefix.hpp"
@@ -163,31 +164,17 @@ const std::array<std::string_view, 12> kSetNames = {
     "steering-p", "steering-i",  "steering-d", "steering-zero", "forward-p",  "forward-i",
     "forward-d",  "forward-int", "backward-p", "backward-i",    "backward-d", "backward-int"};
 
+constexpr auto kSvgui2019PacketNames =
+    base::enum_names<std::uint8_t>({kAuth, "AUTH"}, {kAuthReply, "AUTH-REPLY"}, {kTask, "TASK"},
+                                   {kSet, "SETTINGS"}, {kAnswer, "ANSWER"}, {kSix, "DATA"});
+constexpr auto kSvguiHeadPacketNames = base::enum_names<std::uint8_t>(
+    {kAuth, "AUTH"}, {kAuthReply, "AUTH-REPLY"}, {kSet, "SET"}, {kAnswer, "ANSWER"},
+    {kSix, "SET-REQUEST"}, {kMap, "MAP"}, {kLowFreq, "LOW-FREQ-DATA"},
+    {kHighFreq, "HIGH-FREQ-DATA"}, {kControl, "CONTROL"});
+
 std::string_view packet_name(std::uint8_t code, Version version) {
-  switch (code) {
-    case kAuth:
-      return "AUTH";
-    case kAuthReply:
-      return "AUTH-REPLY";
-    case kTask:
-      return version == Version::v2019 ? "TASK" : "";
-    case kSet:
-      return version == Version::v2019 ? "SETTINGS" : "SET";
-    case kAnswer:
-      return "ANSWER";
-    case kSix:
-      return version == Version::v2019 ? "DATA" : "SET-REQUEST";
-    case kMap:
-      return version == Version::head ? "MAP" : "";
-    case kLowFreq:
-      return version == Version::head ? "LOW-FREQ-DATA" : "";
-    case kHighFreq:
-      return version == Version::head ? "HIGH-FREQ-DATA" : "";
-    case kControl:
-      return version == Version::head ? "CONTROL" : "";
-    default:
-      return "";
-  }
+  if (version == Version::v2019) return kSvgui2019PacketNames.name(code, "");
+  return kSvguiHeadPacketNames.name(code, "");
 }
 
 std::string kind_name(std::uint8_t code, Version version) {
