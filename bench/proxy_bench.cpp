@@ -19,7 +19,9 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <future>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -33,77 +35,94 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace hil::link;
 
-// A car on its own thread: echoes every byte, or counts and discards them.
-class Car {
+// What a server started on a ServingThread listens on, and what keeps it
+// serving.
+struct Served {
+  std::string address;
+  std::shared_ptr<void> server;
+};
+
+// An io_context run on a thread of its own until the object is gone:
+// `serve` starts a server there, and it serves until then.
+class ServingThread {
  public:
-  explicit Car(bool echo) : echo_(echo) {
+  explicit ServingThread(const std::function<Served(TransportContext&)>& serve) {
     std::promise<std::string> address;
-    thread_ = std::thread([this, &address] {
+    thread_ = std::thread([this, &serve, &address] {
       AsioExecutor executor(io_);
       TransportContext ctx{executor, &io_};
-      auto listener = listen(ctx, parse_endpoint("tcp://127.0.0.1:0"));
-      listener->start([this](BytePipePtr p) {
-        pipes_.push_back(p);
-        std::weak_ptr<BytePipe> weak = p;
-        p->start({[this, weak](ByteView b) {
-                    received_ += b.size();
-                    if (echo_)
-                      if (auto self = weak.lock()) self->write(b);
-                  },
-                  [](std::error_code) {}});
-      });
-      address.set_value(listener->address());
+      const Served served = serve(ctx);
+      address.set_value(served.address);
       auto guard = asio::make_work_guard(io_);
       io_.run();
     });
     address_ = address.get_future().get();
   }
-  ~Car() {
+  ~ServingThread() {
     io_.stop();
     thread_.join();
   }
   const std::string& address() const { return address_; }
-  std::uint64_t received() const { return received_; }
 
  private:
-  bool echo_;
   asio::io_context io_;
   std::thread thread_;
   std::string address_;
-  std::vector<BytePipePtr> pipes_;
+};
+
+// A car on its own thread: echoes every byte, or counts and discards them.
+class Car {
+ public:
+  explicit Car(bool echo)
+      : echo_(echo), thread_([this](TransportContext& ctx) { return serve(ctx); }) {}
+  const std::string& address() const { return thread_.address(); }
+  std::uint64_t received() const { return received_; }
+
+ private:
+  // The accepted connections, then the listener: both live on the car's thread.
+  struct Server {
+    std::vector<BytePipePtr> pipes;
+    std::unique_ptr<Listener> listener;
+  };
+
+  Served serve(TransportContext& ctx) {
+    auto server = std::make_shared<Server>();
+    server->listener = listen(ctx, parse_endpoint("tcp://127.0.0.1:0"));
+    server->listener->start([this, pipes = &server->pipes](BytePipePtr p) {
+      pipes->push_back(p);
+      std::weak_ptr<BytePipe> weak = p;
+      p->start({[this, weak](ByteView b) {
+                  received_ += b.size();
+                  if (echo_)
+                    if (auto self = weak.lock()) self->write(b);
+                },
+                [](std::error_code) {}});
+    });
+    return Served{server->listener->address(), server};
+  }
+
+  bool echo_;
   std::atomic<std::uint64_t> received_{0};
+  ServingThread thread_;  // last: it serves with the members above
 };
 
 // The proxy on its own thread.
 class ProxyThread {
  public:
-  ProxyThread(const std::string& upstream, const std::string& protocol) {
-    std::promise<std::string> address;
-    thread_ = std::thread([&] {
-      AsioExecutor executor(io_);
-      TransportContext ctx{executor, &io_};
-      ProxyOptions o;
-      o.listen = parse_endpoint("tcp://127.0.0.1:0");
-      o.upstream = parse_endpoint(upstream);
-      o.protocol = protocol_adapter(protocol);
-      Proxy proxy(ctx, o);
-      proxy.start();
-      address.set_value(proxy.address());
-      auto guard = asio::make_work_guard(io_);
-      io_.run();
-    });
-    address_ = address.get_future().get();
-  }
-  ~ProxyThread() {
-    io_.stop();
-    thread_.join();
-  }
-  const std::string& address() const { return address_; }
+  ProxyThread(const std::string& upstream, const std::string& protocol)
+      : thread_([&](TransportContext& ctx) {
+          ProxyOptions o;
+          o.listen = parse_endpoint("tcp://127.0.0.1:0");
+          o.upstream = parse_endpoint(upstream);
+          o.protocol = protocol_adapter(protocol);
+          auto proxy = std::make_shared<Proxy>(ctx, o);
+          proxy->start();
+          return Served{proxy->address(), proxy};
+        }) {}
+  const std::string& address() const { return thread_.address(); }
 
  private:
-  asio::io_context io_;
-  std::thread thread_;
-  std::string address_;
+  ServingThread thread_;
 };
 
 int connect_to(const std::string& uri) {

@@ -261,4 +261,42 @@ double Reader::metres(const YAML::Node& n, const std::string& what) const {
   return value * scale;
 }
 
+YAML::Node ItemReader::leading(const char* key) const {
+  if (!node_.IsMap()) bad(node_, "must be a map with at least '" + std::string(key) + "'");
+  const YAML::Node n = node_[key];
+  if (!n) bad(node_, "'" + std::string(key) + "' is missing");
+  return n;
+}
+
+std::optional<YAML::Node> ItemReader::get(const char* key) const {
+  YAML::Node n = node_[key];
+  if (!n) return std::nullopt;
+  return n;
+}
+
+void ItemReader::bad(const YAML::Node& n, const std::string& what) const {
+  fail_at(source_, n.Mark(), prefix_ + ": " + what);
+}
+
+std::string ItemReader::scalar(const YAML::Node& n, const char* key) const {
+  if (!n.IsScalar()) bad(n, "'" + std::string(key) + "' must be a single value");
+  return n.Scalar();
+}
+
+std::uint64_t ItemReader::count(const YAML::Node& n, const char* key, std::uint64_t min) const {
+  const auto v = parse_whole(scalar(n, key));
+  if (!v || *v < min)
+    bad(n, "'" + std::string(key) + "' must be a whole number >= " + std::to_string(min));
+  return *v;
+}
+
+std::chrono::nanoseconds ItemReader::duration(const YAML::Node& n, const char* key) const {
+  const auto d = parse_duration(scalar(n, key));
+  if (!d) {
+    bad(n, "'" + std::string(key) +
+               "' must be a duration with a unit, like 250ms or 1.5s (units: ns, us, ms, s)");
+  }
+  return *d;
+}
+
 }  // namespace hil::config

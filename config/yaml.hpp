@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "config/error.hpp"
@@ -82,6 +83,18 @@ class Reader {
   /// map[key], or a failure "WHERE: 'key' is missing" at the map.
   YAML::Node required(const YAML::Node& map, const std::string& key,
                       const std::string& where) const;
+  /// Which of `keys` `map` has, "" for none; a second one fails at itself
+  /// with clash(first, second) as the message.
+  template <class Clash>
+  std::string one_key(const YAML::Node& map, const Keys& keys, Clash clash) const {
+    std::string found;
+    for (const auto& k : keys) {
+      if (!map[k]) continue;
+      if (!found.empty()) fail(map[k], clash(found, k));
+      found = k;
+    }
+    return found;
+  }
 
   /// The scalar's own text (an unquoted 001 stays "001").
   std::string scalar(const YAML::Node& n, const std::string& what) const;
@@ -99,6 +112,46 @@ class Reader {
 
  private:
   std::string file_;
+};
+
+/// One map of a file's list being read (a fault rule, a behaviour): the
+/// values such an item is made of, every failure "PREFIX: what" at the node
+/// it is about, the prefix naming the item ("rule 3 (drop)").
+class ItemReader {
+ protected:
+  /// `keys_label` introduces the allowed keys when one is unknown ("this
+  /// kind takes"). `file` and `node` must outlive the reader.
+  ItemReader(const std::string& file, const YAML::Node& node, std::string prefix,
+             std::string keys_label)
+      : source_(file),
+        node_(node),
+        prefix_(std::move(prefix)),
+        keys_label_(std::move(keys_label)) {}
+
+  /// The value of the key that says what the item is ('kind', 'do'): the
+  /// item must be a map that has it.
+  YAML::Node leading(const char* key) const;
+  /// The item's value at `key`, or nullopt when it has none.
+  std::optional<YAML::Node> get(const char* key) const;
+  /// Every key of the item is one of `allowed` (any range of words), given once.
+  template <class Words>
+  void check_keys(const Words& allowed) const {
+    Reader(source_).check_keys(node_, Keys(allowed.begin(), allowed.end()), prefix_, keys_label_);
+  }
+  [[noreturn]] void bad(const YAML::Node& n, const std::string& what) const;
+  /// The text of `n`, which must be a single value.
+  std::string scalar(const YAML::Node& n, const char* key) const;
+  /// A whole number of at least `min`.
+  std::uint64_t count(const YAML::Node& n, const char* key, std::uint64_t min = 1) const;
+  /// A duration with a unit (250ms, 1.5s).
+  std::chrono::nanoseconds duration(const YAML::Node& n, const char* key) const;
+
+  const std::string& source_;
+  const YAML::Node& node_;
+  std::string prefix_;
+
+ private:
+  std::string keys_label_;
 };
 
 }  // namespace hil::config

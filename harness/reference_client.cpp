@@ -58,17 +58,41 @@ void later(link::Executor& executor, std::shared_ptr<bool> alive, std::function<
   });
 }
 
+// What every car's reference session keeps: the executor, the timeline it
+// records to, and the flag that drops what is still due once it is gone.
+class RecordingSession : public ReferenceSession {
+ public:
+  ~RecordingSession() override { *alive_ = false; }
+
+ protected:
+  RecordingSession(link::Executor& executor, RunTimeline& timeline)
+      : executor_(executor), timeline_(timeline) {}
+
+  /// Tells `done` how its action ended, on a later turn (later()).
+  void done_later(const Done& done, bool ok, std::string reason) {
+    later(executor_, alive_, [done, ok, reason = std::move(reason)] { done(ok, reason); });
+  }
+  /// Stamps the log of `session` (a serial client's) with the run's time
+  /// in microseconds instead of the wall clock's.
+  template <class Session>
+  void log_in_run_time(Session& session) {
+    session.set_wall_clock([this] { return executor_.now().count() / 1000; });
+  }
+
+  link::Executor& executor_;
+  RunTimeline& timeline_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
 // ------------------------------------------------------------------ LOGI
 
-class LogiReference final : public ReferenceSession {
+class LogiReference final : public RecordingSession {
  public:
   LogiReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
                 client::logi::ClientConfig config)
-      : executor_(context.executor),
-        timeline_(timeline),
+      : RecordingSession(context.executor, timeline),
         session_(context, std::move(endpoint), std::move(config),
                  [this](Time now, const client::logi::Event& e) { on_event(now, e); }) {}
-  ~LogiReference() override { *alive_ = false; }
 
   void execute(const std::string& text, Done done) override {
     const auto parsed = client::logi::parse_operator_action(text);
@@ -77,7 +101,7 @@ class LogiReference final : public ReferenceSession {
                                   ? column_message(static_cast<std::size_t>(parsed.error->column),
                                                    parsed.error->message)
                                   : "no action";
-      later(executor_, alive_, [done, why] { done(false, why); });
+      done_later(done, false, why);
       return;
     }
     // Each action has a runner of its own, so a scheduled one (an
@@ -132,11 +156,8 @@ class LogiReference final : public ReferenceSession {
     actions_.on_event(now, event);
   }
 
-  link::Executor& executor_;
-  RunTimeline& timeline_;
   client::logi::LogiSession session_;
   client::logi::ActionHost actions_{session_, executor_};
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 // ------------------------------------------------------------------- WR8
@@ -180,22 +201,20 @@ struct ProgramWr8 {
 /// records whichever it speaks, its requests named as the operator types
 /// them.
 template <class Dialect>
-class Wr8Reference final : public ReferenceSession {
+class Wr8Reference final : public RecordingSession {
  public:
   Wr8Reference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
                typename Dialect::Config config, Dialect dialect = {})
-      : executor_(context.executor),
-        timeline_(timeline),
+      : RecordingSession(context.executor, timeline),
         dialect_(dialect),
         session_(context, std::move(endpoint), std::move(config),
                  [this](Time now, const typename Dialect::Event& e) { on_event(now, e); }),
         runner_(std::make_unique<Runner>(executor_, session_)) {}
-  ~Wr8Reference() override { *alive_ = false; }
 
   void execute(const std::string& text, Done done) override {
     auto parsed = dialect_.parse(text);
     if (const auto why = line_problem(parsed)) {
-      later(executor_, alive_, [done, why = *why] { done(false, why); });
+      done_later(done, false, *why);
       return;
     }
     retired_.clear();
@@ -203,9 +222,7 @@ class Wr8Reference final : public ReferenceSession {
     runner_->execute(std::move(*parsed.action),
                      [this, generation, done](const typename Runner::Result& r) {
                        if (generation != generation_) return;
-                       const bool ok = r.ok;
-                       const std::string reason = r.ok ? std::string() : r.detail;
-                       later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
+                       done_later(done, r.ok, r.ok ? std::string() : r.detail);
                      });
   }
 
@@ -258,44 +275,37 @@ class Wr8Reference final : public ReferenceSession {
     if (runner_) runner_->on_event(now, event);
   }
 
-  link::Executor& executor_;
-  RunTimeline& timeline_;
   Dialect dialect_;
   typename Dialect::Session session_;
   std::unique_ptr<Runner> runner_;
   std::vector<std::unique_ptr<Runner>> retired_;
   std::uint64_t generation_ = 0;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 // --------------------------------------------------------------- Arduino
 
-class ArduinoReference final : public ReferenceSession {
+class ArduinoReference final : public RecordingSession {
  public:
   ArduinoReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
                    client::arduino::ClientConfig config)
-      : executor_(context.executor),
-        timeline_(timeline),
+      : RecordingSession(context.executor, timeline),
         session_(context, std::move(endpoint), std::move(config)) {
-    session_.set_wall_clock([this] { return executor_.now().count() / 1000; });
+    log_in_run_time(session_);
     make_runner();
   }
-  ~ArduinoReference() override {
-    *alive_ = false;
-    runner_.reset();
-  }
+  ~ArduinoReference() override { runner_.reset(); }
 
   void start() override { session_.open(); }
 
   void execute(const std::string& text, Done done) override {
     auto parsed = client::arduino::parse_operator_line(text);
     if (const auto why = line_problem(parsed)) {
-      later(executor_, alive_, [done, why = *why] { done(false, why); });
+      done_later(done, false, *why);
       return;
     }
     // Quitting means nothing in a scenario: the run decides when it ends.
     if (std::holds_alternative<client::arduino::QuitCommand>(*parsed.action)) {
-      later(executor_, alive_, [done] { done(true, ""); });
+      done_later(done, true, "");
       return;
     }
     pending_[next_index_++] = std::move(done);
@@ -324,9 +334,7 @@ class ArduinoReference final : public ReferenceSession {
       if (it == pending_.end()) return;
       Done done = std::move(it->second);
       pending_.erase(it);
-      const bool ok = o.ok;
-      const std::string reason = o.ok ? std::string() : client::arduino::describe_outcome(o);
-      later(executor_, alive_, [done, ok, reason] { done(ok, reason); });
+      done_later(done, o.ok, o.ok ? std::string() : client::arduino::describe_outcome(o));
     });
   }
 
@@ -349,26 +357,22 @@ class ArduinoReference final : public ReferenceSession {
                event);
   }
 
-  link::Executor& executor_;
-  RunTimeline& timeline_;
   client::arduino::ArduinoSession session_;
   std::unique_ptr<client::arduino::OperatorRunner> runner_;
   std::map<std::size_t, Done> pending_;
   std::size_t next_index_ = 0;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 // ------------------------------------------------------------------ Leka
 
-class LekaReference final : public ReferenceSession {
+class LekaReference final : public RecordingSession {
  public:
   LekaReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
                 client::leka::ClientConfig config)
-      : executor_(context.executor),
-        timeline_(timeline),
+      : RecordingSession(context.executor, timeline),
         session_(context, std::move(endpoint), std::move(config)),
         runner_(executor_, session_) {
-    session_.set_wall_clock([this] { return executor_.now().count() / 1000; });
+    log_in_run_time(session_);
     // The port has no events of its own: look again whenever the wire opens
     // or closes, so the record comes at the moment it happened.
     listener_ = timeline_.listen([this](const Record& r) {
@@ -376,25 +380,21 @@ class LekaReference final : public ReferenceSession {
         later(executor_, alive_, [this] { poll(); });
     });
   }
-  ~LekaReference() override {
-    *alive_ = false;
-    timeline_.unlisten(listener_);
-  }
+  ~LekaReference() override { timeline_.unlisten(listener_); }
 
   void start() override { session_.open(); }
 
   void execute(const std::string& text, Done done) override {
     auto parsed = client::leka::parse_script(text, "scenario");
     if (const auto* e = std::get_if<client::leka::ScriptError>(&parsed)) {
-      const std::string why = column_message(e->column, e->message);
-      later(executor_, alive_, [done, why] { done(false, why); });
+      done_later(done, false, column_message(e->column, e->message));
       return;
     }
     if (!session_.is_open()) {
-      const std::string why =
+      done_later(
+          done, false,
           "the port is not open" +
-          (session_.open_error().empty() ? std::string() : ": " + session_.open_error());
-      later(executor_, alive_, [done, why] { done(false, why); });
+              (session_.open_error().empty() ? std::string() : ": " + session_.open_error()));
       return;
     }
     const std::uint64_t generation = ++generation_;
@@ -406,7 +406,7 @@ class LekaReference final : public ReferenceSession {
         },
         [this, generation, failure, done](bool ok) {
           if (generation != generation_) return;
-          later(executor_, alive_, [done, ok, failure] { done(ok, *failure); });
+          done_later(done, ok, *failure);
         });
   }
 
@@ -430,14 +430,11 @@ class LekaReference final : public ReferenceSession {
   }
 
  private:
-  link::Executor& executor_;
-  RunTimeline& timeline_;
   client::leka::LekaSession session_;
   client::leka::OperatorRunner runner_;
   client::ConnectionState state_ = client::ConnectionState::disconnected;
   std::uint64_t generation_ = 0;
   RunTimeline::ListenerId listener_ = 0;
-  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace

@@ -84,10 +84,12 @@ Option<Config> flag_option(std::string name, bool Config::*member, std::string w
           }};
 }
 
+// `reconnect_delays`, the same setting for every client that has it.
 template <class Config>
-Option<Config> delays_option(std::vector<Duration> Config::*member, std::string what) {
+Option<Config> delays_option(std::vector<Duration> Config::*member) {
   const std::string takes = "a list of durations above 0, like [1s, 2s, 3s]";
-  return {{"reconnect_delays", takes, std::move(what)},
+  return {{"reconnect_delays", takes,
+           "the waits before reconnect attempts 1, 2, 3, ...; the last repeats"},
           [member, takes](Config& c, const Json& v) -> std::optional<std::string> {
             const Json list = v.is_array() ? v : Json::array({v});
             std::vector<Duration> delays;
@@ -110,8 +112,7 @@ const std::vector<Option<client::logi::ClientConfig>>& logi_options() {
                       "how long a command waits for its FB before it times out"),
       count_option("max_retries", &C::max_retries, 0, 10,
                    "resends of SP, MD and MV:STOP after a timeout"),
-      delays_option(&C::reconnect_delays,
-                    "the waits before reconnect attempts 1, 2, 3, ...; the last repeats"),
+      delays_option(&C::reconnect_delays),
       duration_option("stale_after", &C::stale_after,
                       "how long without a STAT before the stale warning"),
       flag_option("keepalive", &C::keepalive, "repeat the held direction's MV while it is held"),
@@ -142,8 +143,7 @@ const std::vector<Option<client::wr8::ClientConfig>>& wr8_options() {
                       "how long a TASK or SETTINGS waits for its first answer"),
       duration_option("stale_after", &C::stale_after,
                       "how long without DATA before the live state is stale"),
-      delays_option(&C::reconnect_delays,
-                    "the waits before reconnect attempts 1, 2, 3, ...; the last repeats"),
+      delays_option(&C::reconnect_delays),
   };
   return options;
 }
@@ -161,8 +161,7 @@ const std::vector<Option<client::wr8::SvguiConfig>>& svgui_options() {
                       "the least time between two packets sent (0: send at once)", true),
       duration_option("control_period", &C::control_period,
                       "head: how often a held CONTROL is repeated"),
-      delays_option(&C::reconnect_delays,
-                    "the waits before reconnect attempts 1, 2, 3, ...; the last repeats"),
+      delays_option(&C::reconnect_delays),
   };
   return options;
 }

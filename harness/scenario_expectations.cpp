@@ -115,14 +115,10 @@ class ExpectationReader : public config::Reader {
   /// matcher map of `never: {...}` or `always: {...}`. Returns the key.
   std::string read_quantifier(const YAML::Node& n, const std::string& where, Expectation& e,
                               std::optional<YAML::Node>& nested) const {
-    std::string quantifier;
-    for (const auto& k : kQuantifierKeys) {
-      if (!n[k]) continue;
-      if (!quantifier.empty()) {
-        fail(n[k], where + ": '" + quantifier + "' and '" + k + "' do not go together");
-      }
-      quantifier = k;
-    }
+    const std::string quantifier =
+        one_key(n, kQuantifierKeys, [&](const std::string& first, const std::string& second) {
+          return where + ": '" + first + "' and '" + second + "' do not go together";
+        });
     // Assigning one YAML::Node to another rebinds the data both refer to,
     // so the nested matcher is kept apart instead.
     if (quantifier == "never") {

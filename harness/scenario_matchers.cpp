@@ -1,9 +1,20 @@
 #include "harness/scenario_parts.hpp"
 
+#include "base/enum_names.hpp"
 #include "protocol/wr8/profile.hpp"
 
 namespace hil::harness::scenario_parts {
 namespace {
+/// The tests a field's map may hold: `speed_cmps: {at_least: 20, below: 40}`.
+constexpr auto kFieldTestWords = base::enum_names<FieldTest::Op>(
+    {FieldTest::Op::not_equals, "not"}, {FieldTest::Op::contains, "contains"},
+    {FieldTest::Op::less, "below"}, {FieldTest::Op::greater, "above"},
+    {FieldTest::Op::greater_equal, "at_least"}, {FieldTest::Op::less_equal, "at_most"});
+/// How a matcher's text writes the comparisons among them.
+constexpr auto kFieldTestSymbols = base::enum_names<FieldTest::Op>(
+    {FieldTest::Op::less, " < "}, {FieldTest::Op::greater, " > "},
+    {FieldTest::Op::greater_equal, " >= "}, {FieldTest::Op::less_equal, " <= "});
+
 /// The names the cars' decoded messages give their fields (docs/scenarios.md,
 /// "The timeline"), to catch a misspelt one; a name far from all of them is
 /// let through, for a firmware's extra keys and a WR8 profile's own DATA.
@@ -50,14 +61,10 @@ class MatcherReader : public config::Reader {
 
   /// Reads the matcher keys of a map whose other keys were checked by the caller.
   Matcher matcher(const YAML::Node& n, const std::string& where) const {
-    std::string source;
-    for (const auto& k : kMatcherSources) {
-      if (!n[k]) continue;
-      if (!source.empty()) {
-        fail(n[k], where + ": one source per matcher ('" + source + "' and '" + k + "')");
-      }
-      source = k;
-    }
+    const std::string source =
+        one_key(n, kMatcherSources, [&](const std::string& first, const std::string& second) {
+          return where + ": one source per matcher ('" + first + "' and '" + second + "')";
+        });
     std::string shorthand;
     for (const auto& k : kWireDirections) {
       if (n[k]) {
@@ -215,7 +222,7 @@ class MatcherReader : public config::Reader {
     if (!n.IsMap() || n.size() == 0) {
       fail(n, where + " must be a map of field names to values, like {percent: 50}");
     }
-    static const Keys kOps = {"not", "contains", "below", "above", "at_least", "at_most"};
+    static const Keys kOps = kFieldTestWords.names();
     std::set<std::string> seen;
     std::string text;
     for (auto it : n) {
@@ -245,25 +252,16 @@ class MatcherReader : public config::Reader {
       for (auto op : v) {
         const std::string k = op.first.Scalar();
         const std::string what = where + ": '" + name + "': '" + k + "'";
-        if (k == "not") {
-          m.tests.push_back(
-              field_test(field, FieldTest::Op::not_equals, field_value(scalar(op.second, what))));
+        const FieldTest::Op op_of = *kFieldTestWords.parse(k);  // check_keys let only these in
+        if (op_of == FieldTest::Op::not_equals) {
+          m.tests.push_back(field_test(field, op_of, field_value(scalar(op.second, what))));
           text += " not " + op.second.Scalar();
-        } else if (k == "contains") {
-          m.tests.push_back(field_test(field, FieldTest::Op::contains, scalar(op.second, what)));
+        } else if (op_of == FieldTest::Op::contains) {
+          m.tests.push_back(field_test(field, op_of, scalar(op.second, what)));
           text += " containing '" + op.second.Scalar() + "'";
         } else {
-          const double limit = number(op.second, what);
-          const auto op_of = k == "below"      ? FieldTest::Op::less
-                             : k == "above"    ? FieldTest::Op::greater
-                             : k == "at_least" ? FieldTest::Op::greater_equal
-                                               : FieldTest::Op::less_equal;
-          m.tests.push_back(field_test(field, op_of, limit));
-          text += (k == "below"      ? " < "
-                   : k == "above"    ? " > "
-                   : k == "at_least" ? " >= "
-                                     : " <= ") +
-                  op.second.Scalar();
+          m.tests.push_back(field_test(field, op_of, number(op.second, what)));
+          text += std::string(kFieldTestSymbols.name(op_of)) + op.second.Scalar();
         }
       }
     }

@@ -100,14 +100,11 @@ class StepReader : public config::Reader {
     allowed.insert(allowed.end(), {"timeout", "expect"});
     allowed.insert(allowed.end(), extra_keys.begin(), extra_keys.end());
     check_keys(n, allowed, where);
-    std::string key;
-    for (const auto& k : kStepKeys) {
-      if (!n[k]) continue;
-      if (!key.empty()) {
-        fail(n[k], where + ": a step does one thing: '" + key + "' and '" + k + "' are two steps");
-      }
-      key = k;
-    }
+    const std::string key =
+        one_key(n, kStepKeys, [&](const std::string& first, const std::string& second) {
+          return where + ": a step does one thing: '" + first + "' and '" + second +
+                 "' are two steps";
+        });
     if (key.empty()) fail(n, where + ": a step needs one of " + join(kStepKeys));
     if (n["timeout"] && key != "wait_until") {
       fail(n["timeout"], where + ": 'timeout' belongs to wait_until");

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 #include <system_error>
+#include <utility>
 
 #include "protocol/common/bytes.hpp"
 
@@ -72,6 +73,33 @@ class BytePipe {
 };
 
 using BytePipePtr = std::shared_ptr<BytePipe>;
+
+/// What a pipe with a backlog of its own keeps for when_drained_to(): the
+/// level, and whom to tell once the backlog is down to it.
+class DrainWatch {
+ public:
+  /// Keeps `callback` for `level`, replacing a waiting one; when the
+  /// backlog, `queued`, is that low already, hands it to `post` instead.
+  template <class Post>
+  void watch(std::size_t level, std::size_t queued, std::function<void()> callback, Post post) {
+    if (queued <= level) {
+      post(std::move(callback));
+      return;
+    }
+    level_ = level;
+    callback_ = std::move(callback);
+  }
+  /// The backlog is `queued` now: a waiting callback runs, once, at its level.
+  void update(std::size_t queued) {
+    if (callback_ && queued <= level_) std::exchange(callback_, nullptr)();
+  }
+  /// The pipe is closed: a waiting callback never runs.
+  void cancel() { callback_ = nullptr; }
+
+ private:
+  std::size_t level_ = 0;
+  std::function<void()> callback_;
+};
 
 /// Accepts connections on an endpoint (a TCP port, a pty path, a mem name).
 class Listener {

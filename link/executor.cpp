@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace hil::link {
 
@@ -108,6 +109,28 @@ std::optional<Time> VirtualExecutor::next_due() const {
   drop_stale_top();
   if (heap_.empty()) return std::nullopt;
   return heap_.front().at;
+}
+
+WakeupTimer::WakeupTimer(Executor& executor, Executor::Task fire)
+    : executor_(executor), fire_(std::move(fire)) {}
+
+WakeupTimer::~WakeupTimer() {
+  *alive_ = false;
+  if (id_ != 0) executor_.cancel(id_);
+}
+
+void WakeupTimer::schedule(std::optional<Time> due) {
+  if (due == due_ && (id_ != 0 || !due)) return;
+  if (id_ != 0) executor_.cancel(id_);
+  id_ = 0;
+  due_ = due;
+  if (!due) return;
+  id_ = executor_.call_at(*due, [this, alive = alive_] {
+    if (!*alive) return;
+    id_ = 0;
+    due_.reset();
+    fire_();
+  });
 }
 
 }  // namespace hil::link

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -27,6 +28,29 @@ class Executor : public Clock {
   TimerId call_after(Duration delay, Task task) { return call_at(now() + delay, std::move(task)); }
   /// Runs `task` as soon as possible, after the task that is running now.
   TimerId post(Task task) { return call_at(now(), std::move(task)); }
+};
+
+/// One task kept due at a time that moves, such as a box's next wakeup:
+/// schedule() re-arms the executor only when the time changed, and the
+/// task never runs once the timer is gone.
+class WakeupTimer {
+ public:
+  /// `executor` must outlive the timer.
+  WakeupTimer(Executor& executor, Executor::Task fire);
+  ~WakeupTimer();
+  WakeupTimer(const WakeupTimer&) = delete;
+  WakeupTimer& operator=(const WakeupTimer&) = delete;
+
+  /// Runs the task at `due` instead of when it was due; nullopt: never.
+  /// Cheap to call after every input.
+  void schedule(std::optional<Time> due);
+
+ private:
+  Executor& executor_;
+  Executor::Task fire_;
+  Executor::TimerId id_ = 0;
+  std::optional<Time> due_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 /// The virtual-time driver's clock and event queue: time moves only when

@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "base/enum_names.hpp"
+
 namespace hil::link {
 namespace {
 
@@ -19,18 +21,12 @@ LinkClose::By side_of(Direction sender) {
 
 }  // namespace
 
+constexpr auto kLinkCloseByNames =
+    base::enum_names<LinkClose::By>({LinkClose::By::client, "client"}, {LinkClose::By::car, "car"},
+                                    {LinkClose::By::fault, "fault"}, {LinkClose::By::hil, "hil"});
+
 std::string_view to_string(LinkClose::By by) {
-  switch (by) {
-    case LinkClose::By::client:
-      return "client";
-    case LinkClose::By::car:
-      return "car";
-    case LinkClose::By::fault:
-      return "fault";
-    case LinkClose::By::hil:
-      return "hil";
-  }
-  return "hil";
+  return kLinkCloseByNames.name(by, "hil");
 }
 
 std::shared_ptr<Link> Link::create(Executor& executor, BytePipePtr client, BytePipePtr car,
@@ -206,6 +202,11 @@ bool Link::is_open() const {
 void Link::set_profile(Direction direction, FaultProfile profile) {
   injectors_[index(direction)]->set_profile(std::move(profile));
   pump(direction);
+}
+
+void Link::set_faults(const FaultProfile& profile) {
+  for (const auto d : {Direction::to_car, Direction::to_client})
+    set_profile(d, for_direction(profile, d));
 }
 
 LinkStats Link::stats() const {

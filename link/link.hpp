@@ -52,6 +52,12 @@ struct LinkOptions {
   FaultProfile to_client;                           ///< faults on bytes from the car to the client
   std::uint64_t seed = 0;  ///< each direction derives its own stream from it
   std::vector<std::shared_ptr<LinkObserver>> observers;
+
+  /// Gives each direction its rules of `profile` (for_direction()).
+  void set_faults(const FaultProfile& profile) {
+    to_car = for_direction(profile, Direction::to_car);
+    to_client = for_direction(profile, Direction::to_client);
+  }
 };
 
 struct LinkStats {
@@ -83,6 +89,8 @@ class Link : public std::enable_shared_from_this<Link> {
 
   /// Replaces one direction's fault rules while the link runs.
   void set_profile(Direction direction, FaultProfile profile);
+  /// Replaces both directions' rules with theirs of `profile` (for_direction()).
+  void set_faults(const FaultProfile& profile);
   LinkStats stats() const;
 
  private:

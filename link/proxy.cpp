@@ -125,8 +125,7 @@ void Proxy::join(BytePipePtr client, BytePipePtr car, std::size_t number) {
   car->set_send_limit(kMaxSendBacklogBytes);
   LinkOptions link_options;
   link_options.protocol = options_.protocol;
-  link_options.to_car = for_direction(options_.faults, Direction::to_car);
-  link_options.to_client = for_direction(options_.faults, Direction::to_client);
+  link_options.set_faults(options_.faults);
   link_options.seed = options_.seed + number - 1;
   if (options_.log)
     link_options.observers.push_back(std::make_shared<TerminalObserver>(id, options_.log));
@@ -167,9 +166,7 @@ void Proxy::set_faults(const FaultProfile& faults) {
   options_.faults = faults;
   gate_->set_profile(for_direction(faults, Direction::to_car));
   for (auto& link : links_) {
-    if (!link->is_open()) continue;
-    link->set_profile(Direction::to_car, for_direction(faults, Direction::to_car));
-    link->set_profile(Direction::to_client, for_direction(faults, Direction::to_client));
+    if (link->is_open()) link->set_faults(faults);
   }
 }
 

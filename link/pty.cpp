@@ -162,12 +162,8 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   }
   void when_drained_to(std::size_t bytes, std::function<void()> callback) override {
     if (state_ == State::closed || !callback) return;
-    if (queued_bytes() <= bytes) {
-      executor_.post(std::move(callback));
-      return;
-    }
-    drain_to_ = bytes;
-    on_drained_ = std::move(callback);
+    drain_.watch(bytes, queued_bytes(), std::move(callback),
+                 [this](std::function<void()> f) { executor_.post(std::move(f)); });
   }
 
   std::uint64_t bytes_lost() const { return lost_; }
@@ -283,7 +279,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
     }
     os_queued_ -= os_queue_.front().size();
     os_queue_.pop_front();
-    if (on_drained_ && queued_bytes() <= drain_to_) std::exchange(on_drained_, nullptr)();
+    drain_.update(queued_bytes());
     if (state_ != State::open && state_ != State::flushing) return;
     if (!os_queue_.empty()) {
       write_os();
@@ -300,7 +296,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
 
   /// Stops using the descriptor and hands it back to the owner.
   void end_session(bool client_gone) {
-    on_drained_ = nullptr;
+    drain_.cancel();
     tx_.clear();
     // Safe while a write is pending: cancel() runs on this thread, so no
     // more of that buffer is written once it returns.
@@ -345,8 +341,7 @@ class PtyPipe final : public BytePipe, public std::enable_shared_from_this<PtyPi
   std::deque<Bytes> os_queue_;
   std::size_t os_queued_ = 0;
   std::size_t send_limit_ = 0;  // 0: no cap
-  std::size_t drain_to_ = 0;    // when_drained_to(): the level, and whom to tell
-  std::function<void()> on_drained_;
+  DrainWatch drain_;            // when_drained_to()
   SerialPacer tx_;  // device -> client
   SerialPacer rx_;  // client -> device
 };

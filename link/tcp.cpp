@@ -91,12 +91,9 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   }
   void when_drained_to(std::size_t bytes, std::function<void()> callback) override {
     if (state_ == State::closed || !callback) return;
-    if (queued_ <= bytes) {
-      asio::post(socket_.get_executor(), std::move(callback));
-      return;
-    }
-    drain_to_ = bytes;
-    on_drained_ = std::move(callback);
+    drain_.watch(bytes, queued_, std::move(callback), [this](std::function<void()> f) {
+      asio::post(socket_.get_executor(), std::move(f));
+    });
   }
 
  private:
@@ -211,7 +208,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
       queued_ -= queue_.front().size();
       queue_.pop_front();
     }
-    if (on_drained_ && queued_ <= drain_to_) std::exchange(on_drained_, nullptr)();
+    drain_.update(queued_);
     if (state_ == State::closed) return;
     if (!queue_.empty()) {
       write_queued();
@@ -236,7 +233,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     state_ = State::closed;
     queue_.clear();
     queued_ = 0;
-    on_drained_ = nullptr;
+    drain_.cancel();
   }
 
   void notify_close(std::error_code ec) {
@@ -264,8 +261,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   std::size_t in_flight_ = 0;  // queue_ entries the current async_write covers
   std::size_t queued_ = 0;
   std::size_t send_limit_ = 0;  // 0: no cap
-  std::size_t drain_to_ = 0;    // when_drained_to(): the level, and whom to tell
-  std::function<void()> on_drained_;
+  DrainWatch drain_;            // when_drained_to()
 };
 
 tcp::endpoint resolve_for_listen(asio::io_context& io, const TcpEndpoint& endpoint,

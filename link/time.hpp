@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace hil::link {
@@ -23,6 +24,22 @@ inline double to_ms(Duration d) {
 
 /// "12.345 ms"-style text with three decimals.
 std::string format_ms(Duration d);
+
+/// The earliest of the times it is shown, for a box's next wakeup: none
+/// until it is shown one.
+class Earliest {
+ public:
+  void consider(Time t) {
+    if (!time_ || t < *time_) time_ = t;
+  }
+  void consider(const std::optional<Time>& t) {
+    if (t) consider(*t);
+  }
+  const std::optional<Time>& time() const { return time_; }
+
+ private:
+  std::optional<Time> time_;
+};
 
 /// Something that knows what time it is.
 class Clock {

@@ -6,6 +6,7 @@
 #include <utility>
 #include <variant>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/overloaded.hpp"
 
 namespace hil::mocks {
@@ -52,16 +53,12 @@ arduino::DecoderOptions decoder_options(const ArduinoConfig& config) {
                                  .accept_lowercase_checksum = config.accept_lowercase_checksum};
 }
 
+// An idle car reports no motion word.
+constexpr auto kArduinoMotionWords =
+    base::enum_names<ArduinoMotion>({ArduinoMotion::move, "M"}, {ArduinoMotion::rotate, "R"});
+
 std::string_view motion_word(ArduinoMotion motion) {
-  switch (motion) {
-    case ArduinoMotion::move:
-      return "M";
-    case ArduinoMotion::rotate:
-      return "R";
-    case ArduinoMotion::idle:
-      break;
-  }
-  return "";
+  return kArduinoMotionWords.name(motion, "");
 }
 
 }  // namespace
@@ -138,24 +135,19 @@ void ArduinoFirmware::on_bytes(Time now, ByteView bytes) {
 void ArduinoFirmware::handle_frame(Time now, const protocol::Frame<Message>& frame) {
   const Message& request = frame.message;
   const std::string kind(arduino::command_of(request.body));
-  switch (dispose(now, kind)) {
-    case Disposition::ignore:
-      break;
-    case Disposition::reject:
-      answer(Message{request.seq, arduino::nack_from_text(config_.reject_code)});
-      break;
-    case Disposition::handle:
-      if (config_.repeat_answer_for_repeated_request && !last_request_.empty() &&
-          frame.raw == last_request_) {
-        send(last_answer_);
-        state_.last_seq = request.seq;
-      } else {
-        answer(Message{request.seq, execute(now, request)});
-        last_request_ = frame.raw;
-      }
-      break;
-  }
-  frame_handled(now, kind);
+  take_command(
+      now, kind,
+      [&] {
+        if (config_.repeat_answer_for_repeated_request && !last_request_.empty() &&
+            frame.raw == last_request_) {
+          send(last_answer_);
+          state_.last_seq = request.seq;
+        } else {
+          answer(Message{request.seq, execute(now, request)});
+          last_request_ = frame.raw;
+        }
+      },
+      [&] { answer(Message{request.seq, arduino::nack_from_text(config_.reject_code)}); });
 }
 
 void ArduinoFirmware::handle_error(const protocol::DecodeError& error) {

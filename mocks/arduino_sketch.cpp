@@ -49,25 +49,20 @@ void ArduinoFirmware::handle_sketch_request(Time now, const Bytes& raw,
   // The sketch compares commands without regard to case; behaviours and
   // counters see the command in upper case, as the readme dialect does.
   const std::string kind = protocol::ascii_upper(request.cmd);
-  switch (dispose(now, kind)) {
-    case Disposition::ignore:
-      break;
-    case Disposition::reject:
-      sketch_answer(request.seq, false, config_.reject_code);
-      break;
-    case Disposition::handle:
-      if (config_.repeat_answer_for_repeated_request && !last_request_.empty() &&
-          raw == last_request_) {
-        send(last_answer_);
-        state_.last_seq = seq_value(request.seq);
-      } else {
-        const SketchReply reply = execute_sketch(now, kind, request.payload);
-        sketch_answer(request.seq, reply.ack, reply.text);
-        last_request_ = raw;
-      }
-      break;
-  }
-  frame_handled(now, kind);
+  take_command(
+      now, kind,
+      [&] {
+        if (config_.repeat_answer_for_repeated_request && !last_request_.empty() &&
+            raw == last_request_) {
+          send(last_answer_);
+          state_.last_seq = seq_value(request.seq);
+        } else {
+          const SketchReply reply = execute_sketch(now, kind, request.payload);
+          sketch_answer(request.seq, reply.ack, reply.text);
+          last_request_ = raw;
+        }
+      },
+      [&] { sketch_answer(request.seq, false, config_.reject_code); });
 }
 
 ArduinoFirmware::SketchReply ArduinoFirmware::execute_sketch(Time now, std::string_view command,

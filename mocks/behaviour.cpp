@@ -47,30 +47,12 @@ void Script::expire(Time now) {
   std::erase_if(ignores_, [now](const ActiveIgnore& i) { return i.until && now >= *i.until; });
 }
 
-std::vector<Behaviour> Script::take_due(Time now) {
-  expire(now);
-  std::vector<Behaviour> due;
-  for (auto it = waiting_.begin(); it != waiting_.end();) {
-    const When& w = it->behaviour.when;
-    const bool time_ok = !w.at || now >= *w.at;
-    if (time_ok && w.after_frame.empty()) {
-      activate(now, it->behaviour);
-      due.push_back(std::move(it->behaviour));
-      it = waiting_.erase(it);
-    } else {
-      ++it;
-    }
-  }
-  return due;
-}
-
-std::vector<Behaviour> Script::frame_handled(Time now, std::string_view kind) {
+template <class Ready>
+std::vector<Behaviour> Script::fire(Time now, Ready ready) {
   std::vector<Behaviour> fired;
   for (auto it = waiting_.begin(); it != waiting_.end();) {
     const When& w = it->behaviour.when;
-    const bool time_ok = !w.at || now >= *w.at;
-    if (!w.after_frame.empty() && time_ok && kind_matches(w.after_frame, kind) &&
-        ++it->frames_seen >= w.after_count) {
+    if ((!w.at || now >= *w.at) && ready(*it)) {
       activate(now, it->behaviour);
       fired.push_back(std::move(it->behaviour));
       it = waiting_.erase(it);
@@ -79,6 +61,19 @@ std::vector<Behaviour> Script::frame_handled(Time now, std::string_view kind) {
     }
   }
   return fired;
+}
+
+std::vector<Behaviour> Script::take_due(Time now) {
+  expire(now);
+  return fire(now, [](const Waiting& w) { return w.behaviour.when.after_frame.empty(); });
+}
+
+std::vector<Behaviour> Script::frame_handled(Time now, std::string_view kind) {
+  return fire(now, [kind](Waiting& w) {
+    const When& when = w.behaviour.when;
+    return !when.after_frame.empty() && kind_matches(when.after_frame, kind) &&
+           ++w.frames_seen >= when.after_count;
+  });
 }
 
 Disposition Script::dispose(Time now, std::string_view kind) {
@@ -97,17 +92,13 @@ Disposition Script::dispose(Time now, std::string_view kind) {
 }
 
 std::optional<Time> Script::next_due() const {
-  std::optional<Time> next;
-  const auto consider = [&next](Time t) {
-    if (!next || t < *next) next = t;
-  };
+  link::Earliest next;
   for (const auto& w : waiting_) {
-    if (w.behaviour.when.after_frame.empty()) consider(w.behaviour.when.at.value_or(Time{0}));
+    if (w.behaviour.when.after_frame.empty()) next.consider(w.behaviour.when.at.value_or(Time{0}));
   }
-  for (const auto& i : ignores_) {
-    if (i.until) consider(*i.until);
-  }
-  return next;
+  for (const auto& i : ignores_)
+    next.consider(i.until);
+  return next.time();
 }
 
 }  // namespace hil::mocks

@@ -135,6 +135,9 @@ class Script {
   };
   void activate(Time now, const Behaviour& b);
   void expire(Time now);
+  /// Activates and hands back, in order, the waiting behaviours `ready` says are due.
+  template <class Ready>
+  std::vector<Behaviour> fire(Time now, Ready ready);
 
   std::vector<Waiting> waiting_;
   std::vector<Reject> rejects_;

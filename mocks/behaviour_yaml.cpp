@@ -2,10 +2,9 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <charconv>
 #include <set>
 
-#include "base/duration.hpp"
+#include "base/enum_names.hpp"
 #include "config/yaml.hpp"
 #include "protocol/common/bytes.hpp"
 
@@ -23,6 +22,10 @@ std::string join(const Keys& keys) {
 
 const Keys kWhenKeys = {"do", "name", "at", "after", "after_count"};
 
+/// The words of a close behaviour's 'mode'.
+constexpr auto kCloseModeWords = base::enum_names<link::CloseMode>(
+    {link::CloseMode::graceful, "graceful"}, {link::CloseMode::reset, "reset"});
+
 Keys keys_of(std::string_view action) {
   Keys keys = kWhenKeys;
   if (action == "reject") keys.insert({"match", "times"});
@@ -33,15 +36,13 @@ Keys keys_of(std::string_view action) {
   return keys;
 }
 
-class BehaviourReader {
+class BehaviourReader : config::ItemReader {
  public:
   BehaviourReader(const std::string& source, const YAML::Node& node, std::size_t index)
-      : source_(source), node_(node), prefix_("behaviour " + std::to_string(index)) {}
+      : ItemReader(source, node, "behaviour " + std::to_string(index), "this action takes") {}
 
   Behaviour read() {
-    if (!node_.IsMap()) bad(node_, "must be a map with at least 'do'");
-    const YAML::Node action_node = node_["do"];
-    if (!action_node) bad(node_, "'do' is missing");
+    const YAML::Node action_node = leading("do");
     const std::string action = scalar(action_node, "do");
     static const Keys kActions = {"reject", "ignore",      "mute-telemetry", "send",
                                   "fault",  "clear-fault", "close"};
@@ -96,62 +97,14 @@ class BehaviourReader {
     } else {
       CloseConnection c;
       if (auto n = get("mode")) {
-        const std::string mode = scalar(*n, "mode");
-        if (mode == "graceful") {
-          c.mode = link::CloseMode::graceful;
-        } else if (mode == "reset") {
-          c.mode = link::CloseMode::reset;
-        } else {
-          bad(*n, "'mode' must be graceful or reset");
-        }
+        const auto mode = kCloseModeWords.parse(scalar(*n, "mode"));
+        if (!mode) bad(*n, "'mode' must be " + kCloseModeWords.list(" or "));
+        c.mode = *mode;
       }
       b.action = c;
     }
     return b;
   }
-
- private:
-  std::optional<YAML::Node> get(const char* key) const {
-    YAML::Node n = node_[key];
-    if (!n) return std::nullopt;
-    return n;
-  }
-
-  void check_keys(const Keys& allowed) {
-    config::Reader(source_).check_keys(node_, config::Keys(allowed.begin(), allowed.end()), prefix_,
-                                       "this action takes");
-  }
-
-  [[noreturn]] void bad(const YAML::Node& n, const std::string& what) {
-    fail_at(source_, n.Mark(), prefix_ + ": " + what);
-  }
-
-  std::string scalar(const YAML::Node& n, const char* key) {
-    if (!n.IsScalar()) bad(n, "'" + std::string(key) + "' must be a single value");
-    return n.Scalar();
-  }
-
-  std::uint64_t count(const YAML::Node& n, const char* key) {
-    const std::string text = scalar(n, key);
-    std::uint64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc{} || ptr != text.data() + text.size() || text.empty() || v < 1)
-      bad(n, "'" + std::string(key) + "' must be a whole number >= 1");
-    return v;
-  }
-
-  Duration duration(const YAML::Node& n, const char* key) {
-    const auto d = parse_duration(scalar(n, key));
-    if (!d) {
-      bad(n, "'" + std::string(key) +
-                 "' must be a duration with a unit, like 250ms or 1.5s (units: ns, us, ms, s)");
-    }
-    return *d;
-  }
-
-  const std::string& source_;
-  const YAML::Node& node_;
-  std::string prefix_;
 };
 
 }  // namespace

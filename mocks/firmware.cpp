@@ -12,28 +12,36 @@ void require_config(std::string_view config, bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(std::string(config) + ": " + what);
 }
 
-sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
-                                                  std::string_view hint) {
-  auto* chassis = vehicle.differential();
+namespace {
+
+// `chassis`, the vehicle's chassis of `kind`, or the error that it has none.
+template <class Chassis>
+Chassis& required_chassis(Chassis* chassis, const sim::Vehicle& vehicle, std::string_view kind,
+                          std::string_view firmware, std::string_view hint) {
   if (chassis == nullptr) {
-    std::string message =
-        std::string(firmware) + ": vehicle '" + vehicle.name() + "' has no differential chassis";
+    std::string message = std::string(firmware) + ": vehicle '" + vehicle.name() + "' has no " +
+                          std::string(kind) + " chassis";
     if (!hint.empty()) message += " (" + std::string(hint) + ")";
     throw std::invalid_argument(message);
   }
   return *chassis;
 }
 
+}  // namespace
+
+sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                                  std::string_view hint) {
+  return required_chassis(vehicle.differential(), vehicle, "differential", firmware, hint);
+}
+
 sim::AckermannChassis& ackermann_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
                                             std::string_view hint) {
-  auto* chassis = vehicle.ackermann();
-  if (chassis == nullptr) {
-    std::string message =
-        std::string(firmware) + ": vehicle '" + vehicle.name() + "' has no Ackermann chassis";
-    if (!hint.empty()) message += " (" + std::string(hint) + ")";
-    throw std::invalid_argument(message);
-  }
-  return *chassis;
+  return required_chassis(vehicle.ackermann(), vehicle, "Ackermann", firmware, hint);
+}
+
+sim::MecanumChassis& mecanum_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                        std::string_view hint) {
+  return required_chassis(vehicle.mecanum(), vehicle, "mecanum", firmware, hint);
 }
 
 Time next_grid_point(Time now, Duration period) {
@@ -100,11 +108,12 @@ void Firmware::wake(Time now) {
 }
 
 std::optional<Time> Firmware::next_wakeup() const {
-  std::optional<Time> next = next_tick();
-  if (const auto due = script_.next_due(); due && (!next || *due < *next)) next = due;
-  if (muted_until_ && (!next || *muted_until_ < *next)) next = muted_until_;
-  if (!delayed_.empty() && (!next || delayed_.front().due < *next)) next = delayed_.front().due;
-  return next;
+  link::Earliest next;
+  next.consider(next_tick());
+  next.consider(script_.next_due());
+  next.consider(muted_until_);
+  if (!delayed_.empty()) next.consider(delayed_.front().due);
+  return next.time();
 }
 
 void Firmware::arm(Behaviour behaviour) {

@@ -40,6 +40,11 @@ sim::DifferentialChassis& differential_chassis_of(sim::Vehicle& vehicle, std::st
 sim::AckermannChassis& ackermann_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
                                             std::string_view hint = {});
 
+/// The vehicle's mecanum chassis, or std::invalid_argument naming the
+/// firmware, the vehicle and `hint`.
+sim::MecanumChassis& mecanum_chassis_of(sim::Vehicle& vehicle, std::string_view firmware,
+                                        std::string_view hint = {});
+
 /// The first whole multiple of `period` after `now`: the next tick of a
 /// timer that has run on that period since the vehicle started.
 Time next_grid_point(Time now, Duration period);
@@ -130,8 +135,8 @@ class Firmware {
   // ---- what each firmware implements ----
   virtual void on_connect(Time /*now*/) {}
   virtual void on_disconnect(Time /*now*/) {}
-  /// Decode and handle client bytes. For each command, call dispose() with
-  /// its kind first and frame_handled() after.
+  /// Decode and handle client bytes. Each command goes through
+  /// take_command() (or dispose() with its kind first, frame_handled() after).
   virtual void on_bytes(Time now, ByteView bytes) = 0;
   /// Control loop and telemetry; called on every wake and after input.
   virtual void on_tick(Time now) = 0;
@@ -151,6 +156,28 @@ class Firmware {
   Disposition dispose(Time now, std::string_view kind);
   /// A client frame of `kind` was handled (fires after-frame behaviours).
   void frame_handled(Time now, std::string_view kind);
+  /// A client command of `kind` through the armed behaviours: `handle()`
+  /// unless one rejects it (`reject()` sends the protocol's refusal) or
+  /// ignores it; then the behaviours waiting for a frame of `kind` fire.
+  template <class Handle, class Reject>
+  void take_command(Time now, std::string_view kind, Handle handle, Reject reject) {
+    switch (dispose(now, kind)) {
+      case Disposition::handle:
+        handle();
+        break;
+      case Disposition::reject:
+        reject();
+        break;
+      case Disposition::ignore:
+        break;
+    }
+    frame_handled(now, kind);
+  }
+  /// take_command() for a command whose rejection goes unanswered.
+  template <class Handle>
+  void take_command(Time now, std::string_view kind, Handle handle) {
+    take_command(now, kind, handle, [] {});
+  }
   /// A client frame (or run of bytes) was bad and dropped or refused.
   void count_bad_frame() { ++stats_.bad_frames; }
   void count_frame_in() { ++stats_.frames_in; }

@@ -239,16 +239,14 @@ void LekaFirmware::handle_item(Time at, const leka::Item& item) {
 
 void LekaFirmware::run_command(Time at, const Command& command) {
   const std::string_view kind = leka::spec_of(command).name;
-  const Disposition disposition = dispose(at, kind);
-  if (disposition == Disposition::handle) {
+  take_command(at, kind, [&] {
     if (in_fault() && moves(command)) {
       ++state_.counters.refused_in_fault;
     } else {
       execute(at, command);
       ++state_.counters.commands_run;
     }
-  }
-  frame_handled(at, kind);
+  });
 }
 
 void LekaFirmware::execute(Time at, const Command& command) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/overloaded.hpp"
 
 namespace hil::mocks {
@@ -14,15 +15,6 @@ using logi::Direction;
 using logi::Mode;
 
 namespace {
-
-sim::MecanumChassis& mecanum_of(sim::Vehicle& vehicle) {
-  sim::MecanumChassis* chassis = vehicle.mecanum();
-  if (chassis == nullptr) {
-    throw std::invalid_argument("LogiFirmware: vehicle '" + vehicle.name() +
-                                "' has no mecanum chassis");
-  }
-  return *chassis;
-}
 
 const LogiConfig& checked(const LogiConfig& c) {
   for (const int s : c.stations)
@@ -87,29 +79,18 @@ sim::MecanumWheels wheel_pattern(Direction d, double w) {
 
 }  // namespace
 
+constexpr auto kLogiRunEndNames = base::enum_names<LogiRunEnd>(
+    {LogiRunEnd::none, "none"}, {LogiRunEnd::arrived, "arrived"}, {LogiRunEnd::stopped, "stopped"},
+    {LogiRunEnd::line_lost, "line_lost"}, {LogiRunEnd::mode_change, "mode_change"},
+    {LogiRunEnd::fault, "fault"}, {LogiRunEnd::disconnect, "disconnect"});
+
 std::string_view to_string(LogiRunEnd end) {
-  switch (end) {
-    case LogiRunEnd::none:
-      return "none";
-    case LogiRunEnd::arrived:
-      return "arrived";
-    case LogiRunEnd::stopped:
-      return "stopped";
-    case LogiRunEnd::line_lost:
-      return "line_lost";
-    case LogiRunEnd::mode_change:
-      return "mode_change";
-    case LogiRunEnd::fault:
-      return "fault";
-    case LogiRunEnd::disconnect:
-      return "disconnect";
-  }
-  return "?";
+  return kLogiRunEndNames.name(end);
 }
 
 LogiFirmware::LogiFirmware(sim::World& world, sim::Vehicle& vehicle, LogiConfig config)
     : FirmwareWith(world, vehicle, "logi", logi::to_string(config.dialect), checked(config)),
-      chassis_(mecanum_of(vehicle)),
+      chassis_(mecanum_chassis_of(vehicle, "LogiFirmware")),
       decoder_(
           logi::DecoderOptions{logi::kDefaultMaxFrameBytes, config_.accept_lowercase_checksum}) {
   state_.speed_percent = config_.boot_speed_percent;
@@ -198,17 +179,9 @@ void LogiFirmware::handle_frame(Time now, const protocol::Frame<Message>& frame)
   }
   count_frame_in();
   const std::string kind = logi::kind_of(frame.message);
-  switch (dispose(now, kind)) {
-    case Disposition::handle:
-      answer(*command, execute(now, frame.message));
-      break;
-    case Disposition::reject:
-      answer(*command, false);
-      break;
-    case Disposition::ignore:
-      break;
-  }
-  frame_handled(now, kind);
+  take_command(
+      now, kind, [&] { answer(*command, execute(now, frame.message)); },
+      [&] { answer(*command, false); });
 }
 
 void LogiFirmware::handle_error(Time now, const protocol::DecodeError& error) {

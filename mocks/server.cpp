@@ -55,7 +55,13 @@ std::string session_counts(const FirmwareStats& now, const FirmwareStats& at_sta
 }  // namespace
 
 MockServer::MockServer(link::TransportContext& context, Firmware& firmware, ServerOptions options)
-    : context_(context), firmware_(firmware), options_(std::move(options)) {
+    : context_(context),
+      firmware_(firmware),
+      options_(std::move(options)),
+      timer_(context.executor, [this] {
+        firmware_.wake(context_.executor.now());
+        flush();
+      }) {
   if (!options_.protocol) options_.protocol = firmware_.adapter();
   gate_ = std::make_unique<link::FaultInjector>(
       link::Direction::to_car, options_.protocol,
@@ -101,10 +107,7 @@ std::string MockServer::address() const {
 void MockServer::set_faults(link::FaultProfile faults) {
   options_.faults = std::move(faults);
   gate_->set_profile(link::for_direction(options_.faults, link::Direction::to_car));
-  if (link_ && link_->is_open()) {
-    for (const auto d : {link::Direction::to_car, link::Direction::to_client})
-      link_->set_profile(d, link::for_direction(options_.faults, d));
-  }
+  if (link_ && link_->is_open()) link_->set_faults(options_.faults);
 }
 
 bool MockServer::client_connected() const {
@@ -143,8 +146,7 @@ void MockServer::on_accept(link::BytePipePtr client) {
 
   link::LinkOptions link_options;
   link_options.protocol = options_.protocol;
-  link_options.to_car = link::for_direction(options_.faults, link::Direction::to_car);
-  link_options.to_client = link::for_direction(options_.faults, link::Direction::to_client);
+  link_options.set_faults(options_.faults);
   link_options.seed = options_.seed + number - 1;
   link_options.observers = options_.observers;
   if (options_.log)
@@ -221,20 +223,7 @@ void MockServer::flush() {
 }
 
 void MockServer::reschedule() {
-  const std::optional<Time> next = running_ ? firmware_.next_wakeup() : std::nullopt;
-  if (next == timer_due_ && (timer_ != 0 || !next)) return;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  timer_ = 0;
-  timer_due_ = next;
-  if (!next) return;
-  std::weak_ptr<bool> alive = alive_;
-  timer_ = context_.executor.call_at(*next, [this, alive] {
-    if (const auto a = alive.lock(); !a || !*a) return;
-    timer_ = 0;
-    timer_due_.reset();
-    firmware_.wake(context_.executor.now());
-    flush();
-  });
+  timer_.schedule(running_ ? firmware_.next_wakeup() : std::nullopt);
 }
 
 void MockServer::close() {
@@ -242,9 +231,7 @@ void MockServer::close() {
   running_ = false;
   if (listener_) listener_->close();
   if (link_) link_->close();
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  timer_ = 0;
-  timer_due_.reset();
+  timer_.schedule(std::nullopt);
 }
 
 }  // namespace hil::mocks

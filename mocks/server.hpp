@@ -77,8 +77,7 @@ class MockServer {
   std::unique_ptr<link::FaultInjector> gate_;  // answers refuse_connection()
   std::shared_ptr<link::Link> link_;
   link::BytePipePtr firmware_end_;  // the firmware's side of the mem pipe into the link
-  link::Executor::TimerId timer_ = 0;
-  std::optional<Time> timer_due_;
+  link::WakeupTimer timer_;         // the firmware's next wakeup
   std::uint64_t served_ = 0;
   std::uint64_t accepted_ = 0;
   std::uint64_t turned_away_ = 0;

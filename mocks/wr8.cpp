@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "base/duration.hpp"
+#include "base/enum_names.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "protocol/common/text.hpp"
 
@@ -65,16 +66,12 @@ Duration wrong_auth_delay(const Wr8Config& config, std::uint64_t failures_in_a_r
   return std::min(delay, config.wrong_auth_max_delay);
 }
 
+constexpr auto kWr8SessionNames = base::enum_names<Wr8Session>(
+    {Wr8Session::unauthenticated, "unauthenticated"}, {Wr8Session::authenticated, "authenticated"},
+    {Wr8Session::refused, "refused"});
+
 std::string_view to_string(Wr8Session session) {
-  switch (session) {
-    case Wr8Session::unauthenticated:
-      return "unauthenticated";
-    case Wr8Session::authenticated:
-      return "authenticated";
-    case Wr8Session::refused:
-      return "refused";
-  }
-  return "?";
+  return kWr8SessionNames.name(session);
 }
 
 Wr8Firmware::Wr8Firmware(sim::World& world, sim::Vehicle& vehicle, Wr8Config config)
@@ -251,17 +248,8 @@ void Wr8Firmware::handle_item(Time now, const wr8::Item& item) {
     return;
   }
   const std::string kind(wr8::to_string(wr8::code_of(message)));
-  switch (dispose(now, kind)) {
-    case Disposition::handle:
-      handle(now, message);
-      break;
-    case Disposition::reject:
-      reject(now, message);
-      break;
-    case Disposition::ignore:
-      break;
-  }
-  frame_handled(now, kind);
+  take_command(
+      now, kind, [&] { handle(now, message); }, [&] { reject(now, message); });
 }
 
 void Wr8Firmware::handle_bad(Time now, const protocol::DecodeError& error) {
@@ -541,15 +529,12 @@ void Wr8Firmware::on_tick(Time now) {
 }
 
 std::optional<Time> Wr8Firmware::next_tick() const {
-  std::optional<Time> next;
-  const auto consider = [&](const std::optional<Time>& t) {
-    if (t && (!next || *t < *next)) next = t;
-  };
-  consider(state_.close_at);
-  consider(state_.next_control);
-  if (state_.blink) consider(state_.blink->until);
-  if (state_.session == Wr8Session::authenticated) consider(state_.next_data);
-  return next;
+  link::Earliest next;
+  next.consider(state_.close_at);
+  next.consider(state_.next_control);
+  if (state_.blink) next.consider(state_.blink->until);
+  if (state_.session == Wr8Session::authenticated) next.consider(state_.next_data);
+  return next.time();
 }
 
 // ---------------------------------------------------------------- output

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <variant>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/text.hpp"
 
 namespace hil::mocks {
@@ -91,18 +92,12 @@ std::string_view profile_of_config(const SvguiConfig& config) {
 
 }  // namespace
 
+constexpr auto kSvguiTaskNames = base::enum_names<SvguiState::Task>(
+    {SvguiState::Task::none, "none"}, {SvguiState::Task::forward, "forward"},
+    {SvguiState::Task::wheels, "wheels"}, {SvguiState::Task::signals, "signals"});
+
 std::string_view to_string(SvguiState::Task task) {
-  switch (task) {
-    case SvguiState::Task::none:
-      return "none";
-    case SvguiState::Task::forward:
-      return "forward";
-    case SvguiState::Task::wheels:
-      return "wheels";
-    case SvguiState::Task::signals:
-      return "signals";
-  }
-  return "?";
+  return kSvguiTaskNames.name(task);
 }
 
 SvguiConfig SvguiConfig::checked() const {
@@ -322,15 +317,14 @@ bool SvguiFirmware::handle_auth(Time now, const svgui::ReadEvent& read) {
     frame_handled(now, "AUTH");
     return false;
   }
-  if (dispose(now, "AUTH") == Disposition::handle) {
+  take_command(now, "AUTH", [&] {
     ++state_.logins;
     send_message(svgui::kProgramAuthReply);
     if (version_ == svgui::Version::head) {
       send_message(map());
       ++state_.maps_sent;
     }
-  }
-  frame_handled(now, "AUTH");
+  });
   return true;
 }
 
@@ -380,18 +374,13 @@ void SvguiFirmware::run_with_coi(Time now, std::string_view kind, std::uint8_t c
         " dropped: busy with COI " + std::to_string(state_.current_coi));
     return;
   }
-  switch (dispose(now, kind)) {
-    case Disposition::handle:
-      state_.current_coi = coi;
-      run();
-      break;
-    case Disposition::reject:
-      send_message(svgui::Answer{coi, 0});
-      break;
-    case Disposition::ignore:
-      break;
-  }
-  frame_handled(now, kind);
+  take_command(
+      now, kind,
+      [&] {
+        state_.current_coi = coi;
+        run();
+      },
+      [&] { send_message(svgui::Answer{coi, 0}); });
 }
 
 void SvguiFirmware::start_task(Time now, std::uint8_t type,
@@ -465,7 +454,7 @@ void SvguiFirmware::handle_head(Time now, ByteView packet) {
     return;
   }
   count_frame_in();
-  if (dispose(now, kind) == Disposition::handle) {
+  take_command(now, kind, [&] {
     if (set != nullptr) {
       state_.head_settings = set->values;
       apply_steering(commanded_wheel_deg_);
@@ -481,8 +470,7 @@ void SvguiFirmware::handle_head(Time now, ByteView packet) {
       commanded_wheel_deg_ = -std::clamp(control->x_axis, -1.0, 1.0) * limit_deg;
       apply_steering(commanded_wheel_deg_);
     }
-  }
-  frame_handled(now, kind);
+  });
 }
 
 // ---------------------------------------------------------------- control
@@ -578,15 +566,11 @@ void SvguiFirmware::on_tick(Time now) {
 }
 
 std::optional<Time> SvguiFirmware::next_tick() const {
-  std::optional<Time> next;
-  const auto consider = [&](const std::optional<Time>& t) {
-    if (t && (!next || *t < *next)) next = t;
-  };
-  consider(state_.next_loop);
-  consider(state_.next_data);
-  consider(state_.next_high_freq);
-  consider(state_.next_low_freq);
-  return next;
+  link::Earliest next;
+  for (const auto& due :
+       {state_.next_loop, state_.next_data, state_.next_high_freq, state_.next_low_freq})
+    next.consider(due);
+  return next.time();
 }
 
 // ---------------------------------------------------------------- output

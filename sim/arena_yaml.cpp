@@ -356,6 +356,21 @@ void emit_number(YAML::Emitter& out, double value) {
   out << format_number(value);
 }
 
+// One `key: value` of the map being written.
+void emit_field(YAML::Emitter& out, const char* key, const std::string& text) {
+  out << YAML::Key << key << YAML::Value;
+  emit_text(out, text);
+}
+void emit_field(YAML::Emitter& out, const char* key, double value) {
+  out << YAML::Key << key << YAML::Value;
+  emit_number(out, value);
+}
+// A point as the `x_m` and `y_m` of the map being written.
+void emit_position(YAML::Emitter& out, Vec2 p) {
+  emit_field(out, "x_m", p.x_m);
+  emit_field(out, "y_m", p.y_m);
+}
+
 }  // namespace
 
 Arena parse_arena(const YAML::Node& node, const std::string& source_name) {
@@ -379,22 +394,16 @@ Arena load_arena(const std::string& path) {
 std::string to_yaml(const Arena& arena) {
   YAML::Emitter out;
   out << YAML::BeginMap;
-  out << YAML::Key << "name" << YAML::Value;
-  emit_text(out, arena.name);
+  emit_field(out, "name", arena.name);
   out << YAML::Key << "size_m" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   emit_number(out, arena.width_m);
   emit_number(out, arena.height_m);
   out << YAML::EndSeq;
   out << YAML::Key << "walls" << YAML::Value << (arena.walls ? "true" : "false");
-  out << YAML::Key << "wall_thickness_m" << YAML::Value;
-  emit_number(out, arena.wall_thickness_m);
+  emit_field(out, "wall_thickness_m", arena.wall_thickness_m);
   out << YAML::Key << "start" << YAML::Value << YAML::Flow << YAML::BeginMap;
-  out << YAML::Key << "x_m" << YAML::Value;
-  emit_number(out, arena.start.x_m);
-  out << YAML::Key << "y_m" << YAML::Value;
-  emit_number(out, arena.start.y_m);
-  out << YAML::Key << "heading_deg" << YAML::Value;
-  emit_number(out, rad_to_deg(arena.start.heading_rad));
+  emit_position(out, arena.start.position());
+  emit_field(out, "heading_deg", rad_to_deg(arena.start.heading_rad));
   out << YAML::EndMap;
 
   // Empty lists are left out: they are optional and read back as empty.
@@ -403,30 +412,18 @@ std::string to_yaml(const Arena& arena) {
     out << YAML::BeginMap;
     if (const auto* b = std::get_if<BoxObstacle>(&obstacle)) {
       out << YAML::Key << "box" << YAML::Value << YAML::Flow << YAML::BeginMap;
-      out << YAML::Key << "name" << YAML::Value;
-      emit_text(out, b->name);
-      out << YAML::Key << "x_m" << YAML::Value;
-      emit_number(out, b->center_m.x_m);
-      out << YAML::Key << "y_m" << YAML::Value;
-      emit_number(out, b->center_m.y_m);
-      out << YAML::Key << "width_m" << YAML::Value;
-      emit_number(out, b->width_m);
-      out << YAML::Key << "height_m" << YAML::Value;
-      emit_number(out, b->height_m);
-      out << YAML::Key << "angle_deg" << YAML::Value;
-      emit_number(out, rad_to_deg(b->angle_rad));
+      emit_field(out, "name", b->name);
+      emit_position(out, b->center_m);
+      emit_field(out, "width_m", b->width_m);
+      emit_field(out, "height_m", b->height_m);
+      emit_field(out, "angle_deg", rad_to_deg(b->angle_rad));
       out << YAML::EndMap;
     } else {
       const auto& c = std::get<CircleObstacle>(obstacle);
       out << YAML::Key << "circle" << YAML::Value << YAML::Flow << YAML::BeginMap;
-      out << YAML::Key << "name" << YAML::Value;
-      emit_text(out, c.name);
-      out << YAML::Key << "x_m" << YAML::Value;
-      emit_number(out, c.center_m.x_m);
-      out << YAML::Key << "y_m" << YAML::Value;
-      emit_number(out, c.center_m.y_m);
-      out << YAML::Key << "radius_m" << YAML::Value;
-      emit_number(out, c.radius_m);
+      emit_field(out, "name", c.name);
+      emit_position(out, c.center_m);
+      emit_field(out, "radius_m", c.radius_m);
       out << YAML::EndMap;
     }
     out << YAML::EndMap;
@@ -436,10 +433,8 @@ std::string to_yaml(const Arena& arena) {
   if (!arena.tapes.empty()) out << YAML::Key << "tapes" << YAML::Value << YAML::BeginSeq;
   for (const auto& tape : arena.tapes) {
     out << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value;
-    emit_text(out, tape.name);
-    out << YAML::Key << "width_m" << YAML::Value;
-    emit_number(out, tape.width_m);
+    emit_field(out, "name", tape.name);
+    emit_field(out, "width_m", tape.width_m);
     out << YAML::Key << "closed" << YAML::Value << (tape.closed ? "true" : "false");
     out << YAML::Key << "points_m" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (const auto& p : tape.points_m) {
@@ -458,12 +453,8 @@ std::string to_yaml(const Arena& arena) {
     out << YAML::Flow << YAML::BeginMap;
     // Always quoted: an id like 001 must stay text for every YAML reader.
     out << YAML::Key << "id" << YAML::Value << YAML::DoubleQuoted << tag.id;
-    out << YAML::Key << "x_m" << YAML::Value;
-    emit_number(out, tag.position_m.x_m);
-    out << YAML::Key << "y_m" << YAML::Value;
-    emit_number(out, tag.position_m.y_m);
-    out << YAML::Key << "radius_m" << YAML::Value;
-    emit_number(out, tag.radius_m);
+    emit_position(out, tag.position_m);
+    emit_field(out, "radius_m", tag.radius_m);
     out << YAML::EndMap;
   }
   if (!arena.tags.empty()) out << YAML::EndSeq;

@@ -42,6 +42,21 @@ Reply bad(const std::string& message) {
   return Reply{400, json{{"error", message}}};
 }
 
+// Runs `parse`, which reads YAML the page sent; the 400 reply for what it
+// threw, if anything: a ConfigError as it reads, another YAML error after
+// `what`.
+template <class Parse>
+std::optional<Reply> bad_yaml(const std::string& what, Parse parse) {
+  try {
+    parse();
+  } catch (const config::ConfigError& e) {
+    return bad(e.what());
+  } catch (const YAML::Exception& e) {
+    return bad(what + ": " + e.what());
+  }
+  return std::nullopt;
+}
+
 // A number field; nullopt when absent; throws a message for a wrong type.
 std::optional<double> number_field(const json& request, const char* name) {
   const auto it = request.find(name);
@@ -332,13 +347,9 @@ Reply LiveModel::set_faults(Car& car, const json& request) {
   link::FaultProfile profile;
   const bool blank = text.find_first_not_of(" \t\r\n") == std::string::npos;
   if (!blank) {
-    try {
-      profile = link::parse_fault_profile_text(text, "profile");
-    } catch (const config::ConfigError& e) {
-      return bad(e.what());
-    } catch (const YAML::Exception& e) {
-      return bad(std::string("profile: ") + e.what());
-    }
+    if (auto reply =
+            bad_yaml("profile", [&] { profile = link::parse_fault_profile_text(text, "profile"); }))
+      return *reply;
   }
   car.viewed.server->set_faults(profile);
   car.viewed.faults = profile;
@@ -351,13 +362,9 @@ Reply LiveModel::trigger(Car& car, const json& request) {
   if (request.contains("yaml")) {
     const std::string yaml = string_field(request, "yaml");
     std::vector<mocks::Behaviour> behaviours;
-    try {
-      behaviours = mocks::parse_behaviours_text(yaml, "behaviour");
-    } catch (const config::ConfigError& e) {
-      return bad(e.what());
-    } catch (const YAML::Exception& e) {
-      return bad(std::string("behaviour: ") + e.what());
-    }
+    if (auto reply = bad_yaml(
+            "behaviour", [&] { behaviours = mocks::parse_behaviours_text(yaml, "behaviour"); }))
+      return *reply;
     for (auto& b : behaviours)
       firmware.arm(std::move(b));
     return Reply{200, json{{"ok", true}, {"armed", behaviours.size()}}};

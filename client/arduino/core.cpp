@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/enum_names.hpp"
 #include "protocol/common/text.hpp"
 
 namespace hil::client::arduino {
@@ -21,40 +22,21 @@ Result outcome(ResultCode code, std::string detail) {
 
 }  // namespace
 
+constexpr auto kArduinoLinkNames = base::enum_names<ConnectionState>(
+    {ConnectionState::disconnected, "CLOSED"}, {ConnectionState::connecting, "OPENING"},
+    {ConnectionState::connected, "OPEN"}, {ConnectionState::degraded, "DEGRADED"},
+    {ConnectionState::reconnecting, "RECONNECTING"}, {ConnectionState::down, "DOWN"});
+
+constexpr auto kResultCodeNames = base::enum_names<ResultCode>(
+    {ResultCode::ok, "ok"}, {ResultCode::nack, "nack"}, {ResultCode::timeout, "timeout"},
+    {ResultCode::link_down, "link_down"}, {ResultCode::invalid_request, "invalid_request"});
+
 std::string_view link_name(ConnectionState s) {
-  switch (s) {
-    case ConnectionState::disconnected:
-      return "CLOSED";
-    case ConnectionState::connecting:
-      return "OPENING";
-    case ConnectionState::connected:
-      return "OPEN";
-    case ConnectionState::degraded:
-      return "DEGRADED";
-    case ConnectionState::reconnecting:
-      return "RECONNECTING";
-    case ConnectionState::down:
-      return "DOWN";
-    case ConnectionState::authenticating:
-      break;
-  }
-  return "?";
+  return kArduinoLinkNames.name(s);
 }
 
 std::string_view to_string(ResultCode c) {
-  switch (c) {
-    case ResultCode::ok:
-      return "ok";
-    case ResultCode::nack:
-      return "nack";
-    case ResultCode::timeout:
-      return "timeout";
-    case ResultCode::link_down:
-      return "link_down";
-    case ResultCode::invalid_request:
-      return "invalid_request";
-  }
-  return "?";
+  return kResultCodeNames.name(c);
 }
 
 ArduinoClientCore::ArduinoClientCore(ClientConfig config)
@@ -118,13 +100,7 @@ RequestId ArduinoClientCore::request(Time now, proto::Body body) {
     complete(id, outcome(ResultCode::invalid_request, e.what()));
     return id;
   }
-  if (state_ == ConnectionState::disconnected || state_ == ConnectionState::down) {
-    complete(id, outcome(ResultCode::link_down,
-                         std::string("the link is ") + std::string(link_name(state_))));
-    return id;
-  }
-  queue_.push_back({id, Purpose::user, std::move(body)});
-  pump(now);
+  queue_user(now, id, std::move(body));
   return id;
 }
 
@@ -150,14 +126,18 @@ RequestId ArduinoClientCore::raw(Time now, std::string_view token) {
   }
   if (envelope.payload.empty())
     envelope.payload = std::string(proto::empty_payload(config_.dialect));
+  queue_user(now, id, std::move(envelope));
+  return id;
+}
+
+void ArduinoClientCore::queue_user(Time now, RequestId id, Payload what) {
   if (state_ == ConnectionState::disconnected || state_ == ConnectionState::down) {
     complete(id, outcome(ResultCode::link_down,
                          std::string("the link is ") + std::string(link_name(state_))));
-    return id;
+    return;
   }
-  queue_.push_back({id, Purpose::user, std::move(envelope)});
+  queue_.push_back({id, Purpose::user, std::move(what)});
   pump(now);
-  return id;
 }
 
 void ArduinoClientCore::on_connected(Time now) {
@@ -275,17 +255,14 @@ void ArduinoClientCore::on_timer(Time now) {
 }
 
 std::optional<Time> ArduinoClientCore::next_wakeup() const {
-  std::optional<Time> due;
-  auto consider = [&](Time t) {
-    if (!due || t < *due) due = t;
-  };
-  if (inflight_) consider(inflight_->deadline);
-  if (const auto reopen = reconnect_.due()) consider(*reopen);
+  link::Earliest due;
+  if (inflight_) due.consider(inflight_->deadline);
+  due.consider(reconnect_.due());
   if (state_ == ConnectionState::connected && connected_ && !inflight_ && queue_.empty() &&
       config_.health_check_interval > Duration::zero()) {
-    consider(last_exchange_ + config_.health_check_interval);
+    due.consider(last_exchange_ + config_.health_check_interval);
   }
-  return due;
+  return due.time();
 }
 
 std::vector<Action> ArduinoClientCore::take_actions() {

@@ -161,11 +161,12 @@ class ArduinoClientCore {
 
  private:
   enum class Purpose : std::uint8_t { user, health_check, reconnect_check };
+  /// A typed request, or a raw token hil does not type, framed as given.
+  using Payload = std::variant<protocol::arduino::Body, protocol::arduino::Envelope>;
   struct Pending {
     RequestId id = 0;
     Purpose purpose = Purpose::user;
-    /// A typed request, or a raw token hil does not type, framed as given.
-    std::variant<protocol::arduino::Body, protocol::arduino::Envelope> what;
+    Payload what;
   };
   struct Inflight {
     Pending pending;
@@ -180,6 +181,9 @@ class ArduinoClientCore {
   static Result lost_result(const Inflight& lost, ResultCode code, const std::string& detail);
   Duration timeout_of(int attempt) const;
   Bytes frame_of(const Pending& pending, std::uint8_t seq) const;
+  /// Queues the operator's request `id`, or completes it link_down at once
+  /// while the link is closed or down.
+  void queue_user(Time now, RequestId id, Payload what);
   void pump(Time now);
   void send_current(Time now);
   void finish(Time now, Result result);

@@ -26,14 +26,14 @@ void ArduinoSession::close() {
 RequestId ArduinoSession::request(protocol::arduino::Body body, Callback done) {
   // Register the callback before the core can complete the request.
   const RequestId id = core_.request(now(), std::move(body));
-  if (done) callbacks_[id] = std::move(done);
+  callbacks_.add(id, std::move(done));
   drain();
   return id;
 }
 
 RequestId ArduinoSession::raw(std::string_view token, Callback done) {
   const RequestId id = core_.raw(now(), token);
-  if (done) callbacks_[id] = std::move(done);
+  callbacks_.add(id, std::move(done));
   drain();
   return id;
 }
@@ -70,14 +70,7 @@ void ArduinoSession::perform(Action& action) {
 }
 
 void ArduinoSession::dispatch(Event& event) {
-  if (auto* done = std::get_if<RequestDone>(&event)) {
-    auto it = callbacks_.find(done->id);
-    if (it != callbacks_.end()) {
-      Callback callback = std::move(it->second);
-      callbacks_.erase(it);
-      callback(done->result);
-    }
-  }
+  if (auto* done = std::get_if<RequestDone>(&event)) callbacks_.complete(done->id, done->result);
   if (on_event_) on_event_(event);
 }
 

@@ -4,7 +4,6 @@
 // feeds it what arrives, keeps one timer for its wakeup, and logs every frame.
 
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -12,6 +11,7 @@
 #include "client/arduino/comm_log.hpp"
 #include "client/arduino/core.hpp"
 #include "client/common/pipe_binding.hpp"
+#include "client/common/request_callbacks.hpp"
 #include "link/endpoint.hpp"
 #include "link/transport.hpp"
 
@@ -19,7 +19,7 @@ namespace hil::client::arduino {
 
 class ArduinoSession {
  public:
-  using Callback = std::function<void(const Result&)>;
+  using Callback = RequestCallbacks<RequestId, Result>::Callback;
   using EventHandler = std::function<void(const Event&)>;
   /// Wall-clock microseconds since the Unix epoch, for the log's timestamps.
   using WallClock = std::function<std::int64_t()>;
@@ -74,7 +74,7 @@ class ArduinoSession {
 
   ArduinoClientCore core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
-  std::map<RequestId, Callback> callbacks_;
+  RequestCallbacks<RequestId, Result> callbacks_;
   EventHandler on_event_;
   WallClock wall_clock_;
   bool draining_ = false;

@@ -20,7 +20,7 @@
 namespace hil::client {
 
 /// `Core` has connect/disconnect/on_connected/on_connect_failed/on_bytes/
-/// on_closed/on_timer(now), take_actions(), take_events() and next_wakeup();
+/// on_closed/on_timer(now), take_actions(), take_events(), next_wakeup() and log();
 /// its actions are a variant of `Open`, `Send` (bytes in `.bytes` or text in
 /// `.text`) and `Close`.
 template <class Core, class Event, class Open, class Send, class Close>
@@ -47,6 +47,8 @@ class ConnectingSession {
   }
 
   const Core& core() const { return core_; }
+  /// The core's communication log.
+  const auto& log() const { return core_.log(); }
 
  protected:
   link::Time now() const { return binding_.now(); }

@@ -6,11 +6,15 @@ namespace hil::client {
 
 PipeBinding::PipeBinding(link::TransportContext& context, link::Endpoint endpoint,
                          Handlers handlers)
-    : context_(context), endpoint_(std::move(endpoint)), handlers_(std::move(handlers)) {}
+    : context_(context),
+      endpoint_(std::move(endpoint)),
+      handlers_(std::move(handlers)),
+      timer_(context.executor, [this] {
+        if (handlers_.timer) handlers_.timer();
+      }) {}
 
 PipeBinding::~PipeBinding() {
   *alive_ = false;
-  if (timer_ != 0) context_.executor.cancel(timer_);
   close();
 }
 
@@ -51,20 +55,6 @@ bool PipeBinding::write(protocol::ByteView bytes) {
   if (!pipe_) return false;
   pipe_->write(bytes);
   return true;
-}
-
-void PipeBinding::schedule(std::optional<link::Time> due) {
-  if (due == timer_due_ && (timer_ != 0 || !due)) return;
-  if (timer_ != 0) context_.executor.cancel(timer_);
-  timer_ = 0;
-  timer_due_ = due;
-  if (!due) return;
-  timer_ = context_.executor.call_at(*due, [this, alive = alive_] {
-    if (!*alive) return;
-    timer_ = 0;
-    timer_due_.reset();
-    if (handlers_.timer) handlers_.timer();
-  });
 }
 
 }  // namespace hil::client

@@ -47,7 +47,7 @@ class PipeBinding {
 
   /// Keeps one timer due at `due` (none when nullopt); cheap to call after
   /// every input, as it only re-arms when the time changed.
-  void schedule(std::optional<link::Time> due);
+  void schedule(std::optional<link::Time> due) { timer_.schedule(due); }
 
   link::Time now() const { return context_.executor.now(); }
   const link::Endpoint& endpoint() const { return endpoint_; }
@@ -58,8 +58,7 @@ class PipeBinding {
   Handlers handlers_;
   link::BytePipePtr pipe_;
   std::uint64_t generation_ = 0;  // callbacks from an older pipe are ignored
-  link::Executor::TimerId timer_ = 0;
-  std::optional<link::Time> timer_due_;
+  link::WakeupTimer timer_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

@@ -276,12 +276,9 @@ void LekaClientCore::on_bytes(Time now, ByteView bytes) {
 }
 
 std::optional<Time> LekaClientCore::next_wakeup() const {
-  std::optional<Time> due;
-  auto consider = [&](Time t) {
-    if (!due || t < *due) due = t;
-  };
+  link::Earliest due;
   for (const auto& p : pending_)
-    if (p.deadline) consider(*p.deadline);
+    due.consider(p.deadline);
   if (connected_ && !queue_.empty() && !sent_.empty()) {
     // The next frame fits once enough of the window's oldest frames leave it.
     const std::size_t need = queue_.front().bytes.size();
@@ -294,9 +291,9 @@ std::optional<Time> LekaClientCore::next_wakeup() const {
       total -= bytes;
       fits = at + config_.loop_period;
     }
-    if (fits) consider(*fits);
+    due.consider(fits);
   }
-  return due;
+  return due.time();
 }
 
 std::vector<SendFrame> LekaClientCore::take_actions() {

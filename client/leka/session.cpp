@@ -42,7 +42,7 @@ BuildResult LekaSession::send(const GroupBuilder& builder) {
 
 RequestId LekaSession::info(InfoCallback done) {
   const RequestId id = core_.info(now());
-  if (done) callbacks_[id] = std::move(done);
+  callbacks_.add(id, std::move(done));
   drain();
   return id;
 }
@@ -64,14 +64,7 @@ void LekaSession::drain() {
       binding_.write(a.bytes);
     }
     for (auto& e : events) {
-      if (auto* done = std::get_if<InfoDone>(&e)) {
-        auto it = callbacks_.find(done->id);
-        if (it != callbacks_.end()) {
-          auto callback = std::move(it->second);
-          callbacks_.erase(it);
-          callback(done->result);
-        }
-      }
+      if (auto* done = std::get_if<InfoDone>(&e)) callbacks_.complete(done->id, done->result);
     }
   });
   binding_.schedule(core_.next_wakeup());

@@ -4,12 +4,12 @@
 // feeds it the robot's lines, keeps one timer for its wakeup, logs both ways.
 
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "client/common/pipe_binding.hpp"
+#include "client/common/request_callbacks.hpp"
 #include "client/leka/comm_log.hpp"
 #include "client/leka/core.hpp"
 #include "link/endpoint.hpp"
@@ -20,7 +20,7 @@ namespace hil::client::leka {
 
 class LekaSession {
  public:
-  using InfoCallback = std::function<void(const InfoResult&)>;
+  using InfoCallback = RequestCallbacks<RequestId, InfoResult>::Callback;
   /// Wall-clock microseconds since the Unix epoch, for the log.
   using WallClock = std::function<std::int64_t()>;
 
@@ -51,7 +51,7 @@ class LekaSession {
 
   LekaClientCore core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
-  std::map<RequestId, InfoCallback> callbacks_;
+  RequestCallbacks<RequestId, InfoResult> callbacks_;
   WallClock wall_clock_;
   std::string open_error_;
   bool draining_ = false;

@@ -3,40 +3,29 @@
 #include <algorithm>
 #include <utility>
 
+#include "base/enum_names.hpp"
+
 namespace hil::client::logi {
 
+constexpr auto kLogiCommandStateNames = base::enum_names<CommandState>(
+    {CommandState::sent, "sent"}, {CommandState::accepted, "accepted"},
+    {CommandState::rejected, "rejected"}, {CommandState::uncertain, "uncertain"},
+    {CommandState::cancelled, "cancelled"});
+
+constexpr auto kLogiRefusalTexts =
+    base::enum_names<Refusal>({Refusal::none, "none"}, {Refusal::not_connected, "not connected"},
+                              {Refusal::mode_speed_unconfirmed,
+                               "mode and speed not confirmed on this connection (send MD and SP)"},
+                              {Refusal::not_held, "no direction held"},
+                              {Refusal::unknown_request, "no such request awaits confirmation"},
+                              {Refusal::not_a_command, "not a command"});
+
 std::string_view to_string(CommandState s) {
-  switch (s) {
-    case CommandState::sent:
-      return "sent";
-    case CommandState::accepted:
-      return "accepted";
-    case CommandState::rejected:
-      return "rejected";
-    case CommandState::uncertain:
-      return "uncertain";
-    case CommandState::cancelled:
-      return "cancelled";
-  }
-  return "?";
+  return kLogiCommandStateNames.name(s);
 }
 
 std::string_view to_string(Refusal r) {
-  switch (r) {
-    case Refusal::none:
-      return "none";
-    case Refusal::not_connected:
-      return "not connected";
-    case Refusal::mode_speed_unconfirmed:
-      return "mode and speed not confirmed on this connection (send MD and SP)";
-    case Refusal::not_held:
-      return "no direction held";
-    case Refusal::unknown_request:
-      return "no such request awaits confirmation";
-    case Refusal::not_a_command:
-      return "not a command";
-  }
-  return "?";
+  return kLogiRefusalTexts.name(r);
 }
 
 namespace {
@@ -85,25 +74,21 @@ void LogiClientCore::on_connected(Time now) {
 void LogiClientCore::on_connect_failed(Time now) {
   if (state() != ConnectionState::connecting) return;
   note(now, "connect failed");
-  if (connection_.wanted()) {
-    schedule_reconnect(now);
-  } else {
-    set_state(ConnectionState::disconnected);
-  }
+  reconnect_or_stop(now);
 }
 
 void LogiClientCore::on_closed(Time now) {
   if (state() != ConnectionState::connected) return;
   note(now, "connection lost");
   lost(now, "connection lost");
-  if (connection_.wanted()) {
-    schedule_reconnect(now);
-  } else {
-    set_state(ConnectionState::disconnected);
-  }
+  reconnect_or_stop(now);
 }
 
-void LogiClientCore::schedule_reconnect(Time now) {
+void LogiClientCore::reconnect_or_stop(Time now) {
+  if (!connection_.wanted()) {
+    set_state(ConnectionState::disconnected);
+    return;
+  }
   auto& reconnect = connection_.reconnect();
   const Duration delay = reconnect.next_delay();
   reconnect.schedule_at(reconnect_time(now, delay));
@@ -403,17 +388,15 @@ void LogiClientCore::on_timer(Time now) {
 }
 
 std::optional<Time> LogiClientCore::next_wakeup() const {
-  std::optional<Time> next = connection_.reconnect().due();
-  auto consider = [&](Time t) {
-    if (!next || t < *next) next = t;
-  };
+  link::Earliest next;
+  next.consider(connection_.reconnect().due());
   for (const auto& p : flight_)
-    consider(p.deadline);
+    next.consider(p.deadline);
   if (state() == ConnectionState::connected && !stale_ && last_stat_) {
-    consider(*last_stat_ + stale_after());
+    next.consider(*last_stat_ + stale_after());
   }
-  if (held_ && keepalive_at_) consider(*keepalive_at_);
-  return next;
+  if (held_) next.consider(keepalive_at_);
+  return next.time();
 }
 
 void LogiClientCore::decode(protocol::ByteView bytes, std::vector<proto::Item>& items) {

@@ -211,7 +211,9 @@ class LogiClientCore : public ConnectionCore<Action, Event> {
   void on_feedback(Time now, const proto::Feedback& fb);
   void on_timeout(Time now, Pending p);
   void lost(Time now, std::string_view why);
-  void schedule_reconnect(Time now);
+  /// A failed or lost connection: the next attempt is scheduled (at
+  /// reconnect_time) while the operator wants it, else disconnected.
+  void reconnect_or_stop(Time now);
   void set_state(ConnectionState s, int attempt = 0);
   void update_movement();
   static bool is_movement(const proto::Message& m);

@@ -34,8 +34,6 @@ class LogiSession
   SubmitResult confirm_resend(RequestId request) {
     return feed([&](Time t) { return mutable_core().confirm_resend(t, request); });
   }
-
-  const std::shared_ptr<CommLog>& log() const { return core().log(); }
 };
 
 }  // namespace hil::client::logi

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -163,6 +164,28 @@ class ActionRunner {
   }
   void on_data(const std::string& text) {
     if (waits_for<op::WaitData>()) finish(true, text);
+  }
+  /// Hands a session event to the action under way, if any: to `own` (the
+  /// dialect's handlers, an Overloaded) when it takes the event's type,
+  /// else a login, a failed login or a connection change to the shared
+  /// words above; other events end nothing.
+  template <class Event, class Own>
+  void dispatch(const Event& event, Own own) {
+    if (!current_) return;
+    std::visit(
+        [&](const auto& e) {
+          using E = std::remove_cvref_t<decltype(e)>;
+          if constexpr (std::is_invocable_v<Own&, const E&>) {
+            own(e);
+          } else if constexpr (std::is_same_v<E, LoginEvent>) {
+            on_login(e);
+          } else if constexpr (std::is_same_v<E, LoginFailedEvent>) {
+            on_login_failed(e);
+          } else if constexpr (std::is_same_v<E, ConnectionEvent>) {
+            on_connection(e);
+          }
+        },
+        event);
   }
   template <class Word>
   bool waits_for() const {

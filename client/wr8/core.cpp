@@ -5,52 +5,34 @@
 #include <utility>
 #include <variant>
 
+#include "base/enum_names.hpp"
 #include "link/capture/wire_log.hpp"
 
 namespace hil::client::wr8 {
 
+constexpr auto kWr8RequestStateNames = base::enum_names<RequestState>(
+    {RequestState::sent, "sent"}, {RequestState::started, "started"},
+    {RequestState::completed, "completed"}, {RequestState::error, "error"},
+    {RequestState::timed_out, "timed_out"}, {RequestState::cancelled, "cancelled"});
+
+constexpr auto kWr8DataStreamNames = base::enum_names<DataStream>(
+    {DataStream::data, "DATA"}, {DataStream::high_freq, "HIGH-FREQ DATA"},
+    {DataStream::low_freq, "LOW-FREQ DATA"});
+
+constexpr auto kWr8RefusalNames =
+    base::enum_names<Refusal>({Refusal::none, "none"}, {Refusal::not_connected, "not_connected"},
+                              {Refusal::bad_request, "bad_request"}, {Refusal::busy, "busy"});
+
 std::string_view to_string(RequestState s) {
-  switch (s) {
-    case RequestState::sent:
-      return "sent";
-    case RequestState::started:
-      return "started";
-    case RequestState::completed:
-      return "completed";
-    case RequestState::error:
-      return "error";
-    case RequestState::timed_out:
-      return "timed_out";
-    case RequestState::cancelled:
-      return "cancelled";
-  }
-  return "?";
+  return kWr8RequestStateNames.name(s);
 }
 
 std::string_view to_string(DataStream s) {
-  switch (s) {
-    case DataStream::data:
-      return "DATA";
-    case DataStream::high_freq:
-      return "HIGH-FREQ DATA";
-    case DataStream::low_freq:
-      return "LOW-FREQ DATA";
-  }
-  return "?";
+  return kWr8DataStreamNames.name(s);
 }
 
 std::string_view to_string(Refusal r) {
-  switch (r) {
-    case Refusal::none:
-      return "none";
-    case Refusal::not_connected:
-      return "not_connected";
-    case Refusal::bad_request:
-      return "bad_request";
-    case Refusal::busy:
-      return "busy";
-  }
-  return "?";
+  return kWr8RefusalNames.name(r);
 }
 
 namespace {
@@ -61,6 +43,14 @@ proto::DecoderOptions decoder_options(const proto::Profile& profile) {
   o.sender = proto::Sender::vehicle;
   return o;
 }
+
+// The live state's field for each DATA code it shows.
+constexpr std::pair<std::uint8_t, std::optional<double> LiveState::*> kLiveFields[] = {
+    {proto::data_code::odometry, &LiveState::odometry_cm},
+    {proto::data_code::speed, &LiveState::speed_mps},
+    {proto::data_code::wheel_angle, &LiveState::wheel_angle_deg},
+    {proto::data_code::battery, &LiveState::battery_percent},
+};
 
 bool is_final(RequestState s) {
   return s != RequestState::sent && s != RequestState::started;
@@ -156,22 +146,8 @@ void Wr8ClientCore::handle(Time now, const proto::Message& message) {
     live.timestamp_ms = data->timestamp_ms;
     live.received = now;
     for (const auto& v : data->values) {
-      const double x = value_of(v);
-      switch (v.code) {
-        case proto::data_code::odometry:
-          live.odometry_cm = x;
-          break;
-        case proto::data_code::speed:
-          live.speed_mps = x;
-          break;
-        case proto::data_code::wheel_angle:
-          live.wheel_angle_deg = x;
-          break;
-        case proto::data_code::battery:
-          live.battery_percent = x;
-          break;
-        default:
-          break;
+      for (const auto& [code, field] : kLiveFields) {
+        if (v.code == code) live.*field = value_of(v);
       }
     }
     live_ = live;
@@ -335,19 +311,14 @@ void Wr8ClientCore::on_timer(Time now) {
 }
 
 std::optional<Time> Wr8ClientCore::next_wakeup() const {
-  std::optional<Time> next;
-  auto take = [&next](Time t) {
-    if (!next || t < *next) next = t;
-  };
-  if (const auto due = connection_.reconnect().due()) take(*due);
-  if (const auto deadline = login_deadline()) take(*deadline);
+  link::Earliest next = connection_wakeup();
   if (state() == ConnectionState::connected) {
     for (const auto& p : pending_) {
-      if (p) take(p->deadline);
+      if (p) next.consider(p->deadline);
     }
-    if (!stale_ && last_data_) take(*last_data_ + config_.stale_after);
+    if (!stale_ && last_data_) next.consider(*last_data_ + config_.stale_after);
   }
-  return next;
+  return next.time();
 }
 
 }  // namespace hil::client::wr8

@@ -224,6 +224,14 @@ class LoginCore : public ConnectionCore<Action, Event> {
     if (this->state() != ConnectionState::authenticating) return std::nullopt;
     return login_deadline_;
   }
+  /// What the connection itself waits for, the earliest first: a reconnect
+  /// attempt, the login's time limit.
+  link::Earliest connection_wakeup() const {
+    link::Earliest next;
+    next.consider(this->connection_.reconnect().due());
+    next.consider(login_deadline());
+    return next;
+  }
 
  private:
   std::optional<Time> login_deadline_;

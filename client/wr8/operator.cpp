@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/enum_names.hpp"
 #include "client/common/operator_text.hpp"
 
 namespace hil::client::wr8 {
@@ -38,30 +39,22 @@ constexpr std::string_view kVocabulary =
     "connect, disconnect, drive CM, turn DEG, task CODE [VALUE...], get-settings, "
     "set NAME=VALUE..., wait DURATION, wait-data";
 
+// A signed whole number is the rest.
+constexpr auto kWr8ValueTypeTexts =
+    base::enum_names<proto::ValueType>({proto::ValueType::float32, "a number"},
+                                       {proto::ValueType::unsigned_int, "a whole number >= 0"});
+
 std::string value_type_text(proto::ValueType type) {
-  switch (type) {
-    case proto::ValueType::float32:
-      return "a number";
-    case proto::ValueType::unsigned_int:
-      return "a whole number >= 0";
-    case proto::ValueType::signed_int:
-      break;
-  }
-  return "a whole number";
+  return std::string(kWr8ValueTypeTexts.name(type, "a whole number"));
 }
 
 // The names `set` reads, as the CLI writes them.
+constexpr auto kWr8SettingNames = base::enum_names<proto::SettingCode>(
+    {proto::SettingCode::p, "p"}, {proto::SettingCode::i, "i"}, {proto::SettingCode::d, "d"},
+    {proto::SettingCode::servo_zero, "servo-zero"});
+
 std::string setting_name(proto::SettingCode code) {
-  switch (code) {
-    case proto::SettingCode::p:
-      return "p";
-    case proto::SettingCode::i:
-      return "i";
-    case proto::SettingCode::d:
-      return "d";
-    case proto::SettingCode::servo_zero:
-      return "servo-zero";
-  }
+  if (const auto name = kWr8SettingNames.find(code)) return std::string(*name);
   return std::to_string(static_cast<int>(code));
 }
 
@@ -144,7 +137,8 @@ ParsedLine parse_operator_line(std::string_view line, const proto::Profile& prof
   }
   if (verb == "set") {
     if (tokens.size() < 2)
-      return fail(end_column, "expected NAME=VALUE after set (names p, i, d, servo-zero)");
+      return fail(end_column,
+                  "expected NAME=VALUE after set (names " + kWr8SettingNames.list() + ")");
     op::SetSettings set;
     for (std::size_t i = 1; i < tokens.size(); ++i) {
       const std::string_view t = tokens[i].text;
@@ -153,9 +147,8 @@ ParsedLine parse_operator_line(std::string_view line, const proto::Profile& prof
         return fail(tokens[i].column, "expected NAME=VALUE, got '" + std::string(t) + "'");
       const auto code = proto::parse_setting(t.substr(0, eq));
       if (!code)
-        return fail(tokens[i].column,
-                    "expected a setting name (p, i, d, servo-zero or 0..3), got '" +
-                        std::string(t.substr(0, eq)) + "'");
+        return fail(tokens[i].column, "expected a setting name (" + kWr8SettingNames.list() +
+                                          " or 0..3), got '" + std::string(t.substr(0, eq)) + "'");
       const auto type = profile.setting_value_type[static_cast<std::size_t>(*code)];
       const auto w = proto::parse_value(t.substr(eq + 1), type);
       if (!w)
@@ -205,18 +198,8 @@ std::string ScriptError::to_string() const {
 
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile) {
-  Script script;
-  int number = 0;
-  for (const std::string_view line : split_lines(text)) {
-    ++number;
-    auto parsed = parse_operator_line(line, profile);
-    if (parsed.error) {
-      script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
-    } else if (parsed.action) {
-      script.steps.push_back({number, std::move(*parsed.action)});
-    }
-  }
-  return script;
+  return parse_script_lines<Script>(
+      text, file, [&](std::string_view line) { return parse_operator_line(line, profile); });
 }
 
 std::string refusal_text(Refusal refusal) {
@@ -321,23 +304,17 @@ void OperatorRunner::on_request(const RequestEvent& r) {
 }
 
 void OperatorRunner::on_event(Time, const Event& event) {
-  if (!current_) return;
-  std::visit(Overloaded{
-                 [&](const LoginEvent& e) { on_login(e); },
-                 [&](const LoginFailedEvent& e) { on_login_failed(e); },
-                 [&](const TelemetryEvent& e) {
-                   on_data("DATA " + std::string(proto::to_string(e.live.state)) + " at " +
-                           std::to_string(e.live.timestamp_ms) + " ms");
-                 },
-                 [&](const ConnectionEvent& e) { on_connection(e); },
-                 [&](const SettingsEvent& e) {
-                   RequestWait& wait = current_->pending;
-                   if (wait.coi && *wait.coi == e.coi) wait.settings = e.settings;
-                 },
-                 [&](const RequestEvent& r) { on_request(r); },
-                 [](const auto&) {},
-             },
-             event);
+  dispatch(event, Overloaded{
+                      [&](const TelemetryEvent& e) {
+                        on_data("DATA " + std::string(proto::to_string(e.live.state)) + " at " +
+                                std::to_string(e.live.timestamp_ms) + " ms");
+                      },
+                      [&](const SettingsEvent& e) {
+                        RequestWait& wait = current_->pending;
+                        if (wait.coi && *wait.coi == e.coi) wait.settings = e.settings;
+                      },
+                      [&](const RequestEvent& r) { on_request(r); },
+                  });
 }
 
 }  // namespace hil::client::wr8

@@ -89,6 +89,25 @@ struct Script {
   std::vector<ScriptError> errors;  ///< every bad line, in order
 };
 
+/// A script's lines read by `parse_line` (the ParseResult of one line) into
+/// `ScriptOf`, Script or its like for another vocabulary: each action with
+/// its line number, each bad line an error in `file`.
+template <class ScriptOf, class ParseLine>
+ScriptOf parse_script_lines(std::string_view text, const std::string& file, ParseLine parse_line) {
+  ScriptOf script;
+  int number = 0;
+  for (const std::string_view line : split_lines(text)) {
+    ++number;
+    auto parsed = parse_line(line);
+    if (parsed.error) {
+      script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
+    } else if (parsed.action) {
+      script.steps.push_back({number, std::move(*parsed.action)});
+    }
+  }
+  return script;
+}
+
 /// Parses a whole script; `file` names it in errors.
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile = proto::default_profile());

@@ -36,8 +36,6 @@ class Wr8Session
   SubmitResult set_settings(std::vector<proto::Setting> settings) {
     return feed([&](Time t) { return mutable_core().set_settings(t, std::move(settings)); });
   }
-
-  const std::shared_ptr<CommLog>& log() const { return core().log(); }
 };
 
 }  // namespace hil::client::wr8

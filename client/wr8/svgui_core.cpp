@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "base/enum_names.hpp"
 #include "client/common/operator_text.hpp"
 
 namespace hil::client::wr8 {
@@ -15,20 +16,14 @@ using svgui::Version;
 
 }  // namespace
 
+// The operator's words for the tasks a smart_vehicle_gui vehicle takes.
+constexpr auto kSvguiTaskWords = base::enum_names<proto::TaskCode>(
+    {proto::TaskCode::drive, "forward"}, {proto::TaskCode::turn, "wheels"},
+    {proto::TaskCode::blink, "signals"}, {proto::TaskCode::get_settings, "set-request"});
+
 std::string svgui_request_name(const RequestEvent& r) {
   if (r.kind == RequestKind::settings) return r.coi == 0 ? "set" : "settings";
-  switch (r.task) {
-    case proto::TaskCode::drive:
-      return "forward";
-    case proto::TaskCode::turn:
-      return "wheels";
-    case proto::TaskCode::blink:
-      return "signals";
-    case proto::TaskCode::get_settings:
-      return "set-request";
-    case proto::TaskCode::check:
-      break;
-  }
+  if (const auto word = kSvguiTaskWords.find(r.task)) return std::string(*word);
   return "task " + std::to_string(static_cast<int>(r.task));
 }
 
@@ -464,25 +459,20 @@ void SvguiClientCore::on_timer(Time now) {
 }
 
 std::optional<Time> SvguiClientCore::next_wakeup() const {
-  std::optional<Time> next;
-  auto take = [&next](Time t) {
-    if (!next || t < *next) next = t;
-  };
-  if (const auto due = connection_.reconnect().due()) take(*due);
-  if (const auto deadline = login_deadline()) take(*deadline);
-  if (state() != ConnectionState::connected) return next;
+  link::Earliest next = connection_wakeup();
+  if (state() != ConnectionState::connected) return next.time();
   for (const auto& p : pending_) {
-    if (p) take(p->deadline);
+    if (p) next.consider(p->deadline);
   }
-  if (set_pending_) take(set_pending_->deadline);
-  if (set_request_pending_) take(set_request_pending_->deadline);
+  if (set_pending_) next.consider(set_pending_->deadline);
+  if (set_request_pending_) next.consider(set_request_pending_->deadline);
   for (const DataStream stream : {DataStream::data, DataStream::high_freq, DataStream::low_freq}) {
     const Stream& s = streams_[index(stream)];
-    if (!s.stale && s.last) take(*s.last + stale_after(stream));
+    if (!s.stale && s.last) next.consider(*s.last + stale_after(stream));
   }
-  if (control_ && next_control_) take(*next_control_);
-  if (!outbox_.empty() && last_sent_) take(*last_sent_ + config_.send_gap);
-  return next;
+  if (control_) next.consider(next_control_);
+  if (!outbox_.empty() && last_sent_) next.consider(*last_sent_ + config_.send_gap);
+  return next.time();
 }
 
 }  // namespace hil::client::wr8

@@ -231,18 +231,8 @@ ParsedSvguiLine parse_svgui_line(std::string_view text, svgui::Version version) 
 }
 
 SvguiScript parse_svgui_script(std::string_view text, std::string file, svgui::Version version) {
-  SvguiScript script;
-  int number = 0;
-  for (const std::string_view line : split_lines(text)) {
-    ++number;
-    auto parsed = parse_svgui_line(line, version);
-    if (parsed.error) {
-      script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
-    } else if (parsed.action) {
-      script.steps.push_back({number, std::move(*parsed.action)});
-    }
-  }
-  return script;
+  return parse_script_lines<SvguiScript>(
+      text, file, [&](std::string_view line) { return parse_svgui_line(line, version); });
 }
 
 std::string format_set(const svgui::Set& set) {
@@ -402,10 +392,8 @@ void SvguiRunner::on_request(const RequestEvent& r) {
 }
 
 void SvguiRunner::on_event(Time, const SvguiEvent& event) {
-  if (!current_) return;
-  std::visit(Overloaded{
-                 [&](const LoginEvent& e) { on_login(e); },
-                 [&](const LoginFailedEvent& e) { on_login_failed(e); },
+  dispatch(
+      event, Overloaded{
                  [&](const DataEvent& e) {
                    on_data("DATA " + std::string(proto::to_string(e.data.state)) + " at " +
                            std::to_string(e.data.timestamp_ms) + " ms");
@@ -424,9 +412,7 @@ void SvguiRunner::on_event(Time, const SvguiEvent& event) {
                      finish(true, "connected; AUTH sent, its answer not awaited");
                  },
                  [&](const RequestEvent& r) { on_request(r); },
-                 [](const auto&) {},
-             },
-             event);
+             });
 }
 
 }  // namespace hil::client::wr8

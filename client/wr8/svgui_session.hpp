@@ -45,8 +45,6 @@ class SvguiSession : public ConnectingSession<SvguiClientCore, SvguiEvent, OpenC
   SubmitResult set_request() {
     return feed([&](Time t) { return mutable_core().set_request(t); });
   }
-
-  const std::shared_ptr<CommLog>& log() const { return core().log(); }
 };
 
 }  // namespace hil::client::wr8

@@ -1,12 +1,8 @@
 #include "link/capture/pcap.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cerrno>
 #include <cstring>
 #include <string_view>
 #include <utility>
@@ -89,12 +85,10 @@ std::shared_ptr<PcapWriter> PcapWriter::open(const std::filesystem::path& path, 
     ec = std::make_error_code(std::errc::invalid_argument);
     return nullptr;
   }
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    ec.assign(errno, std::generic_category());
-    return nullptr;
-  }
-  std::shared_ptr<PcapWriter> writer(new PcapWriter(fd, client, car, std::move(options)));
+  auto file = CaptureFile::open(path, CaptureFile::Mode::truncate, ec);
+  if (!file) return nullptr;
+  std::shared_ptr<PcapWriter> writer(
+      new PcapWriter(std::move(*file), client, car, std::move(options)));
   std::vector<std::uint8_t> header;
   put_native<std::uint32_t>(header, kMagicNanoseconds);
   put_native<std::uint16_t>(header, 2);  // version 2.4
@@ -103,25 +97,22 @@ std::shared_ptr<PcapWriter> PcapWriter::open(const std::filesystem::path& path, 
   put_native<std::uint32_t>(header, 0);  // accuracy, unused
   put_native<std::uint32_t>(header, kSnapLength);
   put_native<std::uint32_t>(header, kLinktypeRawIpv4);
-  writer->write_all(header.data(), header.size());
-  if (writer->error_) {
-    ec = writer->error_;
+  if (!writer->file_.write(header)) {
+    ec = writer->file_.error();
     return nullptr;
   }
   return writer;
 }
 
-PcapWriter::PcapWriter(int fd, std::uint32_t client_address, std::uint32_t car_address,
+PcapWriter::PcapWriter(CaptureFile file, std::uint32_t client_address, std::uint32_t car_address,
                        PcapOptions options)
-    : fd_(fd), options_(std::move(options)) {
+    : file_(std::move(file)), options_(std::move(options)) {
   if (!options_.wall_clock_us) options_.wall_clock_us = [] { return wall_time_us(); };
   client_.address = client_address;
   car_.address = car_address;
 }
 
-PcapWriter::~PcapWriter() {
-  if (fd_ >= 0) ::close(fd_);
-}
+PcapWriter::~PcapWriter() = default;
 
 void PcapWriter::begin(Time at) {
   // Link time gives the spacing (exact in virtual time), the wall clock at
@@ -235,21 +226,8 @@ void PcapWriter::write_segment(Time at, Side& from, const Side& to, std::uint8_t
   put_native<std::uint32_t>(record, static_cast<std::uint32_t>(packet.size()));
   put_native<std::uint32_t>(record, static_cast<std::uint32_t>(packet.size()));
   record.insert(record.end(), packet.begin(), packet.end());
-  write_all(record.data(), record.size());
-  if (!error_) ++packets_written_;
-}
-
-void PcapWriter::write_all(const std::uint8_t* data, std::size_t size) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd_, data, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      if (!error_) error_.assign(errno, std::generic_category());
-      return;
-    }
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
+  file_.write(record);
+  if (!file_.error()) ++packets_written_;
 }
 
 }  // namespace hil::link

@@ -12,6 +12,7 @@
 #include <string>
 #include <system_error>
 
+#include "link/capture/capture_file.hpp"
 #include "link/link.hpp"
 
 namespace hil::link {
@@ -62,7 +63,7 @@ class PcapWriter final : public LinkObserver {
   void on_close(Time at, const LinkClose& close) override;
 
   /// The first write error, if any.
-  std::error_code error() const { return error_; }
+  std::error_code error() const { return file_.error(); }
   std::uint64_t packets_written() const { return packets_written_; }
 
  private:
@@ -73,13 +74,13 @@ class PcapWriter final : public LinkObserver {
     std::uint16_t ip_id = 0;
   };
 
-  PcapWriter(int fd, std::uint32_t client_address, std::uint32_t car_address, PcapOptions options);
+  PcapWriter(CaptureFile file, std::uint32_t client_address, std::uint32_t car_address,
+             PcapOptions options);
   void begin(Time at);
   void write_segment(Time at, Side& from, const Side& to, std::uint8_t flags,
                      protocol::ByteView payload, bool announce_mss);
-  void write_all(const std::uint8_t* data, std::size_t size);
 
-  int fd_ = -1;
+  CaptureFile file_;
   PcapOptions options_;
   Side client_;
   Side car_;
@@ -88,7 +89,6 @@ class PcapWriter final : public LinkObserver {
   std::uint32_t connections_ = 0;
   std::int64_t base_wall_ns_ = 0;
   Time base_at_{0};
-  std::error_code error_;
   std::uint64_t packets_written_ = 0;
 };
 

@@ -1,9 +1,5 @@
 #include "link/capture/wire_log.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <fstream>
 #include <stdexcept>
 #include <utility>
@@ -91,17 +87,13 @@ protocol::Bytes bytes_of(const nlohmann::json& record) {
 
 std::shared_ptr<WireLog> WireLog::open(const std::filesystem::path& path, WireLogOptions options,
                                        std::error_code& ec) {
-  ec.clear();
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  if (fd < 0) {
-    ec.assign(errno, std::generic_category());
-    return nullptr;
-  }
-  return std::shared_ptr<WireLog>(new WireLog(path, fd, std::move(options)));
+  auto file = CaptureFile::open(path, CaptureFile::Mode::append, ec);
+  if (!file) return nullptr;
+  return std::shared_ptr<WireLog>(new WireLog(path, std::move(*file), std::move(options)));
 }
 
-WireLog::WireLog(std::filesystem::path path, int fd, WireLogOptions options)
-    : path_(std::move(path)), fd_(fd), options_(std::move(options)) {
+WireLog::WireLog(std::filesystem::path path, CaptureFile file, WireLogOptions options)
+    : path_(std::move(path)), file_(std::move(file)), options_(std::move(options)) {
   if (!options_.wall_clock_us) options_.wall_clock_us = [] { return wall_time_us(); };
   if (options_.protocol) {
     for (auto& kind : splitters_) {
@@ -111,9 +103,7 @@ WireLog::WireLog(std::filesystem::path path, int fd, WireLogOptions options)
   }
 }
 
-WireLog::~WireLog() {
-  if (fd_ >= 0) ::close(fd_);
-}
+WireLog::~WireLog() = default;
 
 nlohmann::ordered_json WireLog::record(const char* event, Time at) const {
   nlohmann::ordered_json r;
@@ -201,22 +191,11 @@ void WireLog::write_line(const nlohmann::ordered_json& record) {
   // but frame texts come from decoders: replace rather than throw.
   std::string line = record.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   line.push_back('\n');
-  // One write(2) per line on an O_APPEND descriptor: no user-space buffer
-  // to lose in a crash, and the kernel appends the whole line at the end of
-  // the file even when other links log to the same path.
-  const char* data = line.data();
-  std::size_t left = line.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd_, data, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      if (!error_) error_.assign(errno, std::generic_category());
-      return;
-    }
-    data += n;
-    left -= static_cast<std::size_t>(n);
-  }
-  ++records_written_;
+  // One write per line on a file opened to append: the kernel puts the
+  // whole line at the end of the file even when other links log to it.
+  if (file_.write(protocol::ByteView(reinterpret_cast<const std::uint8_t*>(line.data()),
+                                     line.size())))
+    ++records_written_;
 }
 
 std::shared_ptr<const ProtocolAdapter> adapter_of_log(const nlohmann::json& open_record) {

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "link/capture/capture_file.hpp"
 #include "link/link.hpp"
 
 namespace hil::link {
@@ -50,12 +51,12 @@ class WireLog final : public LinkObserver {
   void on_close(Time at, const LinkClose& close) override;
 
   /// The first write error, if any; later records are still attempted.
-  std::error_code error() const { return error_; }
+  std::error_code error() const { return file_.error(); }
   std::uint64_t records_written() const { return records_written_; }
   const std::filesystem::path& path() const { return path_; }
 
  private:
-  WireLog(std::filesystem::path path, int fd, WireLogOptions options);
+  WireLog(std::filesystem::path path, CaptureFile file, WireLogOptions options);
   // Ordered, so every line reads link, event, t_ms, wall_us first.
   nlohmann::ordered_json record(const char* event, Time at) const;
   void on_bytes(const char* event, std::size_t kind_index, Time at, Direction d,
@@ -63,13 +64,12 @@ class WireLog final : public LinkObserver {
   void write_line(const nlohmann::ordered_json& record);
 
   std::filesystem::path path_;
-  int fd_ = -1;
+  CaptureFile file_;
   WireLogOptions options_;
   // [0] sent, [1] delivered; each indexed by Direction. Separate splitters
   // because faults make the two streams differ (a fragment cut before a
   // fault must not glue onto bytes after it).
   std::unique_ptr<FrameSplitter> splitters_[2][2];
-  std::error_code error_;
   std::uint64_t records_written_ = 0;
 };
 

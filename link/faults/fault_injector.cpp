@@ -189,16 +189,13 @@ void FaultInjector::State::finish(Time now) {
 }
 
 std::optional<Time> FaultInjector::State::next_due() const {
-  std::optional<Time> next;
-  const auto consider = [&](std::optional<Time> t) {
-    if (t && (!next || *t < *next)) next = t;
-  };
-  consider(queue_.next_due());
-  consider(partial_release());
-  if (batch_) consider(batch_->deadline);
+  Earliest next;
+  next.consider(queue_.next_due());
+  next.consider(partial_release());
+  if (batch_) next.consider(batch_->deadline);
   // Once the sender has closed, timed rules no longer keep the link alive.
-  if (!broken_ && !finished_) consider(rules_.next_armed());
-  return next;
+  if (!broken_ && !finished_) next.consider(rules_.next_armed());
+  return next.time();
 }
 
 bool FaultInjector::State::refuse_connection(Time now) {

@@ -1,6 +1,5 @@
 #include "link/faults/profile_yaml.hpp"
 
-#include "base/duration.hpp"
 #include "config/yaml.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -67,22 +66,18 @@ std::set<std::string, std::less<>> keys_of(FaultKind kind) {
 }
 
 /// Reads one rule map, reporting every problem at the node it is about.
-class RuleReader {
+class RuleReader : config::ItemReader {
  public:
   RuleReader(const std::string& source, const YAML::Node& node, std::size_t index)
-      : source_(source), node_(node), prefix_("rule " + std::to_string(index)) {}
+      : ItemReader(source, node, "rule " + std::to_string(index), "this kind takes") {}
 
   FaultRule read() {
-    if (!node_.IsMap())
-      fail_at(source_, node_.Mark(), prefix_ + ": must be a map with at least 'kind'");
-    const YAML::Node kind_node = node_["kind"];
-    if (!kind_node) fail_at(source_, node_.Mark(), prefix_ + ": 'kind' is missing");
+    const YAML::Node kind_node = leading("kind");
     const auto kind = parse_fault_kind(scalar(kind_node, "kind"));
     if (!kind) {
       fail_at(source_, kind_node.Mark(),
-           prefix_ + ": unknown kind '" + kind_node.Scalar() +
-               "' (known: fragment, coalesce, corrupt, drop, duplicate, garbage, delay, stall, "
-               "bandwidth, disconnect, reset, refuse)");
+              prefix_ + ": unknown kind '" + kind_node.Scalar() +
+                  "' (known: " + kFaultKindNames.list() + ")");
     }
     prefix_ += " (" + std::string(to_string(*kind)) + ")";
     check_keys(keys_of(*kind));
@@ -95,52 +90,15 @@ class RuleReader {
     if (auto n = get("to")) {
       rule.window.to = duration(*n, "to");
       if (*rule.window.to <= rule.window.from)
-        fail_at(source_, n->Mark(), prefix_ + ": 'to' must be after 'from'");
+        bad(*n, "'to' must be after 'from'");
     }
     read_trigger(rule.trigger);
     read_action(rule.action);
-    if (auto problem = rule_problem(rule)) fail_at(source_, node_.Mark(), prefix_ + ": " + *problem);
+    if (auto problem = rule_problem(rule)) bad(node_, *problem);
     return rule;
   }
 
  private:
-  std::optional<YAML::Node> get(const char* key) const {
-    YAML::Node n = node_[key];
-    if (!n) return std::nullopt;
-    return n;
-  }
-
-  void check_keys(const std::set<std::string, std::less<>>& allowed) {
-    config::Reader(source_).check_keys(node_, config::Keys(allowed.begin(), allowed.end()),
-                                       prefix_, "this kind takes");
-  }
-
-  [[noreturn]] void bad(const YAML::Node& n, const std::string& what) {
-    fail_at(source_, n.Mark(), prefix_ + ": " + what);
-  }
-
-  std::string scalar(const YAML::Node& n, const char* key) {
-    if (!n.IsScalar()) bad(n, "'" + std::string(key) + "' must be a single value");
-    return n.Scalar();
-  }
-
-  std::uint64_t count(const YAML::Node& n, const char* key, std::uint64_t min = 1) {
-    const auto v = config::parse_whole(scalar(n, key));
-    if (!v || *v < min) {
-      bad(n, "'" + std::string(key) + "' must be a whole number >= " + std::to_string(min));
-    }
-    return *v;
-  }
-
-  Duration duration(const YAML::Node& n, const char* key) {
-    const auto d = parse_duration(scalar(n, key));
-    if (!d) {
-      bad(n, "'" + std::string(key) +
-                 "' must be a duration with a unit, like 250ms or 1.5s (units: ns, us, ms, s)");
-    }
-    return *d;
-  }
-
   ByteCountRange byte_range(const YAML::Node& n, const char* key) {
     const std::string expected =
         "'" + std::string(key) + "' must be [min, max] with 1 <= min <= max, or one number";
@@ -178,11 +136,9 @@ class RuleReader {
   }
 
   DirectionFilter direction(const YAML::Node& n) {
-    const std::string text = scalar(n, "direction");
-    if (text == "to_car") return DirectionFilter::to_car;
-    if (text == "to_client") return DirectionFilter::to_client;
-    if (text == "both") return DirectionFilter::both;
-    bad(n, "'direction' must be to_car, to_client or both");
+    const auto filter = kDirectionFilterNames.parse(scalar(n, "direction"));
+    if (!filter) bad(n, "'direction' must be " + kDirectionFilterNames.list(" or "));
+    return *filter;
   }
 
   void read_trigger(Trigger& t) {
@@ -251,16 +207,9 @@ class RuleReader {
       a.target = CorruptTarget::field;
     }
     if (auto n = get("target")) {
-      const std::string t = scalar(*n, "target");
-      if (t == "checksum") {
-        a.target = CorruptTarget::checksum;
-      } else if (t == "field") {
-        a.target = CorruptTarget::field;
-      } else if (t == "random") {
-        a.target = CorruptTarget::random;
-      } else {
-        bad(*n, "'target' must be checksum, field or random");
-      }
+      const auto target = kCorruptTargetNames.parse(scalar(*n, "target"));
+      if (!target) bad(*n, "'target' must be " + kCorruptTargetNames.list(" or "));
+      a.target = *target;
       if (a.target == CorruptTarget::field && a.field.empty())
         bad(*n, "target 'field' needs 'field: NAME'");
       if (a.target != CorruptTarget::field && !a.field.empty()) {
@@ -333,10 +282,6 @@ class RuleReader {
     if (d <= Duration{0}) bad(*n, "'" + std::string(key) + "' must be a positive duration");
     return d;
   }
-
-  const std::string& source_;
-  const YAML::Node& node_;
-  std::string prefix_;
 };
 
 }  // namespace
@@ -350,8 +295,8 @@ FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& sour
       const std::string key = key_node.IsScalar() ? key_node.Scalar() : std::string{};
       if (key != "rules" && key != "description") {
         fail_at(source_name, key_node.Mark(),
-             "unknown key '" + key +
-                 "' (a fault profile has 'rules' and an optional 'description')");
+                "unknown key '" + key +
+                    "' (a fault profile has 'rules' and an optional 'description')");
       }
     }
     // A const lookup, and reset() rather than operator=: assigning to a

@@ -1,6 +1,7 @@
 #include "protocol/logi/codec.hpp"
 
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -102,19 +103,21 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
       out = value == "1";
       return true;
     };
+    // A decimal of at most `digits` digits and at most `max`, signed when `allow_sign`.
+    const auto whole = [&](int& out, bool allow_sign, std::size_t digits = 9,
+                           long long max = std::numeric_limits<long long>::max()) {
+      const auto v = parse_decimal(value, allow_sign, false, digits);
+      if (!v || *v > max) return false;
+      out = static_cast<int>(*v);
+      return true;
+    };
     switch (k) {
-      case kSp: {
-        const auto v = parse_decimal(value, false, false, 3);
-        if (!v || *v > 100) return bad("speed percent 0..100");
-        s.speed_percent = static_cast<int>(*v);
+      case kSp:
+        if (!whole(s.speed_percent, false, 3, 100)) return bad("speed percent 0..100");
         break;
-      }
-      case kSta: {
-        const auto v = parse_decimal(value, false, false, 3);
-        if (!v) return bad("station 0..999");
-        s.station = static_cast<int>(*v);
+      case kSta:
+        if (!whole(s.station, false, 3)) return bad("station 0..999");
         break;
-      }
       case kRun:
         if (!flag(s.running)) return bad("0 or 1");
         break;
@@ -130,12 +133,9 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
         s.manual = *d;
         break;
       }
-      case kDis: {
-        const auto v = parse_decimal(value, false);
-        if (!v) return bad("distance in whole cm");
-        s.distance_cm = static_cast<int>(*v);
+      case kDis:
+        if (!whole(s.distance_cm, false)) return bad("distance in whole cm");
         break;
-      }
       case kTrk: {
         if (value.size() != 4 || value.find_first_not_of("01") != std::string_view::npos) {
           return bad("four 0/1 channels H4H3H2H1");
@@ -145,12 +145,9 @@ std::variant<Message, PayloadError> parse_status(std::string_view body) {
           s.track_mask = static_cast<std::uint8_t>((s.track_mask << 1) | (c - '0'));
         break;
       }
-      case kDev: {
-        const auto v = parse_decimal(value, true);
-        if (!v) return bad("signed integer deviation");
-        s.deviation = static_cast<int>(*v);
+      case kDev:
+        if (!whole(s.deviation, true)) return bad("signed integer deviation");
         break;
-      }
       case kObs:
         if (!flag(s.obstacle)) return bad("0 or 1");
         break;

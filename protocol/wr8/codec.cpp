@@ -4,7 +4,9 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
+#include <variant>
 
 #include "protocol/common/overloaded.hpp"
 
@@ -185,19 +187,34 @@ struct Packet {
     }
     return std::nullopt;
   }
+  /// How many entries of `entry_bytes` the block after the size byte at
+  /// `at` holds, the block ending the packet; or the error: the packet ends
+  /// before the size byte, a size in bytes is no multiple of `entry_bytes`
+  /// (`entry_note` adds what an entry is), or the length does not match.
+  std::variant<std::size_t, Item> block_entries(const Profile& profile, std::size_t at,
+                                                std::size_t entry_bytes,
+                                                std::string_view entry_note = {}) const {
+    if (raw.size() < at + 1) return *length_error(at + 1);
+    const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
+    const std::size_t size = raw[at];
+    if (in_bytes && size % entry_bytes != 0) {
+      return error(ErrorKind::bad_format, "parameter block size " + std::to_string(size) +
+                                              " (byte " + std::to_string(at) +
+                                              ") is not a multiple of " +
+                                              std::to_string(entry_bytes) + " bytes" +
+                                              std::string(entry_note));
+    }
+    const std::size_t count = in_bytes ? size / entry_bytes : size;
+    if (auto e = length_error(at + 1 + count * entry_bytes)) return *e;
+    return count;
+  }
 };
 
 Item decode_task(const Packet& p, const Profile& profile) {
   const ByteView raw = p.raw;
-  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
-  if (raw.size() < 4) return *p.length_error(4);
-  const std::size_t size = raw[3];
-  if (in_bytes && size % kWordBytes != 0) {
-    return p.error(ErrorKind::bad_format, "parameter block size " + std::to_string(size) +
-                                              " (byte 3) is not a multiple of 4 bytes");
-  }
-  const std::size_t count = in_bytes ? size / kWordBytes : size;
-  if (auto e = p.length_error(4 + count * kWordBytes)) return *e;
+  const auto entries = p.block_entries(profile, 3, kWordBytes);
+  if (const auto* e = std::get_if<Item>(&entries)) return *e;
+  const std::size_t count = std::get<std::size_t>(entries);
   const std::uint8_t t = raw[2];
   if (t >= kTaskCount) {
     return p.error(ErrorKind::unknown_code,
@@ -218,16 +235,10 @@ Item decode_task(const Packet& p, const Profile& profile) {
 
 Item decode_settings(const Packet& p, const Profile& profile) {
   const ByteView raw = p.raw;
-  const bool in_bytes = profile.block_unit == BlockSizeUnit::bytes;
-  if (raw.size() < 3) return *p.length_error(3);
-  const std::size_t size = raw[2];
-  if (in_bytes && size % kSettingEntryBytes != 0) {
-    return p.error(ErrorKind::bad_format,
-                   "parameter block size " + std::to_string(size) +
-                       " (byte 2) is not a multiple of 5 bytes (type byte + 4-byte value)");
-  }
-  const std::size_t count = in_bytes ? size / kSettingEntryBytes : size;
-  if (auto e = p.length_error(3 + count * kSettingEntryBytes)) return *e;
+  const auto entries =
+      p.block_entries(profile, 2, kSettingEntryBytes, " (type byte + 4-byte value)");
+  if (const auto* e = std::get_if<Item>(&entries)) return *e;
+  const std::size_t count = std::get<std::size_t>(entries);
   Settings m{raw[1], {}};
   for (std::size_t i = 0; i < count; ++i) {
     const std::size_t at = 3 + i * kSettingEntryBytes;
