@@ -1,7 +1,9 @@
 #pragma once
 // What the client programs' tests share: `hil mock` in the background with
 // its TCP port or pty read from its output, a temporary folder per test,
-// files read back, and a program run to its exit. Every wait is bounded.
+// files read back, a program run to its exit or waited on line by line,
+// and the fixture that holds a client's mock car and folder. Every wait is
+// bounded.
 
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -18,20 +20,12 @@
 #include <string>
 #include <vector>
 
+#include "link/endpoint.hpp"
 #include "tests/apps/hil_cli_support.hpp"
+#include "tests/harness/scratch_dir.hpp"
+#include "tests/support/text.hpp"
 
 namespace hil::test {
-
-inline std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-inline bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
 
 /// The records of a mock's NDJSON wire log (`hil mock --log`) that were
 /// delivered to the car, in order of arrival.
@@ -43,6 +37,12 @@ inline std::vector<std::string> delivered_to_car(const std::string& wire_log_tex
     if (contains(line, R"("event":"delivered")") && contains(line, R"("dir":"to_car")"))
       out.push_back(line);
   return out;
+}
+
+/// What a client takes `--port <path>` for: the serial device at `path`
+/// at `baud`.
+inline link::Endpoint serial_endpoint(std::string path, unsigned baud) {
+  return link::PtyEndpoint{std::move(path), baud, link::Duration{0}};
 }
 
 /// A TCP port nobody listens on: bound by the kernel's choice, then released.
@@ -62,34 +62,19 @@ inline std::string free_tcp_port() {
 /// A fresh folder for one test's files, removed with everything in it.
 class TempDir {
  public:
-  explicit TempDir(const std::string& prefix = "hil-client-test") {
-    static int counter = 0;
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            (prefix + "-" + std::to_string(::getpid()) + "-" +
-             (test != nullptr ? std::string(test->name()) + "-" : std::string()) +
-             std::to_string(counter++));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
+  explicit TempDir(const std::string& prefix = "hil-client-test") : dir_(prefix) {}
 
-  const std::filesystem::path& path() const { return path_; }
+  const std::filesystem::path& path() const { return dir_.path(); }
   /// The path of `name` in the folder.
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  std::string file(const std::string& name) const { return (path() / name).string(); }
   /// Writes `text` as `name` in the folder; its path.
   std::filesystem::path write(const std::string& name, const std::string& text) const {
-    std::ofstream(path_ / name, std::ios::binary) << text;
-    return path_ / name;
+    std::ofstream(path() / name, std::ios::binary) << text;
+    return path() / name;
   }
 
  private:
-  std::filesystem::path path_;
+  ScratchDir dir_;
 };
 
 /// `hil mock <car>` in the background, ready once it has named where it
@@ -115,7 +100,7 @@ class MockCar {
     return {};
   }
   HilProcess& process() { return process_; }
-  const std::string& output() const { return process_.output(); }
+  const std::string& output() { return process_.output(); }
   /// Ctrl-C; the mock's exit status (0 when it stopped cleanly).
   std::optional<int> stop() {
     stopped_ = true;
@@ -157,5 +142,95 @@ inline CommandResult run_to_exit(const std::string& program, const std::vector<s
   result.output = process.output();
   return result;
 }
+
+/// Waits up to `limit` for `process` to exit: a fatal failure when it is
+/// still running then, a failure when its status is not `expected`.
+inline void expect_exit_status(HilProcess& process, int expected,
+                               std::chrono::milliseconds limit = std::chrono::seconds(20)) {
+  const auto status = process.wait_exit(limit);
+  ASSERT_TRUE(status) << process.output();
+  EXPECT_EQ(*status, expected) << process.output();
+}
+
+/// Waits for a line containing each of `texts` in turn, each after the one
+/// before; a failure for each that does not come within `limit`.
+inline void expect_lines(HilProcess& process, const std::vector<std::string>& texts,
+                         std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+  for (const auto& text : texts)
+    EXPECT_TRUE(process.wait_for_line(text, limit)) << text << "\n" << process.output();
+}
+
+/// As expect_lines, but a fatal failure at the first line that does not come.
+inline void assert_lines(HilProcess& process, const std::vector<std::string>& texts,
+                         std::chrono::milliseconds limit = std::chrono::seconds(10)) {
+  for (const auto& text : texts)
+    ASSERT_TRUE(process.wait_for_line(text, limit)) << text << "\n" << process.output();
+}
+
+/// A client program's tests against one mock car: a scratch folder and,
+/// once a test starts it, `hil mock`, which must stop cleanly at the end.
+class ClientProgramTest : public ::testing::Test {
+ protected:
+  /// `program`: the client's path; `port`: what --port is given until a
+  /// mock on TCP names its own.
+  ClientProgramTest(std::string program, const std::string& temp_prefix, std::string port = {},
+                    std::chrono::milliseconds limit = std::chrono::seconds(30))
+      : program_(std::move(program)), limit_(limit), temp(temp_prefix), port(std::move(port)) {}
+
+  void TearDown() override {
+    if (mock) {
+      EXPECT_EQ(mock->stop(), 0) << mock->output();
+    }
+  }
+
+  /// Starts `hil mock` with `args`, ready once it prints `ready_text`; a
+  /// mock on TCP gives its port to the client.
+  void start_mock(std::vector<std::string> args, const std::string& ready_text = kTcpReady) {
+    mock.emplace(std::move(args), ready_text);
+    ASSERT_TRUE(mock->ready()) << mock->output();
+    if (ready_text != kTcpReady) return;
+    port = mock->port();
+    ASSERT_FALSE(port.empty()) << mock->output();
+  }
+
+  /// `--port PORT`, then `args`.
+  std::vector<std::string> on_port(std::vector<std::string> args) const {
+    args.insert(args.begin(), {"--port", port});
+    return args;
+  }
+
+  /// The client with `--port PORT` and `args`, run to its exit.
+  CommandResult client(std::vector<std::string> args) { return client(std::move(args), limit_); }
+  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit) {
+    return run_to_exit(program_, on_port(std::move(args)), limit);
+  }
+
+  std::filesystem::path write(const std::string& name, const std::string& text) {
+    return temp.write(name, text);
+  }
+
+  /// Runs the client with `args`, then `--script` and the path of `name`
+  /// holding `text`: it refuses the script with exit 2, naming its path and
+  /// then `says`. The client's output.
+  std::string expect_script_refused(const std::string& name, const std::string& text,
+                                    const std::string& says, std::vector<std::string> args = {}) {
+    const auto script = write(name, text);
+    args.insert(args.end(), {"--script", script.string()});
+    const auto r = client(std::move(args));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, script.string() + says)) << r.output;
+    return r.output;
+  }
+
+ private:
+  std::string program_;
+  std::chrono::milliseconds limit_;
+
+ protected:
+  TempDir temp;
+  std::filesystem::path dir = temp.path();
+  std::string port;
+  std::optional<MockCar> mock;
+};
 
 }  // namespace hil::test

@@ -1,11 +1,6 @@
 // hil mock as a desk user runs it: in the background, talked to over real
 // TCP and a real pty, stopped with Ctrl-C.
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -14,67 +9,26 @@
 #include <ctime>
 #include <filesystem>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
 #include "tests/apps/hil_cli_support.hpp"
+#include "tests/support/connection.hpp"
 
 namespace hil::test {
 namespace {
 
 using namespace std::chrono_literals;
 
-// A file descriptor the test reads with bounded waits.
-class Fd {
- public:
-  explicit Fd(int fd) : fd_(fd) {}
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  bool ok() const { return fd_ >= 0; }
-  void send(const std::string& text) {
-    ASSERT_EQ(::write(fd_, text.data(), text.size()), static_cast<ssize_t>(text.size()));
-  }
-  /// Reads until `text` has arrived (true) or `limit` passed or the peer closed.
-  bool read_until(const std::string& text, std::chrono::milliseconds limit = 10s) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (received.find(text) == std::string::npos) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-          deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0) return false;
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) return false;
-      char buf[512];
-      const ssize_t n = ::read(fd_, buf, sizeof buf);
-      if (n <= 0) return false;
-      received.append(buf, static_cast<std::size_t>(n));
-    }
-    return true;
-  }
-  std::string received;
-
- private:
-  int fd_;
-};
-
-int port_in(const std::string& line) {
-  std::smatch m;
-  if (!std::regex_search(line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) return -1;
-  return std::stoi(m[1]);
-}
-
 TEST(HilMock, LogiCarAnswersOverTcpAndStopsCleanlyOnCtrlC) {
   HilProcess mock({"mock", "logi", "--port", "0", "--seed", "7"});
   ASSERT_TRUE(mock.started());
-  const auto line = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << mock.output();
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
   EXPECT_NE(mock.output().find("seed 7 (replay with --seed 7)"), std::string::npos);
-  Fd client(connect_loopback(port_in(*line)));
+  Conn client = tcp_connect(port);
   ASSERT_TRUE(client.ok());
-  client.send("LOGI:SP:050:D7#");
+  ASSERT_TRUE(client.send("LOGI:SP:050:D7#"));
   EXPECT_TRUE(client.read_until("FB:SP:1")) << client.received;
   EXPECT_TRUE(client.read_until("STAT:SP:050")) << client.received;
   EXPECT_TRUE(mock.wait_for_line("client connected")) << mock.output();
@@ -89,17 +43,18 @@ TEST(HilMock, LogiCarAnswersOverTcpAndStopsCleanlyOnCtrlC) {
 
 TEST(HilMock, CountRunsIndependentCarsAndASecondClientIsTurnedAway) {
   HilProcess mock({"mock", "logi", "--port", "0", "--count", "2"});
-  const auto first = mock.wait_for_line("car0 connect to");
-  const auto second = mock.wait_for_line("car1 connect to");
-  ASSERT_TRUE(first && second) << mock.output();
-  ASSERT_NE(port_in(*first), port_in(*second));
-  Fd a(connect_loopback(port_in(*first)));
-  Fd b(connect_loopback(port_in(*second)));
-  a.send("LOGI:MD:MAN:0C#");
-  b.send("LOGI:MD:MAN:0C#");
+  int first = -1;
+  int second = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, first, "car0 connect to"));
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, second, "car1 connect to"));
+  ASSERT_NE(first, second);
+  Conn a = tcp_connect(first);
+  Conn b = tcp_connect(second);
+  ASSERT_TRUE(a.send("LOGI:MD:MAN:0C#"));
+  ASSERT_TRUE(b.send("LOGI:MD:MAN:0C#"));
   EXPECT_TRUE(a.read_until("FB:MD:1"));
   EXPECT_TRUE(b.read_until("FB:MD:1"));
-  Fd extra(connect_loopback(port_in(*first)));
+  Conn extra = tcp_connect(first);
   ASSERT_TRUE(extra.ok());
   EXPECT_FALSE(extra.read_until("LOGI", 3s));  // closed by the car with no byte
   EXPECT_TRUE(extra.received.empty());
@@ -114,7 +69,7 @@ struct ArduinoOnPty {
       : path(make_dir(dir) + "/robot0"),
         mock(command(args, path)),
         listening(mock.wait_for_line("as a serial port at 9600 baud")),
-        port(listening ? ::open(path.c_str(), O_RDWR | O_NOCTTY) : -1) {}
+        port(listening ? pty_open(path) : Conn()) {}
   ~ArduinoOnPty() { std::filesystem::remove_all(dir); }
   ArduinoOnPty(const ArduinoOnPty&) = delete;
   ArduinoOnPty& operator=(const ArduinoOnPty&) = delete;
@@ -131,95 +86,103 @@ struct ArduinoOnPty {
     return all;
   }
 
+  /// The robot said where it listens and its port is open.
+  void expect_ready() {
+    ASSERT_TRUE(listening) << mock.output();
+    EXPECT_NE(listening->find(path), std::string::npos);
+    ASSERT_TRUE(port.ok());
+  }
+
   std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("hil-mock-ard-" + std::to_string(::getpid()));
   std::string path;
   HilProcess mock;
   std::optional<std::string> listening;
-  Fd port;
+  Conn port;
 };
 
-TEST(HilMock, ArduinoRobotAnswersOnAPty) {
-  ArduinoOnPty robot({});
-  ASSERT_TRUE(robot.listening) << robot.mock.output();
-  EXPECT_NE(robot.listening->find(robot.path), std::string::npos);
-  ASSERT_TRUE(robot.port.ok());
-  // The real client's PING (one space for no argument), answered as the
-  // real sketch answers it: the default profile is the board people own.
-  robot.port.send("^01|PING| *31$");
-  EXPECT_TRUE(robot.port.read_until("^01|ACK|PONG*")) << robot.port.received;
+/// A profile of the robot and how it answers: each request sent in turn
+/// and the answer waited for.
+struct ArduinoAnswers {
+  const char* name;
+  std::vector<std::string> args;
+  std::vector<std::pair<std::string, std::string>> exchanges;
+};
+
+class HilMockArduino : public ::testing::TestWithParam<ArduinoAnswers> {};
+
+TEST_P(HilMockArduino, RobotAnswersOnAPty) {
+  ArduinoOnPty robot(GetParam().args);
+  ASSERT_NO_FATAL_FAILURE(robot.expect_ready());
+  for (const auto& [request, answer] : GetParam().exchanges) {
+    ASSERT_TRUE(robot.port.send(request));
+    EXPECT_TRUE(robot.port.read_until(answer)) << request << ": " << robot.port.received;
+  }
   EXPECT_EQ(robot.mock.interrupt(), 0);
 }
 
-// --profile firmware plays the real sketch: the README's empty-payload PING
-// is refused as the board refuses it, and the real client's one-space PING
-// is answered PONG (arduino.ino at 8dcfab0); --profile readme takes it.
-TEST(HilMock, ArduinoFirmwareProfileAnswersAsTheRealSketch) {
-  ArduinoOnPty robot({"--profile", "firmware"});
-  ASSERT_TRUE(robot.listening) << robot.mock.output();
-  ASSERT_TRUE(robot.port.ok());
-  robot.port.send("^01|PING|*11$");
-  EXPECT_TRUE(robot.port.read_until("^01|NACK|BAD_FMT*41$")) << robot.port.received;
-  robot.port.send("^02|PING| *32$");
-  EXPECT_TRUE(robot.port.read_until("^02|ACK|PONG*5D$")) << robot.port.received;
-  EXPECT_EQ(robot.mock.interrupt(), 0);
-}
-
-TEST(HilMock, ArduinoReadmeProfileAnswersTheReadmesFrames) {
-  ArduinoOnPty robot({"--profile", "readme"});
-  ASSERT_TRUE(robot.listening) << robot.mock.output();
-  ASSERT_TRUE(robot.port.ok());
-  robot.port.send("^01|PING|*11$");
-  EXPECT_TRUE(robot.port.read_until("^01|ACK|OK*4C$")) << robot.port.received;
-  EXPECT_EQ(robot.mock.interrupt(), 0);
-}
+INSTANTIATE_TEST_SUITE_P(
+    Profiles, HilMockArduino,
+    ::testing::Values(
+        // The real client's PING (one space for no argument), answered as the
+        // real sketch answers it: the default profile is the board people own.
+        ArduinoAnswers{"Default", {}, {{"^01|PING| *31$", "^01|ACK|PONG*"}}},
+        // --profile firmware plays the real sketch: the README's
+        // empty-payload PING is refused as the board refuses it, and the
+        // real client's one-space PING is answered PONG (arduino.ino at
+        // 8dcfab0).
+        ArduinoAnswers{
+            "Firmware",
+            {"--profile", "firmware"},
+            {{"^01|PING|*11$", "^01|NACK|BAD_FMT*41$"}, {"^02|PING| *32$", "^02|ACK|PONG*5D$"}}},
+        // --profile readme takes the README's PING.
+        ArduinoAnswers{"Readme", {"--profile", "readme"}, {{"^01|PING|*11$", "^01|ACK|OK*4C$"}}}),
+    [](const ::testing::TestParamInfo<ArduinoAnswers>& info) { return info.param.name; });
 
 // --reply-latency holds each answer back by the firmware's processing
 // time; real time, so only the lower bound is checked.
 TEST(HilMock, AReplyLatencyHoldsTheAnswerBackAtLeastThatLong) {
   ArduinoOnPty robot({"--reply-latency", "300ms"});
-  ASSERT_TRUE(robot.listening) << robot.mock.output();
-  ASSERT_TRUE(robot.port.ok());
+  ASSERT_NO_FATAL_FAILURE(robot.expect_ready());
   const auto sent = std::chrono::steady_clock::now();
-  robot.port.send("^01|PING| *31$");
+  ASSERT_TRUE(robot.port.send("^01|PING| *31$"));
   ASSERT_TRUE(robot.port.read_until("^01|ACK|PONG*5E$")) << robot.port.received;
   EXPECT_GE(std::chrono::steady_clock::now() - sent, std::chrono::milliseconds(300));
   EXPECT_EQ(robot.mock.interrupt(), 0);
 }
 
-TEST(HilMock, AReplyLatencyWithoutAUnitIsRefused) {
-  HilProcess mock({"mock", "arduino", "--reply-latency", "20", "--pty", "/tmp/hil-unused-ard"});
+/// `hil mock ARGS` refuses to start: exit 2, saying `says`.
+void expect_refused(const std::vector<std::string>& args, const std::string& says) {
+  HilProcess mock(args);
   EXPECT_EQ(mock.wait_exit(), 2) << mock.output();
-  EXPECT_NE(mock.output().find("--reply-latency must be a duration with a unit (20ms, 1.5s), got "
-                               "'20'"),
-            std::string::npos)
-      << mock.output();
+  EXPECT_NE(mock.output().find(says), std::string::npos) << mock.output();
+}
+
+TEST(HilMock, AReplyLatencyWithoutAUnitIsRefused) {
+  expect_refused({"mock", "arduino", "--reply-latency", "20", "--pty", "/tmp/hil-unused-ard"},
+                 "--reply-latency must be a duration with a unit (20ms, 1.5s), got '20'");
 }
 
 TEST(HilMock, AnUnknownProfileIsRefusedWithTheCarsProfiles) {
-  HilProcess mock({"mock", "leka", "--profile", "firmware", "--pty", "/tmp/hil-unused-leka"});
-  EXPECT_EQ(mock.wait_exit(), 2) << mock.output();
-  EXPECT_NE(mock.output().find("leka has no profile 'firmware'; its profiles are readme (the "
-                               "default)"),
-            std::string::npos)
-      << mock.output();
+  expect_refused({"mock", "leka", "--profile", "firmware", "--pty", "/tmp/hil-unused-leka"},
+                 "leka has no profile 'firmware'; its profiles are readme (the default)");
 }
 
 TEST(HilMock, Wr8VehicleAuthenticatesWithTheConfiguredString) {
   HilProcess mock({"mock", "wr8", "--port", "0", "--auth", "0123456789"});
-  const auto line = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << mock.output();
-  Fd client(connect_loopback(port_in(*line)));
-  client.send(std::string("\x01") + "0123456789");
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  Conn client = tcp_connect(port);
+  ASSERT_TRUE(client.send(std::string("\x01") + "0123456789"));
   ASSERT_TRUE(client.read_until(std::string("\x02", 1))) << client.received.size();
   EXPECT_EQ(mock.interrupt(), 0);
 }
 
 TEST(HilMock, Wr8SvguiHeadStreamsDataStampedWithTheTimeOfDayAndAnswersTheRealGuisLogin) {
   HilProcess mock({"mock", "wr8", "--profile", "svgui-head", "--port", "0"});
-  const auto line = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << mock.output();
-  Fd client(connect_loopback(port_in(*line)));
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  Conn client = tcp_connect(port);
   // HIGH-FREQ DATA flows before any login: length byte 0x41, code 9, then
   // the big-endian milliseconds since local midnight.
   const std::string high_freq("\x41\x09", 2);
@@ -242,25 +205,23 @@ TEST(HilMock, Wr8SvguiHeadStreamsDataStampedWithTheTimeOfDayAndAnswersTheRealGui
   EXPECT_LT(std::min(off, day_ms - off), 10'000) << stamp << " vs " << local_ms;
   // The head GUI's AUTH is answered with the fixed AUTH-REPLY.
   client.received.clear();
-  client.send(std::string("\x0C\x01konnichiwa", 12) + std::string(1, '\0'));
+  ASSERT_TRUE(client.send(std::string("\x0C\x01konnichiwa", 12) + std::string(1, '\0')));
   EXPECT_TRUE(client.read_until(std::string("\x04\x02\x01\x02\x03", 5))) << client.received.size();
   EXPECT_EQ(mock.interrupt(), 0);
 }
 
 TEST(HilMock, Wr8SvguiHeadKeepsItsDataRates) {
-  const auto r = run_hil("mock wr8 --profile svgui-head --data-hz 5");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("svgui-head vehicle sends HIGH-FREQ DATA every 50 ms"), std::string::npos)
-      << r.output;
+  expect_run(says("mock wr8 --profile svgui-head --data-hz 5", 2,
+                  {"svgui-head vehicle sends HIGH-FREQ DATA every 50 ms"}));
 }
 
 TEST(HilMock, DeskCommandsDropAParcelThatLocksTheCarAndTakeItAway) {
   HilProcess mock({"mock", "logi", "--port", "0", "--commands"});
-  const auto line = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << mock.output();
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
   ASSERT_TRUE(mock.wait_for_line("type 'help' for desk commands"));
-  Fd client(connect_loopback(port_in(*line)));
-  client.send("LOGI:MD:MAN:0C#LOGI:MV:FWD:23#");
+  Conn client = tcp_connect(port);
+  ASSERT_TRUE(client.send("LOGI:MD:MAN:0C#LOGI:MV:FWD:23#"));
   ASSERT_TRUE(client.read_until("FB:MV:1")) << client.received;
   ASSERT_TRUE(mock.write_stdin("obstacle 10\n"));
   EXPECT_TRUE(mock.wait_for_line("car0: parcel dropped 10 cm ahead")) << mock.output();
@@ -279,31 +240,25 @@ TEST(HilMock, DeskCommandsDropAParcelThatLocksTheCarAndTakeItAway) {
 }
 
 TEST(HilMock, BadInputIsAClearError) {
-  const auto world = run_hil("mock logi --world tests/apps/data/bad-world.yaml");
-  EXPECT_EQ(world.exit_code, 1);
-  EXPECT_NE(world.output.find("hil mock: tests/apps/data/bad-world.yaml:"), std::string::npos)
-      << world.output;
-  const auto auth = run_hil("mock wr8 --auth short");
-  EXPECT_EQ(auth.exit_code, 2);
-  EXPECT_NE(auth.output.find("--auth must be exactly 10 characters, got 5"), std::string::npos)
-      << auth.output;
-  const auto car = run_hil("mock tesla");
-  EXPECT_EQ(car.exit_code, 2);
-  const auto behaviours = run_hil("mock logi --behaviours /nonexistent.yaml");
-  EXPECT_EQ(behaviours.exit_code, 1);
-  EXPECT_NE(behaviours.output.find("/nonexistent.yaml: cannot read the file"), std::string::npos)
-      << behaviours.output;
+  for (const CliRun& run : {
+           says("mock logi --world tests/apps/data/bad-world.yaml", 1,
+                {"hil mock: tests/apps/data/bad-world.yaml:"}),
+           says("mock wr8 --auth short", 2, {"--auth must be exactly 10 characters, got 5"}),
+           says("mock tesla", 2, {}),
+           says("mock logi --behaviours /nonexistent.yaml", 1,
+                {"/nonexistent.yaml: cannot read the file"}),
+       })
+    expect_run(run);
 }
 
 TEST(HilMock, APortInUseIsReportedWithTheFix) {
   HilProcess first({"mock", "logi", "--port", "0"});
-  const auto line = first.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(line) << first.output();
-  const auto second = run_hil("mock logi --port " + std::to_string(port_in(*line)));
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(first, port));
+  const auto second = run_hil("mock logi --port " + std::to_string(port));
   EXPECT_EQ(second.exit_code, 1);
-  EXPECT_NE(
-      second.output.find("cannot listen on tcp://127.0.0.1:" + std::to_string(port_in(*line))),
-      std::string::npos)
+  EXPECT_NE(second.output.find("cannot listen on tcp://127.0.0.1:" + std::to_string(port)),
+            std::string::npos)
       << second.output;
   EXPECT_NE(second.output.find("choose another --port"), std::string::npos);
   EXPECT_EQ(first.interrupt(), 0);

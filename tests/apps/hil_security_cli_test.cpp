@@ -3,8 +3,6 @@
 // shows every program a scenario starts, keeps scenario paths inside the
 // scenario's library and writes its JUnit file whole.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -15,11 +13,12 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <regex>
 #include <string>
 
 #include "tests/apps/hil_cli_support.hpp"
+#include "tests/harness/scratch_dir.hpp"
+#include "tests/support/text.hpp"
 
 namespace hil::test {
 namespace {
@@ -32,27 +31,40 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------- listeners
 
+/// Checks that `process` started and said a line containing `text`, and
+/// that the line holds `holds`; the line in `line` when given.
+void expect_says(HilProcess& process, const std::string& text, const std::string& holds,
+                 std::string* line = nullptr) {
+  ASSERT_TRUE(process.started());
+  const auto said = process.wait_for_line(text);
+  ASSERT_TRUE(said) << process.output();
+  EXPECT_THAT(*said, HasSubstr(holds));
+  if (line != nullptr) *line = *said;
+}
+
+/// A listener bound to every interface warns on its start, naming the
+/// address, and stops cleanly on Ctrl-C.
+void expect_warns_of_every_interface(HilProcess& process) {
+  ASSERT_NO_FATAL_FAILURE(
+      expect_says(process, "reachable from other machines", "warning: listening on 0.0.0.0"));
+  EXPECT_EQ(process.interrupt(), 0) << process.output();
+}
+
 TEST(DefaultBind, MockTcpCarsListenOnLoopbackOnlyAndSayNothingAboutTheNetwork) {
   for (const std::string car : {"logi", "wr8"}) {
+    SCOPED_TRACE(car);
     HilProcess mock({"mock", car, "--port", "0", "--no-status"});
-    ASSERT_TRUE(mock.started());
-    const auto line = mock.wait_for_line("connect to tcp://");
-    ASSERT_TRUE(line) << car << ": " << mock.output();
-    EXPECT_THAT(*line, HasSubstr("connect to tcp://127.0.0.1:")) << car;
+    ASSERT_NO_FATAL_FAILURE(expect_says(mock, "connect to tcp://", "connect to tcp://127.0.0.1:"));
     ASSERT_TRUE(mock.wait_for_line("Ctrl-C stops")) << mock.output();
-    EXPECT_THAT(mock.output(), Not(HasSubstr("reachable from other machines"))) << car;
+    EXPECT_THAT(mock.output(), Not(HasSubstr("reachable from other machines")));
     // Ctrl-C right after start-up is caught like any later one.
-    EXPECT_EQ(mock.interrupt(), 0) << car << ": " << mock.output();
+    EXPECT_EQ(mock.interrupt(), 0) << mock.output();
   }
 }
 
 TEST(DefaultBind, AMockBoundToEveryInterfaceWarnsNamingTheAddress) {
   HilProcess mock({"mock", "logi", "--port", "0", "--bind", "0.0.0.0", "--no-status"});
-  ASSERT_TRUE(mock.started());
-  const auto line = mock.wait_for_line("reachable from other machines");
-  ASSERT_TRUE(line) << mock.output();
-  EXPECT_THAT(*line, HasSubstr("warning: listening on 0.0.0.0"));
-  EXPECT_EQ(mock.interrupt(), 0) << mock.output();
+  ASSERT_NO_FATAL_FAILURE(expect_warns_of_every_interface(mock));
   // On stderr, where warnings are looked for: stdout alone does not carry it.
   const std::string hil = HIL_BINARY;
   HilProcess stdout_only(
@@ -65,20 +77,14 @@ TEST(DefaultBind, AMockBoundToEveryInterfaceWarnsNamingTheAddress) {
 
 TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
   HilProcess mock({"mock", "logi", "--port", "0", "--view", "0", "--no-status"});
-  ASSERT_TRUE(mock.started());
-  const auto line = mock.wait_for_line("view: ");
-  ASSERT_TRUE(line) << mock.output();
-  EXPECT_THAT(*line, HasSubstr("view: http://127.0.0.1:"));
+  std::string line;
+  ASSERT_NO_FATAL_FAILURE(expect_says(mock, "view: ", "view: http://127.0.0.1:", &line));
   // The page answers there (and the server is up before Ctrl-C comes).
   std::smatch port;
-  ASSERT_TRUE(std::regex_search(*line, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(std::stoi(port[1])));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_TRUE(std::regex_search(line, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
+  const int fd = connect_loopback(std::stoi(port[1]));
+  ASSERT_GE(fd, 0);
   const std::string request = "GET / HTTP/1.0\r\n\r\n";
-  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
   ASSERT_EQ(::write(fd, request.data(), request.size()), static_cast<ssize_t>(request.size()));
   char reply[16] = {};
   EXPECT_GT(::read(fd, reply, sizeof reply - 1), 0);
@@ -90,20 +96,14 @@ TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
 TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
   {
     HilProcess proxy({"proxy", "--listen", "tcp://127.0.0.1:0", "--upstream", "tcp://127.0.0.1:9"});
-    ASSERT_TRUE(proxy.started());
-    const auto line = proxy.wait_for_line("clients connect to");
-    ASSERT_TRUE(line) << proxy.output();
-    EXPECT_THAT(*line, HasSubstr("clients connect to tcp://127.0.0.1:"));
+    ASSERT_NO_FATAL_FAILURE(
+        expect_says(proxy, "clients connect to", "clients connect to tcp://127.0.0.1:"));
     EXPECT_THAT(proxy.output(), Not(HasSubstr("reachable from other machines")));
     // Ctrl-C right after start-up is caught like any later one.
     EXPECT_EQ(proxy.interrupt(), 0) << proxy.output();
   }
   HilProcess proxy({"proxy", "--listen", "tcp://0.0.0.0:0", "--upstream", "tcp://127.0.0.1:9"});
-  ASSERT_TRUE(proxy.started());
-  const auto line = proxy.wait_for_line("reachable from other machines");
-  ASSERT_TRUE(line) << proxy.output();
-  EXPECT_THAT(*line, HasSubstr("warning: listening on 0.0.0.0"));
-  EXPECT_EQ(proxy.interrupt(), 0) << proxy.output();
+  ASSERT_NO_FATAL_FAILURE(expect_warns_of_every_interface(proxy));
 }
 
 // ---------------------------------------------------------------- WR8 login
@@ -123,19 +123,22 @@ void fail_a_login(int port) {
   ::close(fd);
 }
 
+/// Waits for `hil mock wr8` to name its port, then fails a login there.
+void fail_a_login_once_listening(HilProcess& mock, int& port) {
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  fail_a_login(port);
+}
+
 TEST(Wr8Login, HilMockLogsFailedLoginsByCarWithoutTheStringAndSlowsEachRetry) {
   HilProcess mock({"mock", "wr8", "--port", "0", "--no-status"});
-  const auto listed = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(listed) << mock.output();
-  std::smatch port;
-  ASSERT_TRUE(std::regex_search(*listed, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
-  fail_a_login(std::stoi(port[1]));
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(fail_a_login_once_listening(mock, port));
   const auto first = mock.wait_for_line("login refused");
   ASSERT_TRUE(first) << mock.output();
   EXPECT_THAT(*first, HasSubstr("car0: wr8: login refused (AUTH **********)"));
   EXPECT_THAT(*first, HasSubstr("closing the connection in 1.000 s"));
   // A guesser's next try waits twice as long (the library keeps 1 s).
-  fail_a_login(std::stoi(port[1]));
+  fail_a_login(port);
   const auto second = mock.wait_for_line("login refused");
   ASSERT_TRUE(second) << mock.output();
   EXPECT_THAT(*second, HasSubstr("failed login 2 in a row"));
@@ -147,11 +150,8 @@ TEST(Wr8Login, HilMockLogsFailedLoginsByCarWithoutTheStringAndSlowsEachRetry) {
 
 TEST(Wr8Login, QuietMockSaysNothingAboutLogins) {
   HilProcess mock({"mock", "wr8", "--port", "0", "--no-status", "-q"});
-  const auto listed = mock.wait_for_line("connect to tcp://");
-  ASSERT_TRUE(listed) << mock.output();
-  std::smatch port;
-  ASSERT_TRUE(std::regex_search(*listed, port, std::regex(R"(127\.0\.0\.1:(\d+))")));
-  fail_a_login(std::stoi(port[1]));
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(fail_a_login_once_listening(mock, port));
   EXPECT_EQ(mock.interrupt(), 0);
   EXPECT_THAT(mock.output(), Not(HasSubstr("login refused")));
 }
@@ -168,19 +168,9 @@ TEST(Wr8Login, HilDecodeShowsTheBytesOfAnAuthButNotItsText) {
 /// A scratch scenario library: <tmp>/lib/logi/<name>.yaml and friends.
 class ScratchLibrary : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    tmp_ =
-        fs::temp_directory_path() / ("hil-sec-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(tmp_);
-    fs::create_directories(tmp_ / "lib" / "logi");
-  }
-  void TearDown() override { fs::remove_all(tmp_); }
-  static std::string read(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  }
-  fs::path tmp_;
+  void SetUp() override { fs::create_directories(tmp_ / "lib" / "logi"); }
+  ScratchDir dir_{"hil-sec"};
+  fs::path tmp_ = dir_.path();
 };
 
 const std::string kPass = std::string(HIL_SOURCE_DIR) + "/tests/harness/data/run/pass.yaml";
@@ -220,7 +210,7 @@ TEST_F(ScratchLibrary, TheJunitFileIsWrittenWholeWithNothingLeftBeside) {
   std::ofstream(junit) << "an older report";
   const auto run = run_hil("run " + kPass + " --junit " + junit.string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
-  const std::string xml = read(junit);
+  const std::string xml = read_file(junit);
   EXPECT_EQ(xml.rfind("<?xml", 0), 0u) << xml;
   EXPECT_THAT(xml, HasSubstr("</testsuite>"));
   std::size_t files = 0;

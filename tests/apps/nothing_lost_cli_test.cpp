@@ -19,10 +19,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/apps/hil_cli_support.hpp"
+#include "tests/support/sanitizers.hpp"
 
 namespace hil::test {
 namespace {
@@ -246,26 +248,13 @@ fs::path pcap_of(const fs::path& first, const std::string& link_id) {
   return first.parent_path() / (first.stem().string() + "-" + number + first.extension().string());
 }
 
-int port_of(const std::string& line) {
-  std::smatch m;
-  if (!std::regex_search(line, m, std::regex(R"(tcp://127\.0\.0\.1:(\d+))"))) return -1;
-  return std::stoi(m[1]);
-}
-
-/// `hil proxy` from the car's port to a free one, logging to `log`; its
-/// process id (the shell execs hil, so it keeps the id it printed).
-std::unique_ptr<HilProcess> start_proxy(int car_port, const fs::path& log, pid_t& pid, int& port) {
+/// `hil proxy` from the car's port to a free one, logging to `log`.
+std::unique_ptr<HilProcess> start_proxy(int car_port, const fs::path& log) {
   const fs::path pcap = fs::path(log).replace_extension(".pcap");
-  const std::string command =
-      "echo pid $$; exec '" + std::string(HIL_BINARY) +
-      "' proxy --listen tcp://127.0.0.1:0 --upstream tcp://127.0.0.1:" + std::to_string(car_port) +
-      " --log '" + log.string() + "' --pcap '" + pcap.string() + "' -q";
-  auto proxy = std::make_unique<HilProcess>("/bin/sh", std::vector<std::string>{"-c", command});
-  pid = -1;
-  port = -1;
-  if (const auto line = proxy->wait_for_line("pid ")) pid = std::stoi(line->substr(4));
-  if (const auto line = proxy->wait_for_line("clients connect to")) port = port_of(*line);
-  return proxy;
+  return std::make_unique<HilProcess>(
+      std::vector<std::string>{"proxy", "--listen", "tcp://127.0.0.1:0", "--upstream",
+                               "tcp://127.0.0.1:" + std::to_string(car_port), "--log", log.string(),
+                               "--pcap", pcap.string(), "-q"});
 }
 
 fs::path scratch_log(const std::string& name) {
@@ -284,148 +273,142 @@ void remove_captures(const fs::path& log) {
     fs::remove(pcap_of(pcap, "link" + std::to_string(n)));
 }
 
-// A sanitizer build runs the same checks on a quarter of the bytes: the
-// proxy is several times slower there (5-15x under ThreadSanitizer) and CI
-// runs the whole suite under both sanitizers.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizerBuild = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-constexpr bool kSanitizerBuild = true;
-#else
-constexpr bool kSanitizerBuild = false;
-#endif
-#else
-constexpr bool kSanitizerBuild = false;
-#endif
-
 /// Megabytes sent to the car (and echoed back) over all links together.
 std::uint64_t megabytes_under_load() {
   // Override for a longer run: HIL_NOTHING_LOST_MB=500 ctest -R NothingLost
   if (const char* mb = std::getenv("HIL_NOTHING_LOST_MB")) return std::strtoull(mb, nullptr, 10);
   // Enough that all eight links carry traffic at once for a while, small
   // enough that the log and pcaps a CI run writes stay under ~100 MB.
+  // A sanitizer build runs the same checks on a quarter of the bytes: the
+  // proxy is several times slower there.
   return kSanitizerBuild ? 2 : 8;
 }
 
-TEST(NothingLost, UnderLoadEveryByteOnEverySocketIsInTheLog) {
+/// The car, `hil proxy` in front of it logging to a scratch log, and the
+/// clients writing through the proxy.
+class NothingLost : public ::testing::Test {
+ protected:
+  /// Starts the proxy with its log named after `name`, then `count`
+  /// clients, client i writing `limit(i)` bytes (0: until the link breaks).
+  void start(const std::string& name, int count, const std::function<std::uint64_t(int)>& limit) {
+    log_ = scratch_log(name);
+    proxy_ = start_proxy(car_.port(), log_);
+    ASSERT_GT(proxy_->pid(), 0) << proxy_->output();
+    ASSERT_NO_FATAL_FAILURE(wait_for_port(*proxy_, port_, "clients connect to"));
+    for (int i = 0; i < count; ++i) {
+      auto c = std::make_unique<Client>();
+      c->letter = static_cast<char>('A' + i);
+      c->limit = limit(i);
+      c->start(port_);
+      ASSERT_GE(c->fd, 0);
+      clients_.push_back(std::move(c));
+    }
+  }
+
+  /// Reads the whole log (one link per client) into links_ and checks each
+  /// link against the car, its client and its pcap: the bytes delivered to
+  /// the car are those the car read, the bytes delivered to the client
+  /// those the client read, the close is logged, and the pcap holds the
+  /// same bytes. `more` checks what else holds for the way the run ended.
+  void check_links(const std::function<void(const LinkTotals&, const Client&,
+                                            std::uint64_t car_received)>& more) {
+    links_ = read_log(log_, lines_);
+    const auto car_received = car_.received();
+    ASSERT_EQ(links_.size(), clients_.size());
+    for (const auto& [id, l] : links_) {
+      SCOPED_TRACE(id);
+      const auto& c = *clients_.at(static_cast<std::size_t>(l.letter - 'A'));
+      more(l, c, car_received.at(c.letter));
+      EXPECT_EQ(l.delivered_to_car, car_received.at(c.letter));
+      EXPECT_EQ(l.delivered_to_client, c.read);
+      EXPECT_TRUE(l.closed) << "the close record is missing";
+      const auto pcap = pcap_payload(pcap_of(fs::path(log_).replace_extension(".pcap"), id));
+      EXPECT_EQ(pcap[0], l.delivered_to_car);
+      EXPECT_EQ(pcap[1], l.delivered_to_client);
+    }
+  }
+
+  /// Bytes delivered both ways over all links.
+  std::uint64_t delivered() const {
+    std::uint64_t total = 0;
+    for (const auto& [id, l] : links_)
+      total += l.delivered_to_car + l.delivered_to_client;
+    return total;
+  }
+
+  EchoCar car_;
+  fs::path log_;
+  int port_ = -1;
+  std::unique_ptr<HilProcess> proxy_;
+  std::vector<std::unique_ptr<Client>> clients_;
+  std::map<std::string, LinkTotals> links_;
+  std::uint64_t lines_ = 0;
+};
+
+TEST_F(NothingLost, UnderLoadEveryByteOnEverySocketIsInTheLog) {
   constexpr int kClients = 8;
   const std::uint64_t total = megabytes_under_load() * 1000 * 1000;
-  EchoCar car;
-  const auto log = scratch_log("load");
-  pid_t pid = -1;
-  int port = -1;
-  const auto proxy = start_proxy(car.port(), log, pid, port);
-  ASSERT_GT(pid, 0) << proxy->output();
-  ASSERT_GT(port, 0) << proxy->output();
-
-  std::vector<std::unique_ptr<Client>> clients;
-  for (int i = 0; i < kClients; ++i) {
-    auto c = std::make_unique<Client>();
-    c->letter = static_cast<char>('A' + i);
-    c->limit = total / kClients + static_cast<std::uint64_t>(i) * 1009;  // sizes tell them apart
-    c->start(port);
-    ASSERT_GE(c->fd, 0);
-    clients.push_back(std::move(c));
-  }
-  for (auto& c : clients)
+  ASSERT_NO_FATAL_FAILURE(start("load", kClients, [&](int i) {
+    return total / kClients + static_cast<std::uint64_t>(i) * 1009;  // sizes tell them apart
+  }));
+  for (auto& c : clients_)
     c->join();
-  ASSERT_EQ(proxy->interrupt(60s), 0) << proxy->output();
+  ASSERT_EQ(proxy_->interrupt(60s), 0) << proxy_->output();
 
-  std::uint64_t lines = 0;
-  const auto links = read_log(log, lines);
-  const auto car_received = car.received();
-  ASSERT_EQ(links.size(), static_cast<std::size_t>(kClients));
-  std::uint64_t logged = 0;
-  for (const auto& [id, l] : links) {
-    SCOPED_TRACE(id);
-    const auto& c = *clients.at(static_cast<std::size_t>(l.letter - 'A'));
-    // Every byte each client wrote reached the car and came back.
-    EXPECT_EQ(c.written, c.limit);
-    EXPECT_EQ(l.sent_to_car, c.written);
-    EXPECT_EQ(l.delivered_to_car, car_received.at(c.letter));
-    EXPECT_EQ(l.sent_to_client, car_received.at(c.letter));
-    EXPECT_EQ(l.delivered_to_client, c.read);
-    EXPECT_EQ(c.read, c.written);
-    EXPECT_TRUE(l.closed);
-    logged += l.delivered_to_car + l.delivered_to_client;
-    // The pcap of the link holds the same bytes.
-    const auto pcap = pcap_payload(pcap_of(fs::path(log).replace_extension(".pcap"), id));
-    EXPECT_EQ(pcap[0], l.delivered_to_car);
-    EXPECT_EQ(pcap[1], l.delivered_to_client);
-  }
-  std::cout << "[ figures  ] " << logged << " bytes through " << kClients
-            << " links, all in the log (" << lines << " records, " << fs::file_size(log) / 1000000
+  // Every byte each client wrote reached the car and came back.
+  ASSERT_NO_FATAL_FAILURE(
+      check_links([](const LinkTotals& l, const Client& c, std::uint64_t car_received) {
+        EXPECT_EQ(c.written, c.limit);
+        EXPECT_EQ(l.sent_to_car, c.written);
+        EXPECT_EQ(l.sent_to_client, car_received);
+        EXPECT_EQ(c.read, c.written);
+      }));
+  std::cout << "[ figures  ] " << delivered() << " bytes through " << kClients
+            << " links, all in the log (" << lines_ << " records, " << fs::file_size(log_) / 1000000
             << " MB) and in the pcaps\n";
-  remove_captures(log);
+  remove_captures(log_);
 }
 
-void stop_mid_stream(int signal) {
+class NothingLostOnSignal : public NothingLost, public ::testing::WithParamInterface<int> {};
+
+TEST_P(NothingLostOnSignal, MidStreamLeavesAWholeLogThatMatchesTheSockets) {
   constexpr int kClients = 4;
-  EchoCar car;
-  const auto log = scratch_log(signal == SIGINT ? "sigint" : "sigterm");
-  pid_t pid = -1;
-  int port = -1;
-  const auto proxy = start_proxy(car.port(), log, pid, port);
-  ASSERT_GT(pid, 0) << proxy->output();
-  ASSERT_GT(port, 0) << proxy->output();
-  std::vector<std::unique_ptr<Client>> clients;
-  for (int i = 0; i < kClients; ++i) {
-    auto c = std::make_unique<Client>();
-    c->letter = static_cast<char>('A' + i);
-    c->start(port);  // no limit: writes until the proxy goes away
-    ASSERT_GE(c->fd, 0);
-    clients.push_back(std::move(c));
-  }
+  const int signal = GetParam();
+  // No limit: each client writes until the proxy goes away.
+  ASSERT_NO_FATAL_FAILURE(
+      start(signal == SIGINT ? "sigint" : "sigterm", kClients, [](int) { return 0; }));
   // Stop it once every link carries traffic both ways.
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   for (;;) {
     bool all = true;
-    for (auto& c : clients)
+    for (auto& c : clients_)
       all = all && c->read > 1000000;
     if (all) break;
     ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "no traffic through the proxy";
     std::this_thread::sleep_for(10ms);
   }
-  ::kill(pid, signal);
-  ASSERT_EQ(proxy->wait_exit(30s), 0) << proxy->output();
-  for (auto& c : clients) {
+  ::kill(proxy_->pid(), signal);
+  ASSERT_EQ(proxy_->wait_exit(30s), 0) << proxy_->output();
+  for (auto& c : clients_) {
     ::shutdown(c->fd, SHUT_RDWR);  // the writer may be blocked on a full socket
     c->join();
   }
   // The car's threads see the end too; give them their last reads.
   std::this_thread::sleep_for(200ms);
 
-  std::uint64_t lines = 0;
-  const auto links = read_log(log, lines);
-  const auto car_received = car.received();
-  ASSERT_EQ(links.size(), static_cast<std::size_t>(kClients));
-  for (const auto& [id, l] : links) {
-    SCOPED_TRACE(id);
-    const auto& c = *clients.at(static_cast<std::size_t>(l.letter - 'A'));
+  ASSERT_NO_FATAL_FAILURE(check_links([](const LinkTotals& l, const Client& c, std::uint64_t) {
     EXPECT_LE(l.sent_to_car, c.written);  // the rest was still in the kernel
-    EXPECT_EQ(l.delivered_to_car, car_received.at(c.letter));
-    EXPECT_EQ(l.delivered_to_client, c.read);
-    EXPECT_TRUE(l.closed) << "the close record is missing";
-    const auto pcap = pcap_payload(pcap_of(fs::path(log).replace_extension(".pcap"), id));
-    EXPECT_EQ(pcap[0], l.delivered_to_car);
-    EXPECT_EQ(pcap[1], l.delivered_to_client);
-  }
-  std::uint64_t delivered = 0;
-  for (const auto& [id, l] : links)
-    delivered += l.delivered_to_car + l.delivered_to_client;
-  std::cout << "[ figures  ] stopped by signal " << signal << " after " << delivered
-            << " bytes through " << kClients << " links; log whole (" << lines << " records)\n";
-  remove_captures(log);
+  }));
+  std::cout << "[ figures  ] stopped by signal " << signal << " after " << delivered()
+            << " bytes through " << kClients << " links; log whole (" << lines_ << " records)\n";
+  remove_captures(log_);
 }
 
-TEST(NothingLost, SigintMidStreamLeavesAWholeLogThatMatchesTheSockets) {
-  stop_mid_stream(SIGINT);
-}
-
-TEST(NothingLost, SigtermMidStreamLeavesAWholeLogThatMatchesTheSockets) {
-  stop_mid_stream(SIGTERM);
-}
+INSTANTIATE_TEST_SUITE_P(SigintAndSigterm, NothingLostOnSignal, ::testing::Values(SIGINT, SIGTERM),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return info.param == SIGINT ? std::string("Sigint")
+                                                       : std::string("Sigterm");
+                         });
 
 }  // namespace
 }  // namespace hil::test

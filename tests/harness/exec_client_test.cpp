@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "harness/exec_client.hpp"
 
@@ -43,43 +45,40 @@ TEST(ClientLines, ResultWordsOnlyCountAsTheFirstWord) {
   EXPECT_EQ(parse_client_line("[unclosed stamp ok").kind, ClientLine::Kind::output);
 }
 
+/// An event line and the client record it becomes: its kind, when the
+/// case checks it, and the fields its data holds.
+struct EventLine {
+  const char* text;
+  std::optional<RecordKind> kind;
+  nlohmann::json data;
+};
+
 TEST(ClientLines, EventLinesBecomeTheReferenceClientsRecords) {
-  auto line = parse_client_line("event connection connected");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, ClientKind::connection);
-  EXPECT_EQ(line.record_data["state"], "connected");
-
-  line = parse_client_line("[ 3.5] event command MV:FWD uncertain");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, ClientKind::command);
-  EXPECT_EQ(line.record_data["command"], "MV:FWD");
-  EXPECT_EQ(line.record_data["state"], "uncertain");
-
-  line = parse_client_line("event stale");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, ClientKind::stale);
-  EXPECT_EQ(parse_client_line("event fresh").record_kind, ClientKind::fresh);
-
-  line = parse_client_line("event notice Not in manual mode");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_data["text"], "Not in manual mode");
-
-  line = parse_client_line("event parse_error bad_checksum: checksum 00, computed 4D");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, ClientKind::parse_error);
-  EXPECT_EQ(line.record_data["text"], "bad_checksum: checksum 00, computed 4D");
-
-  line = parse_client_line("event movement disabled not connected");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_kind, ClientKind::movement);
-  EXPECT_EQ(line.record_data["enabled"], false);
-  EXPECT_EQ(line.record_data["reason"], "not connected");
-  EXPECT_EQ(parse_client_line("event movement enabled").record_data["enabled"], true);
-
-  line = parse_client_line("event login failed wrong key");
-  ASSERT_EQ(line.kind, ClientLine::Kind::event);
-  EXPECT_EQ(line.record_data["ok"], false);
-  EXPECT_EQ(line.record_data["reason"], "wrong key");
+  const std::vector<EventLine> cases = {
+      {"event connection connected", ClientKind::connection, {{"state", "connected"}}},
+      {"[ 3.5] event command MV:FWD uncertain",
+       ClientKind::command,
+       {{"command", "MV:FWD"}, {"state", "uncertain"}}},
+      {"event stale", ClientKind::stale, nlohmann::json::object()},
+      {"event fresh", ClientKind::fresh, nlohmann::json::object()},
+      {"event notice Not in manual mode", std::nullopt, {{"text", "Not in manual mode"}}},
+      {"event parse_error bad_checksum: checksum 00, computed 4D",
+       ClientKind::parse_error,
+       {{"text", "bad_checksum: checksum 00, computed 4D"}}},
+      {"event movement disabled not connected",
+       ClientKind::movement,
+       {{"enabled", false}, {"reason", "not connected"}}},
+      {"event movement enabled", std::nullopt, {{"enabled", true}}},
+      {"event login failed wrong key", std::nullopt, {{"ok", false}, {"reason", "wrong key"}}},
+  };
+  for (const EventLine& c : cases) {
+    SCOPED_TRACE(c.text);
+    const auto line = parse_client_line(c.text);
+    ASSERT_EQ(line.kind, ClientLine::Kind::event);
+    if (c.kind) EXPECT_EQ(line.record_kind, *c.kind);
+    for (const auto& [field, value] : c.data.items())
+      EXPECT_EQ(line.record_data[field], value) << field;
+  }
 }
 
 TEST(ClientLines, MalformedEventsAreKeptAsOutputNotGuessed) {

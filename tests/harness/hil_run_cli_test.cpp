@@ -12,24 +12,18 @@
 #include <sstream>
 
 #include "tests/apps/hil_cli_support.hpp"
+#include "tests/harness/junit_check.hpp"
+#include "tests/harness/scratch_dir.hpp"
+#include "tests/support/text.hpp"
 
 namespace hil::test {
 namespace {
 
-using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 
 const std::string kData = "tests/harness/data/run";
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
 
 // The table's rows: the first two columns of the lines after the header,
 // up to the first blank line.
@@ -55,56 +49,38 @@ std::string last_line(const std::string& output) {
   return lines.empty() ? std::string() : lines.back();
 }
 
-std::string read(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+/// `hil run ARGS`: checks its exit code, the rows of its table and, when
+/// given, its summary line; its output, for more checks.
+std::string expect_table(const std::string& args, int exit_code,
+                         const std::vector<std::string>& table, const std::string& summary = {}) {
+  const auto r = run_hil("run " + args);
+  EXPECT_EQ(r.exit_code, exit_code) << r.output;
+  EXPECT_EQ(rows(r.output), table);
+  if (!summary.empty()) EXPECT_EQ(last_line(r.output), summary);
+  return r.output;
 }
 
-class TempDir {
- public:
-  TempDir()
-      : path_(std::filesystem::temp_directory_path() /
-              ("hil_run_cli_test_" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
 TEST(HilRunCli, WithoutFilesIsAUsageError) {
-  const auto r = run_hil("run");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.output, HasSubstr("paths"));
+  expect_run(says("run", 2, {"paths"}));
 }
 
 TEST(HilRunCli, APathThatDoesNotExistIsAUsageError) {
-  const auto r = run_hil("run " + kData + "/pass.yaml no-such-scenario.yaml");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.output, HasSubstr("no-such-scenario.yaml: no such file or folder"));
-  EXPECT_THAT(r.output, Not(HasSubstr("passed")));
+  expect_run({.args = "run " + kData + "/pass.yaml no-such-scenario.yaml",
+              .exit_code = 2,
+              .contains = {"no-such-scenario.yaml: no such file or folder"},
+              .lacks = {"passed"}});
 }
 
 TEST(HilRunCli, AFolderWithoutScenariosIsAUsageError) {
-  const auto r = run_hil("run scenarios/worlds");
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_THAT(r.output, HasSubstr("no scenario files"));
+  expect_run(says("run scenarios/worlds", 2, {"no scenario files"}));
 }
 
 TEST(HilRunCli, MalformedOptionsAreUsageErrors) {
-  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --set speed").exit_code, 2);
-  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --repeat 0").exit_code, 2);
-  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --jobs 0").exit_code, 2);
-  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --seed x").exit_code, 2);
-  EXPECT_EQ(run_hil("run " + kData + "/pass.yaml --tags nobody-has-this").exit_code, 2);
-  const auto slack = run_hil("run " + kData + "/pass.yaml --slack 100");
-  EXPECT_EQ(slack.exit_code, 2);
-  EXPECT_THAT(slack.output, HasSubstr("'100' is not a duration (e.g. 100ms, 0.5s)"));
+  for (const char* option :
+       {"--set speed", "--repeat 0", "--jobs 0", "--seed x", "--tags nobody-has-this"})
+    expect_run(says("run " + kData + "/pass.yaml " + option, 2, {}));
+  expect_run(says("run " + kData + "/pass.yaml --slack 100", 2,
+                  {"'100' is not a duration (e.g. 100ms, 0.5s)"}));
 }
 
 TEST(HilRunCli, SlackIsTakenAndCarriedIntoTheReproCommand) {
@@ -116,35 +92,25 @@ TEST(HilRunCli, SlackIsTakenAndCarriedIntoTheReproCommand) {
 }
 
 TEST(HilRunCli, AFileThatDoesNotLoadIsAFailedRowWithItsLineAndColumn) {
-  const auto r = run_hil("run " + kData + "/more/broken.yaml");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(rows(r.output), ElementsAre("broken FAIL"));
-  EXPECT_THAT(r.output, HasSubstr("  error: " + kData + "/more/broken.yaml:6:5: "));
-  EXPECT_THAT(r.output, HasSubstr("'pres FWD'"));
-  EXPECT_THAT(r.output, HasSubstr("  repeat: hil run " + kData + "/more/broken.yaml\n"));
-  EXPECT_EQ(last_line(r.output), "0 passed, 1 failed");
+  const auto out =
+      expect_table(kData + "/more/broken.yaml", 1, {"broken FAIL"}, "0 passed, 1 failed");
+  expect_contains(out, {"  error: " + kData + "/more/broken.yaml:6:5: ", "'pres FWD'",
+                        "  repeat: hil run " + kData + "/more/broken.yaml\n"});
 }
 
 TEST(HilRunCli, APassingScenarioExitsZero) {
-  const auto r = run_hil("run " + kData + "/pass.yaml");
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_THAT(rows(r.output), ElementsAre("run-pass PASS"));
-  EXPECT_THAT(r.output, HasSubstr(" s sim "));
-  EXPECT_THAT(r.output, Not(HasSubstr("repeat:")));
+  const auto out = expect_table(kData + "/pass.yaml", 0, {"run-pass PASS"}, "1 passed, 0 failed");
+  EXPECT_THAT(out, HasSubstr(" s sim "));
+  EXPECT_THAT(out, Not(HasSubstr("repeat:")));
   // Not a terminal: no colour codes in a CI log.
-  EXPECT_THAT(r.output, Not(HasSubstr("\033[")));
-  EXPECT_EQ(last_line(r.output), "1 passed, 0 failed");
+  EXPECT_THAT(out, Not(HasSubstr("\033[")));
 }
 
 TEST(HilRunCli, AFailingScenarioShowsEvidenceAndTheCommandThatRepeatsIt) {
-  const auto r = run_hil("run " + kData + "/fail.yaml");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(rows(r.output), ElementsAre("run-fail FAIL"));
-  EXPECT_THAT(r.output, HasSubstr("FAIL run-fail  (" + kData + "/fail.yaml, seed 9)\n"));
-  EXPECT_THAT(r.output, HasSubstr("  expect line 11 (the car was told to run): "));
-  EXPECT_THAT(r.output, HasSubstr("    evidence:\n"));
-  EXPECT_THAT(r.output, HasSubstr("  repeat: hil run " + kData + "/fail.yaml --seed 9\n"));
-  EXPECT_EQ(last_line(r.output), "0 passed, 1 failed");
+  const auto out = expect_table(kData + "/fail.yaml", 1, {"run-fail FAIL"}, "0 passed, 1 failed");
+  expect_contains(out, {"FAIL run-fail  (" + kData + "/fail.yaml, seed 9)\n",
+                        "  expect line 11 (the car was told to run): ", "    evidence:\n",
+                        "  repeat: hil run " + kData + "/fail.yaml --seed 9\n"});
 }
 
 TEST(HilRunCli, TheReproCommandCarriesTheSeedVariablesAndClient) {
@@ -159,12 +125,10 @@ TEST(HilRunCli, TheReproCommandCarriesTheSeedVariablesAndClient) {
 
 TEST(HilRunCli, AFolderRunsEveryScenarioInItSortedByFile) {
   // flaky.yaml has no seed of its own: seed 1 makes it fail.
-  const auto r = run_hil("run " + kData + " -v --seed 1");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(rows(r.output),
-              ElementsAre("run-fail FAIL", "run-flaky FAIL", "broken FAIL", "run-pass PASS"));
-  EXPECT_THAT(r.output, HasSubstr("skipped " + kData + "/more/not-a-scenario.yaml"));
-  EXPECT_EQ(last_line(r.output), "1 passed, 3 failed");
+  const auto out = expect_table(kData + " -v --seed 1", 1,
+                                {"run-fail FAIL", "run-flaky FAIL", "broken FAIL", "run-pass PASS"},
+                                "1 passed, 3 failed");
+  EXPECT_THAT(out, HasSubstr("skipped " + kData + "/more/not-a-scenario.yaml"));
 }
 
 TEST(HilRunCli, ParallelRunsKeepTheSameOrder) {
@@ -175,7 +139,7 @@ TEST(HilRunCli, ParallelRunsKeepTheSameOrder) {
 }
 
 TEST(HilRunCli, WritesJunitAndTheReportFolder) {
-  TempDir tmp;
+  const ScratchDir tmp("hil-run-cli");
   const auto junit = tmp.path() / "hil.xml";
   const auto report = tmp.path() / "report";
   const auto r = run_hil("run " + kData + "/pass.yaml " + kData + "/fail.yaml " + kData +
@@ -183,36 +147,29 @@ TEST(HilRunCli, WritesJunitAndTheReportFolder) {
                          report.string() + "'");
   EXPECT_EQ(r.exit_code, 1);
 
-  const std::string xml = read(junit);
+  const std::string xml = read_file(junit);
   EXPECT_THAT(xml, HasSubstr("<testsuite name=\"hil\" tests=\"3\" failures=\"2\""));
   EXPECT_THAT(xml, HasSubstr("classname=\"tests.harness.data.run\" name=\"run-pass\""));
   EXPECT_THAT(xml, HasSubstr("<failure message=\"expect line 11"));
   EXPECT_THAT(xml, HasSubstr("repeat: hil run " + kData + "/fail.yaml --seed 9"));
-  if (std::system("python3 -c 'import xml.dom.minidom' >/dev/null 2>&1") == 0) {
-    const std::string check =
-        "python3 -c \"import sys, xml.dom.minidom as m; "
-        "assert len(m.parse(sys.argv[1]).getElementsByTagName('testcase'))"
-        " == 3\" '" +
-        junit.string() + "'";
-    EXPECT_EQ(std::system(check.c_str()), 0);
-  }
+  if (python_xml_available()) EXPECT_EQ(python_checks_junit(junit, 3), 0);
 
-  const std::string index = read(report / "index.html");
+  const std::string index = read_file(report / "index.html");
   EXPECT_THAT(index, HasSubstr("1 passed, 2 failed"));
   EXPECT_THAT(index, HasSubstr("href=\"run-pass/index.html\""));
   EXPECT_THAT(index, HasSubstr("href=\"run-fail/index.html\""));
   EXPECT_THAT(index, HasSubstr("href=\"broken/index.html\""));
-  const std::string pass_page = read(report / "run-pass" / "index.html");
+  const std::string pass_page = read_file(report / "run-pass" / "index.html");
   EXPECT_THAT(pass_page, HasSubstr("<span class=\"pass\">PASS</span>"));
   EXPECT_THAT(pass_page, HasSubstr("release"));
-  EXPECT_THAT(read(report / "run-fail" / "index.html"),
+  EXPECT_THAT(read_file(report / "run-fail" / "index.html"),
               HasSubstr("hil run " + kData + "/fail.yaml --seed 9"));
-  const std::string ndjson = read(report / "run-pass" / "timeline.ndjson");
+  const std::string ndjson = read_file(report / "run-pass" / "timeline.ndjson");
   EXPECT_THAT(ndjson, StartsWith("{\"t_ms\":"));
   EXPECT_THAT(ndjson, HasSubstr("MV:STOP"));
-  EXPECT_THAT(read(report / "run-pass" / "trajectory.svg"), HasSubstr("<svg"));
+  EXPECT_THAT(read_file(report / "run-pass" / "trajectory.svg"), HasSubstr("<svg"));
   // The wire log: every frame each way, as the mock car's --log writes it.
-  const std::string wire = read(report / "run-pass" / "wire.ndjson");
+  const std::string wire = read_file(report / "run-pass" / "wire.ndjson");
   EXPECT_THAT(wire, HasSubstr("\"link\":\"car0/link1\""));
   EXPECT_THAT(wire, HasSubstr("MV:STOP"));
   EXPECT_THAT(pass_page, HasSubstr("href=\"wire.ndjson\""));
@@ -220,51 +177,37 @@ TEST(HilRunCli, WritesJunitAndTheReportFolder) {
 }
 
 TEST(HilRunCli, AnUnwritableJunitFileFailsTheRun) {
-  const auto r = run_hil("run " + kData + "/pass.yaml --junit /nonexistent-dir/hil.xml");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(r.output, HasSubstr("cannot write /nonexistent-dir/hil.xml"));
+  expect_run(says("run " + kData + "/pass.yaml --junit /nonexistent-dir/hil.xml", 1,
+                  {"cannot write /nonexistent-dir/hil.xml"}));
 }
 
 TEST(HilRunCli, RepeatRunsWithConsecutiveSeedsAndReportsFlakiness) {
-  const auto r = run_hil("run " + kData + "/flaky.yaml --seed 1 --repeat 4");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_THAT(rows(r.output), ElementsAre("run-flaky #1 FLAKY", "run-flaky #2 PASS",
-                                          "run-flaky #3 FLAKY", "run-flaky #4 PASS"));
-  EXPECT_THAT(r.output, HasSubstr("repeat: hil run " + kData + "/flaky.yaml --seed 1\n"));
-  EXPECT_THAT(r.output, HasSubstr("repeat: hil run " + kData + "/flaky.yaml --seed 3\n"));
-  EXPECT_THAT(r.output,
-              HasSubstr("FLAKY run-flaky (" + kData + "/flaky.yaml): 2 of 4 runs failed\n"));
-  EXPECT_EQ(last_line(r.output), "0 passed, 1 failed");
+  const auto out = expect_table(
+      kData + "/flaky.yaml --seed 1 --repeat 4", 1,
+      {"run-flaky #1 FLAKY", "run-flaky #2 PASS", "run-flaky #3 FLAKY", "run-flaky #4 PASS"},
+      "0 passed, 1 failed");
+  expect_contains(out, {"repeat: hil run " + kData + "/flaky.yaml --seed 1\n",
+                        "repeat: hil run " + kData + "/flaky.yaml --seed 3\n",
+                        "FLAKY run-flaky (" + kData + "/flaky.yaml): 2 of 4 runs failed\n"});
 
-  const auto steady = run_hil("run " + kData + "/pass.yaml --repeat 3");
-  EXPECT_EQ(steady.exit_code, 0);
-  EXPECT_THAT(rows(steady.output),
-              ElementsAre("run-pass #1 PASS", "run-pass #2 PASS", "run-pass #3 PASS"));
-  EXPECT_EQ(last_line(steady.output), "1 passed, 0 failed");
+  expect_table(kData + "/pass.yaml --repeat 3", 0,
+               {"run-pass #1 PASS", "run-pass #2 PASS", "run-pass #3 PASS"}, "1 passed, 0 failed");
 }
 
 TEST(HilRunCli, TagsChooseWhichScenariosRun) {
   const std::string files = kData + "/pass.yaml " + kData + "/fail.yaml ";
-  const auto smoke = run_hil("run " + files + "--tags smoke,nightly");
-  EXPECT_EQ(smoke.exit_code, 0);
-  EXPECT_THAT(rows(smoke.output), ElementsAre("run-pass PASS"));
-
-  const auto excluded = run_hil("run " + files + "--exclude-tags fails-on-purpose");
-  EXPECT_EQ(excluded.exit_code, 0);
-  EXPECT_THAT(rows(excluded.output), ElementsAre("run-pass PASS"));
-
+  expect_table(files + "--tags smoke,nightly", 0, {"run-pass PASS"});
+  expect_table(files + "--exclude-tags fails-on-purpose", 0, {"run-pass PASS"});
   // A file that does not load cannot say its tags; it stays in, so a
   // broken file never lets a gate pass.
-  const auto broken = run_hil("run " + files + kData + "/more/broken.yaml --tags smoke");
-  EXPECT_EQ(broken.exit_code, 1);
-  EXPECT_THAT(rows(broken.output), ElementsAre("broken FAIL", "run-pass PASS"));
+  expect_table(files + kData + "/more/broken.yaml --tags smoke", 1,
+               {"broken FAIL", "run-pass PASS"});
 }
 
 TEST(HilRunCli, OptionsBeforeTheFilesTakeOneValueEach) {
-  const auto r = run_hil("run --tags smoke --set speed=30 --exclude-tags x " + kData +
-                         "/pass.yaml " + kData + "/fail.yaml");
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_THAT(rows(r.output), ElementsAre("run-pass PASS"));
+  expect_table("--tags smoke --set speed=30 --exclude-tags x " + kData + "/pass.yaml " + kData +
+                   "/fail.yaml",
+               0, {"run-pass PASS"});
 }
 
 TEST(HilRunCli, ListPrintsWhatWouldRunWithoutRunningIt) {

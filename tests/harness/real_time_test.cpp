@@ -16,13 +16,8 @@
 namespace hil::harness {
 namespace {
 
-using link::milliseconds;
-using link::seconds;
-
-using test::action;
-using test::of;
-using test::step_of;
-using test::wait;
+// The scenario pieces and the times they are given in.
+using namespace test;
 
 Scenario exec_scenario(mocks::CarKind kind, std::string command, std::vector<Step> steps) {
   Scenario s;
@@ -105,13 +100,9 @@ TEST(ExternalClient, EventLinesAndOtherOutputAreRecordedForExpectations) {
     done
     echo "event connection disconnected")";
   Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
-  Expectation connected;
-  connected.label = "the client said it connected";
-  connected.what = Matcher{Source::client,
-                           ClientKind::connection,
-                           {{"state", FieldTest::Op::equals, "connected"}},
-                           "connected"};
-  s.expectations.push_back(connected);
+  s.expectations.push_back(
+      expectation("the client said it connected",
+                  client_record(ClientKind::connection, "state", "connected", "connected")));
   const ScenarioOutcome o = run_scenario(s);
   ASSERT_TRUE(o.passed()) << summary(o);
 
@@ -246,14 +237,9 @@ TEST(ExternalClient, WhatTheProgramDoesAfterItsInputClosedIsNotJudgedByTheScenar
   const std::string client =
       R"sh(while read -r line; do echo "ok"; done; echo "event command ST:STOP accepted")sh";
   Scenario s = exec_scenario(mocks::CarKind::logi, client, {action("speed 50")});
-  Expectation never;
-  never.label = "no ST:STOP during the session";
-  never.quantifier = Quantifier::never;
-  never.what = Matcher{Source::client,
-                       ClientKind::command,
-                       {{"command", FieldTest::Op::equals, "ST:STOP"}},
-                       "ST:STOP"};
-  s.expectations.push_back(never);
+  s.expectations.push_back(expectation(
+      "no ST:STOP during the session",
+      client_record(ClientKind::command, "command", "ST:STOP", "ST:STOP"), Quantifier::never));
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
   EXPECT_EQ(of(o, ClientKind::command).size(), 1u) << "still in the timeline";
@@ -276,11 +262,8 @@ TEST(ExternalClient, AnExpectationOnTheExitCodeReplacesTheCleanExitRule) {
   Scenario s =
       exec_scenario(mocks::CarKind::logi, R"(while read -r line; do echo "ok $line"; done; exit 4)",
                     {action("speed 50")});
-  Expectation exit;
-  exit.label = "exits with 4";
-  exit.what =
-      Matcher{Source::client, ClientKind::exit, {{"code", FieldTest::Op::equals, 4}}, "exit 4"};
-  s.expectations.push_back(exit);
+  s.expectations.push_back(
+      expectation("exits with 4", client_record(ClientKind::exit, "code", 4, "exit 4")));
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
   EXPECT_EQ(o.expectations.size(), 1u);

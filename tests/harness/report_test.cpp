@@ -14,11 +14,16 @@
 #include <sstream>
 
 #include "harness/report.hpp"
+#include "tests/harness/junit_check.hpp"
+#include "tests/support/text.hpp"
 #include "view/drawing.hpp"
 
 namespace hil::harness {
 namespace {
 
+using hil::test::expect_contains;
+using hil::test::lines_of;
+using hil::test::read_file;
 using std::chrono::milliseconds;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -120,27 +125,6 @@ std::string console(const std::vector<ReportEntry>& entries, ConsoleOptions opti
   std::ostringstream out;
   write_console(out, entries, options);
   return out.str();
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);)
-    lines.push_back(line);
-  return lines;
-}
-
-/// Expects `text` to contain each of `parts`.
-void expect_contains(const std::string& text, const std::vector<std::string>& parts) {
-  for (const auto& part : parts)
-    EXPECT_THAT(text, HasSubstr(part));
-}
-
-std::string read(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 TEST(ReportConsole, OneRowPerRunAndTheSummaryLineLast) {
@@ -316,8 +300,7 @@ TEST(ReportJunit, HostileTextStaysInsideItsElement) {
 }
 
 TEST(ReportJunit, IsXmlThatAParserAccepts) {
-  if (std::system("python3 -c 'import xml.dom.minidom' >/dev/null 2>&1") != 0)
-    GTEST_SKIP() << "python3 is not installed";
+  if (!hil::test::python_xml_available()) GTEST_SKIP() << "python3 is not installed";
   auto o = failed_expectation();
   o.name = "a<b>&\"c\"";
   o.expectations[0].message = "</failure><x>& \x01 \xFF";
@@ -328,12 +311,7 @@ TEST(ReportJunit, IsXmlThatAParserAccepts) {
     std::ofstream out(path);
     out << junit_xml(entries);
   }
-  const std::string check =
-      "python3 -c \"import sys, xml.dom.minidom as m; "
-      "d = m.parse(sys.argv[1]); "
-      "assert len(d.getElementsByTagName('testcase')) == 5\" '" +
-      path.string() + "'";
-  EXPECT_EQ(std::system(check.c_str()), 0);
+  EXPECT_EQ(hil::test::python_checks_junit(path, 5), 0);
   std::filesystem::remove(path);
 }
 
@@ -378,13 +356,13 @@ TEST(ReportFolder, EachRunGetsItsPageTimelineAndTrajectory) {
   std::filesystem::remove_all(dir);
   write_report_dir(dir.string(), all_four());
 
-  const std::string index = read(dir / "index.html");
+  const std::string index = read_file(dir / "index.html");
   EXPECT_THAT(index, HasSubstr("1 passed, 3 failed"));
   EXPECT_THAT(index, HasSubstr("href=\"release-sends-stop/index.html\""));
   EXPECT_THAT(index, HasSubstr("href=\"broken/index.html\""));
 
   const auto run = dir / "release-sends-stop";
-  const std::string page = read(run / "index.html");
+  const std::string page = read_file(run / "index.html");
   expect_contains(
       page, {"<span class=\"fail\">FAIL</span>", "hil run scenarios/logi/release.yaml --seed 42",
              "<p>window: 5.000 s .. 5.300 s</p>", "car received  LOGI:MV:STOP:A1#",
@@ -393,10 +371,10 @@ TEST(ReportFolder, EachRunGetsItsPageTimelineAndTrajectory) {
   EXPECT_THAT(page, Not(HasSubstr("http")));
   expect_well_escaped(without_scripts(page.substr(page.find("<body>"))));
 
-  EXPECT_THAT(read(run / "trajectory.svg"), HasSubstr("<svg"));
-  const std::string ndjson = read(dir / "drive-forward" / "timeline.ndjson");
+  EXPECT_THAT(read_file(run / "trajectory.svg"), HasSubstr("<svg"));
+  const std::string ndjson = read_file(dir / "drive-forward" / "timeline.ndjson");
   EXPECT_EQ(ndjson, passing().timeline.to_ndjson());
-  EXPECT_THAT(read(dir / "drive-forward" / "index.html"), HasSubstr("data-source=\"wire\""));
+  EXPECT_THAT(read_file(dir / "drive-forward" / "index.html"), HasSubstr("data-source=\"wire\""));
   std::filesystem::remove_all(dir);
 }
 

@@ -19,13 +19,8 @@
 namespace hil::harness {
 namespace {
 
-using link::milliseconds;
-using link::seconds;
-
-using test::action;
-using test::of;
-using test::step_of;
-using test::wait;
+// The scenario pieces and the times they are given in.
+using namespace test;
 Step wait_until(Matcher m, Duration timeout) {
   std::string text = "wait until " + m.text;
   return step_of(std::move(text), WaitUntilStep{std::move(m), timeout});
@@ -495,10 +490,7 @@ Step must_fail(Step step, std::string contains = "") {
 }
 
 Matcher never_seen() {
-  return Matcher{Source::client,
-                 ClientKind::notice,
-                 {{"text", FieldTest::Op::equals, "no such notice"}},
-                 "a notice that never comes"};
+  return client_record(ClientKind::notice, "text", "no such notice", "a notice that never comes");
 }
 
 TEST(RunnerExpectedFailure, AStepThatFailsAsExpectedPassesAndTheSequenceGoesOn) {

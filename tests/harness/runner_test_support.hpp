@@ -8,8 +8,12 @@
 
 #include "harness/outcome.hpp"
 #include "harness/scenario.hpp"
+#include "link/time.hpp"
 
 namespace hil::harness::test {
+
+using link::milliseconds;
+using link::seconds;
 
 /// A step as a scenario file would give it (line 0: built in code).
 inline Step step_of(std::string text, StepAction action) {
@@ -25,6 +29,26 @@ inline Step action(const std::string& text) {
 
 inline Step wait(Duration d) {
   return step_of("wait", WaitStep{d});
+}
+
+/// The client's records of `kind` whose `field` equals `value`, named
+/// `text` in reports.
+inline Matcher client_record(ClientKind kind, std::string field, nlohmann::json value,
+                             std::string text) {
+  return Matcher{Source::client,
+                 kind,
+                 {{std::move(field), FieldTest::Op::equals, std::move(value)}},
+                 std::move(text)};
+}
+
+/// An expectation called `label` on what `what` matches, held by `quantifier`.
+inline Expectation expectation(std::string label, Matcher what,
+                               Quantifier quantifier = Quantifier::exists) {
+  Expectation e;
+  e.label = std::move(label);
+  e.what = std::move(what);
+  e.quantifier = quantifier;
+  return e;
 }
 
 /// The records of one kind, in time order.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "harness/scenario_yaml.hpp"
@@ -15,6 +16,12 @@ namespace {
 using namespace test;
 
 // ------------------------------------------------------------------ matchers
+
+/// What the loader makes of `{client: ...}`: the client's records of
+/// `kind` that pass `tests`, named `text` in reports.
+Matcher client_matcher(RecordKind kind, std::vector<FieldTest> tests, std::string text) {
+  return Matcher{Source::client, kind, std::move(tests), std::move(text)};
+}
 
 Matcher matcher_of(const std::string& expectation) {
   return logi("expect:\n  - " + expectation + "\n").expectations.at(0).what;
@@ -128,21 +135,17 @@ TEST(ScenarioYamlMatchers, FrameContentMistakesAreReportedWhereTheyAre) {
 }
 
 TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
-  EXPECT_EQ(matcher_of("{client: parse_error}"),
-            (Matcher{Source::client,
-                     ClientKind::parse_error,
-                     {},
-                     "client reported a frame it could not parse"}));
+  EXPECT_EQ(
+      matcher_of("{client: parse_error}"),
+      client_matcher(ClientKind::parse_error, {}, "client reported a frame it could not parse"));
   EXPECT_EQ(matcher_of("{client: {parse_error: bad_checksum}}"),
-            (Matcher{Source::client,
-                     ClientKind::parse_error,
-                     {{"text", Op::contains, "bad_checksum"}},
-                     "client could not parse a frame: 'bad_checksum'"}));
-  EXPECT_EQ(matcher_of("{client: {movement: false, reason: not connected}}"),
-            (Matcher{Source::client,
-                     ClientKind::movement,
+            client_matcher(ClientKind::parse_error, {{"text", Op::contains, "bad_checksum"}},
+                           "client could not parse a frame: 'bad_checksum'"));
+  EXPECT_EQ(
+      matcher_of("{client: {movement: false, reason: not connected}}"),
+      client_matcher(ClientKind::movement,
                      {{"enabled", Op::equals, false}, {"reason", Op::contains, "not connected"}},
-                     "client disabled movement because of 'not connected'"}));
+                     "client disabled movement because of 'not connected'"));
   const std::string head = "name: t\ncar: logi\nsteps: [connect]\nexpect:\n  - client: ";
   EXPECT_NE(error_of(head + "{movement: maybe}\n"), "");
   EXPECT_EQ(error_of(head + "{parse_error: x, state: y}\n"),
@@ -151,18 +154,15 @@ TEST(ScenarioYamlMatchers, ClientParseErrorsAndMovementControls) {
 
 TEST(ScenarioYamlMatchers, ClientEvents) {
   EXPECT_EQ(matcher_of("{client: stale}"),
-            (Matcher{Source::client, ClientKind::stale, {}, "client warned of stale telemetry"}));
+            client_matcher(ClientKind::stale, {}, "client warned of stale telemetry"));
   EXPECT_EQ(matcher_of("{client: fresh}").kind, ClientKind::fresh);
   EXPECT_EQ(matcher_of("{client: {login: false, reason: refused}}"),
-            (Matcher{Source::client,
-                     ClientKind::login,
-                     {{"ok", Op::equals, false}, {"reason", Op::contains, "refused"}},
-                     "client login refused because of 'refused'"}));
+            client_matcher(ClientKind::login,
+                           {{"ok", Op::equals, false}, {"reason", Op::contains, "refused"}},
+                           "client login refused because of 'refused'"));
   EXPECT_EQ(matcher_of("{client: {notice: \"Not in manual mode\"}}"),
-            (Matcher{Source::client,
-                     ClientKind::notice,
-                     {{"text", Op::contains, "Not in manual mode"}},
-                     "client notice containing 'Not in manual mode'"}));
+            client_matcher(ClientKind::notice, {{"text", Op::contains, "Not in manual mode"}},
+                           "client notice containing 'Not in manual mode'"));
   EXPECT_EQ(matcher_of("{client: {command: SP, state: rejected}}").tests,
             (std::vector<FieldTest>{{"command", Op::kind_prefix, "SP"},
                                     {"state", Op::equals, "rejected"}}));
@@ -173,10 +173,9 @@ TEST(ScenarioYamlMatchers, ClientEvents) {
   EXPECT_EQ(matcher_of("{client: {output: ok}}").tests,
             (std::vector<FieldTest>{{"line", Op::contains, "ok"}}));
   EXPECT_EQ(matcher_of("{client: {action: \"press FWD\", ok: false}}"),
-            (Matcher{Source::client,
-                     ClientKind::action,
-                     {{"text", Op::equals, "press FWD"}, {"ok", Op::equals, false}},
-                     "action 'press FWD' failed"}));
+            client_matcher(ClientKind::action,
+                           {{"text", Op::equals, "press FWD"}, {"ok", Op::equals, false}},
+                           "action 'press FWD' failed"));
   EXPECT_EQ(matcher_of("{client: disconnected}").tests,
             (std::vector<FieldTest>{{"state", Op::equals, "disconnected"}}));
 }

@@ -23,46 +23,28 @@ namespace {
 using namespace std::chrono_literals;
 
 /// A temp dir with the mock robot on a pty in it.
-struct ArduinoClientCli : ::testing::Test {
-  void TearDown() override {
-    if (mock) {
-      EXPECT_EQ(mock->stop(), 0) << mock->output();
-    }
+struct ArduinoClientCli : ClientProgramTest {
+  ArduinoClientCli() : ClientProgramTest(ARDUINO_CLIENT_BINARY, "hil-arduino-client") {
+    port = temp.file("robot0");
   }
 
   void start_mock(std::vector<std::string> extra = {}) {
-    mock.emplace(mock_on_pty_args("arduino", port, std::move(extra)),
-                 "as a serial port at 9600 baud");
-    ASSERT_TRUE(mock->ready()) << mock->output();
+    ClientProgramTest::start_mock(mock_on_pty_args("arduino", port, std::move(extra)),
+                                  "as a serial port at 9600 baud");
   }
-
-  std::filesystem::path write(const std::string& name, const std::string& text) {
-    return temp.write(name, text);
-  }
-
-  /// Runs arduino-client with `args` (after --port) to its exit.
-  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 30s) {
-    args.insert(args.begin(), {"--port", port});
-    return run_to_exit(ARDUINO_CLIENT_BINARY, args, limit);
-  }
-
-  TempDir temp{"hil-arduino-client"};
-  std::filesystem::path dir = temp.path();
-  std::string port = temp.file("robot0");
-  std::optional<MockCar> mock;
 };
 
 TEST_F(ArduinoClientCli, RawTokensRunOnceEachAndTheStatusShowsTheSpeedSet) {
   start_mock();
   const auto r = client({"PING", "V 160", "STATUS"});
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "PING -> ACK PONG\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "V 160 -> ACK OK\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=160,DIR=stop,MOT:IDLE")) << r.output;
+  expect_contains(r.output, {"PING -> ACK PONG\n", "V 160 -> ACK OK\n",
+                             "STATUS -> ACK STATUS:V=160,DIR=stop,MOT:IDLE"});
   // The seed CLI's raw form works too, and the robot moves.
   const auto move = client({"v:200", "M:20", "status"});
   EXPECT_EQ(move.exit_code, 0) << move.output;
-  EXPECT_TRUE(contains(move.output, "STATUS -> ACK STATUS:V=200,DIR=fwd,MOT:MOVE,tleft:")) << move.output;
+  EXPECT_TRUE(contains(move.output, "STATUS -> ACK STATUS:V=200,DIR=fwd,MOT:MOVE,tleft:"))
+      << move.output;
 }
 
 // The real CLI's own command line (CLI.py at 8dcfab0) against the mock
@@ -73,16 +55,12 @@ TEST_F(ArduinoClientCli, TheRealClisCommandsAgainstTheSketchProfile) {
   const auto r = client({"--profile", "firmware", "--keep-going", "PING", "V:160", "M:20", "B", "I",
                          "STATUS", "S", "V:999", "HELP"});
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "PING -> ACK PONG\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "V 160 -> ACK OK\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "M 20 -> ACK ACCEPTED\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "B -> ACK B:")) << r.output;
-  EXPECT_TRUE(contains(r.output, "I -> ACK I:AL=")) << r.output;
+  expect_contains(r.output, {"PING -> ACK PONG\n", "V 160 -> ACK OK\n", "M 20 -> ACK ACCEPTED\n",
+                             "B -> ACK B:", "I -> ACK I:AL="});
   // (Moving or done by then, depending on the machine: 20 cm take 360 ms.)
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=160,DIR=")) << r.output;
-  EXPECT_TRUE(contains(r.output, "S -> ACK STOPPED\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "V:999 -> NACK BAD_V\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "HELP -> ACK CMDS:PING,HELP,STATUS,V,M,R,S,B,I\n")) << r.output;
+  expect_contains(r.output,
+                  {"STATUS -> ACK STATUS:V=160,DIR=", "S -> ACK STOPPED\n", "V:999 -> NACK BAD_V\n",
+                   "HELP -> ACK CMDS:PING,HELP,STATUS,V,M,R,S,B,I\n"});
 }
 
 TEST_F(ArduinoClientCli, AnUnknownProfileIsRefusedWithTheValidNames) {
@@ -100,13 +78,11 @@ TEST_F(ArduinoClientCli, AScriptRunsAndItsFrameLogIsWritten) {
   const auto log = dir / "run.csv";
   const auto r = client({"--script", script.string(), "--log", log.string()});
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "V 120 -> ACK OK\n")) << r.output;
-  EXPECT_TRUE(contains(r.output, "B -> ACK ")) << r.output;
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=120,DIR=stop,MOT:IDLE")) << r.output;
+  expect_contains(
+      r.output, {"V 120 -> ACK OK\n", "B -> ACK ", "STATUS -> ACK STATUS:V=120,DIR=stop,MOT:IDLE"});
   const auto csv = read_file(log);
   EXPECT_EQ(csv.rfind("time,direction,seq,raw,hex\n", 0), 0u) << csv;
-  EXPECT_TRUE(contains(csv, ",TX,01,^01|V|120*")) << csv;
-  EXPECT_TRUE(contains(csv, ",RX,01,^01|ACK|OK*")) << csv;
+  expect_contains(csv, {",TX,01,^01|V|120*", ",RX,01,^01|ACK|OK*"});
 }
 
 TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
@@ -125,27 +101,28 @@ TEST_F(ArduinoClientCli, TheExampleScriptsRunAgainstTheMock) {
     ASSERT_TRUE(mock->process().wait_for_line("client gone", 20s)) << mock->output();
   }
   const auto r = client({"STATUS"});
-  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE")) << "a fresh boot: " << r.output;
+  EXPECT_TRUE(contains(r.output, "STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE"))
+      << "a fresh boot: " << r.output;
 }
 
 TEST_F(ArduinoClientCli, TheReplReadsAPipeAndQueuesLinesInOrder) {
   start_mock();
   HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(repl.write_stdin("ping\n"));
-  ASSERT_TRUE(repl.wait_for_line("PING -> ACK PONG")) << repl.output();
+  ASSERT_NO_FATAL_FAILURE(assert_lines(repl, {"PING -> ACK PONG"}));
   // Three lines at once: the second and third wait for the one before.
   ASSERT_TRUE(repl.write_stdin("V 170\nM 10\nstatus\n"));
-  ASSERT_TRUE(repl.wait_for_line("V 170 -> ACK OK")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("M 10 -> ACK ACCEPTED")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK STATUS:V=170,DIR=fwd,MOT:MOVE,tleft:")) << repl.output();
+  ASSERT_NO_FATAL_FAILURE(
+      assert_lines(repl, {"V 170 -> ACK OK", "M 10 -> ACK ACCEPTED",
+                          "STATUS -> ACK STATUS:V=170,DIR=fwd,MOT:MOVE,tleft:"}));
   // A bad line is an error and the REPL goes on.
   ASSERT_TRUE(repl.write_stdin("V 300\n"));
   const auto error = repl.wait_for_line("error: column 3:");
   ASSERT_TRUE(error) << repl.output();
   EXPECT_TRUE(contains(*error, "V needs a number 0..255, not '300'")) << *error;
   ASSERT_TRUE(repl.write_stdin("history\n"));
-  ASSERT_TRUE(repl.wait_for_line("TX seq=00 ^00|PING| *30$")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("|ACK|STATUS:V=170,DIR=fwd,MOT:MOVE")) << repl.output();
+  ASSERT_NO_FATAL_FAILURE(
+      assert_lines(repl, {"TX seq=00 ^00|PING| *30$", "|ACK|STATUS:V=170,DIR=fwd,MOT:MOVE"}));
   const auto log = dir / "session.ndjson";
   ASSERT_TRUE(repl.write_stdin("save-log " + log.string() + "\n"));
   const auto saved = repl.wait_for_line(" frame(s) to " + log.string() + " (ndjson)");
@@ -157,8 +134,7 @@ TEST_F(ArduinoClientCli, TheReplReadsAPipeAndQueuesLinesInOrder) {
   EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
   EXPECT_FALSE(contains(repl.output(), "arduino> ")) << "no prompt on a pipe";
   const auto ndjson = read_file(log);
-  EXPECT_TRUE(contains(ndjson, R"("raw":"^00|PING| *30$")")) << ndjson;
-  EXPECT_TRUE(contains(ndjson, R"("direction":"RX")")) << ndjson;
+  expect_contains(ndjson, {R"("raw":"^00|PING| *30$")", R"("direction":"RX")"});
   EXPECT_EQ(std::count(ndjson.begin(), ndjson.end(), '\n'), frames) << ndjson;
 }
 
@@ -169,15 +145,16 @@ TEST_F(ArduinoClientCli, TheReplEndsAtTheEndOfItsInputAfterTheLastReply) {
   repl.close_stdin();
   EXPECT_EQ(repl.wait_exit(20s), 0) << repl.output();
   EXPECT_TRUE(contains(repl.output(), "V 90 -> ACK OK\n")) << repl.output();
-  EXPECT_TRUE(contains(repl.output(), "STATUS -> ACK STATUS:V=90,DIR=stop,MOT:IDLE")) << repl.output();
+  EXPECT_TRUE(contains(repl.output(), "STATUS -> ACK STATUS:V=90,DIR=stop,MOT:IDLE"))
+      << repl.output();
 }
 
 TEST_F(ArduinoClientCli, ReconnectReopensThePortAndTheBoardResets) {
   start_mock();
   HilProcess repl(ARDUINO_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(repl.write_stdin("V 99\nreconnect\nstatus\n"));
-  ASSERT_TRUE(repl.wait_for_line("reconnected, link OPEN")) << repl.output();
-  ASSERT_TRUE(repl.wait_for_line("STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE")) << repl.output();
+  ASSERT_NO_FATAL_FAILURE(assert_lines(
+      repl, {"reconnected, link OPEN", "STATUS -> ACK STATUS:V=140,DIR=stop,MOT:IDLE"}));
   EXPECT_EQ(repl.interrupt(), 130) << repl.output();
 }
 
@@ -199,11 +176,9 @@ TEST_F(ArduinoClientCli, ANackedCommandExits1WithItsCodeAndStopsTheRun) {
 }
 
 TEST_F(ArduinoClientCli, ATypoInAScriptExits2WithFileLineAndColumn) {
-  const auto script = write("typo.txt", "ping\nV 160\n  stauts\n");
-  const auto r = client({"--script", script.string()});
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(contains(r.output, script.string() + ":3:3: unknown command 'stauts'")) << r.output;
-  EXPECT_FALSE(contains(r.output, "PING ->")) << "nothing runs: " << r.output;
+  const auto out = expect_script_refused("typo.txt", "ping\nV 160\n  stauts\n",
+                                         ":3:3: unknown command 'stauts'");
+  EXPECT_FALSE(contains(out, "PING ->")) << "nothing runs: " << out;
   const auto token = client({"PING", "V 999"});
   EXPECT_EQ(token.exit_code, 2) << token.output;
   EXPECT_TRUE(contains(token.output, "argument 2 'V 999', column 3: V needs a number 0..255"))
@@ -213,8 +188,7 @@ TEST_F(ArduinoClientCli, ATypoInAScriptExits2WithFileLineAndColumn) {
 TEST_F(ArduinoClientCli, APortThatDoesNotExistIsAClearErrorAndExit1) {
   const auto r = client({"PING"});  // no mock: the pty path does not exist
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "link DOWN: cannot open " + port)) << r.output;
-  EXPECT_TRUE(contains(r.output, "PING -> LINK DOWN (")) << r.output;
+  expect_contains(r.output, {"link DOWN: cannot open " + port, "PING -> LINK DOWN ("});
 }
 
 TEST_F(ArduinoClientCli, BadUsageExits2AndHelpExits0) {
@@ -230,12 +204,10 @@ TEST_F(ArduinoClientCli, BadUsageExits2AndHelpExits0) {
 
 TEST(ArduinoClientPort, ADevicePathIsASerialPortAndAUriIsTakenAsItIs) {
   using apps::arduino_client::endpoint_for_port;
-  EXPECT_EQ(endpoint_for_port("/dev/ttyUSB0", 9600),
-            link::Endpoint(link::PtyEndpoint{"/dev/ttyUSB0", 9600, link::Duration{0}}));
+  EXPECT_EQ(endpoint_for_port("/dev/ttyUSB0", 9600), serial_endpoint("/dev/ttyUSB0", 9600));
   EXPECT_EQ(endpoint_for_port("pty:///tmp/hil-arduino0", 115200),
-            link::Endpoint(link::PtyEndpoint{"/tmp/hil-arduino0", 115200, link::Duration{0}}));
-  EXPECT_EQ(endpoint_for_port("pty:///tmp/a?baud=300", 9600),
-            link::Endpoint(link::PtyEndpoint{"/tmp/a", 300, link::Duration{0}}));
+            serial_endpoint("/tmp/hil-arduino0", 115200));
+  EXPECT_EQ(endpoint_for_port("pty:///tmp/a?baud=300", 9600), serial_endpoint("/tmp/a", 300));
   EXPECT_EQ(endpoint_for_port("tcp://127.0.0.1:9200", 9600),
             link::Endpoint(link::TcpEndpoint{"127.0.0.1", 9200}));
   EXPECT_THROW(endpoint_for_port("ftp://x", 9600), link::EndpointError);

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "apps/leka-client/app.hpp"
+#include "tests/apps/client_program_support.hpp"
 
 namespace hil::apps::leka_client {
 namespace {
@@ -21,12 +22,12 @@ leka::Script script_of(const std::string& text) {
 }
 
 TEST(LekaClientApp, APathIsASerialDeviceAndAUriKeepsItsOwnBaud) {
-  EXPECT_EQ(endpoint_for_port("/dev/ttyUSB0", 115200),
-            link::Endpoint(link::PtyEndpoint{"/dev/ttyUSB0", 115200, link::Duration{0}}));
+  using hil::test::serial_endpoint;
+  EXPECT_EQ(endpoint_for_port("/dev/ttyUSB0", 115200), serial_endpoint("/dev/ttyUSB0", 115200));
   EXPECT_EQ(endpoint_for_port("pty:///tmp/hil-leka0", 57600),
-            link::Endpoint(link::PtyEndpoint{"/tmp/hil-leka0", 57600, link::Duration{0}}));
+            serial_endpoint("/tmp/hil-leka0", 57600));
   EXPECT_EQ(endpoint_for_port("pty:///tmp/hil-leka0?baud=9600", 57600),
-            link::Endpoint(link::PtyEndpoint{"/tmp/hil-leka0", 9600, link::Duration{0}}));
+            serial_endpoint("/tmp/hil-leka0", 9600));
   EXPECT_THROW(endpoint_for_port("bogus://x", 115200), link::EndpointError);
 }
 

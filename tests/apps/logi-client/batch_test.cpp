@@ -10,145 +10,102 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/logi-client/batch.hpp"
-#include "tests/apps/client_program_support.hpp"
+#include "tests/apps/logi-client/logi_client_support.hpp"
 
 namespace hil::test {
 namespace {
 
 using namespace std::chrono_literals;
-namespace fs = std::filesystem;
 
-/// `hil mock logi` on a free port (the same car every run).
-struct MockLogi : MockCar {
-  explicit MockLogi(std::vector<std::string> extra = {})
-      : MockCar(mock_on_tcp_args("logi", with_seed(std::move(extra))), kTcpReady) {}
-  static std::vector<std::string> with_seed(std::vector<std::string> extra) {
-    extra.insert(extra.begin(), {"--seed", "1"});
-    return extra;
-  }
+struct LogiClientBatch : LogiClientTest {
+  // A port nothing listens on for the runs that must not get as far as
+  // connecting.
+  LogiClientBatch() : LogiClientTest("logi-client-batch") { port = "1"; }
 };
 
-TEST(LogiClientBatch, TheManualDriveScriptDrivesTheMockCarAndExits0) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.process().output();
-  const TempDir temp("logi-client-manual");
-  const auto& dir = temp.path();
+TEST_F(LogiClientBatch, TheManualDriveScriptDrivesTheMockCarAndExits0) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
   const auto log = dir / "run.txt";
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--log", log.string(), "--script",
-                                         "scenarios/clients/logi-client/manual-drive.txt"});
-  const auto status = client.wait_exit(30s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 0) << client.output();
+  HilProcess client(LOGI_CLIENT_BINARY,
+                    on_port({"--log", log.string(), "--script",
+                             "scenarios/clients/logi-client/manual-drive.txt"}));
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 0, 30s));
   const std::string& out = client.output();
-  EXPECT_NE(out.find("link connected"), std::string::npos) << out;
-  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\[ *\d+\.\d{3} s\] ok   speed 40)"))) << out;
-  EXPECT_NE(out.find("ok   press FWD"), std::string::npos) << out;
-  EXPECT_NE(out.find("ok   release"), std::string::npos) << out;
-  EXPECT_NE(out.find("ok   disconnect"), std::string::npos) << out;
-  EXPECT_EQ(out.find("FAIL"), std::string::npos) << out;
   // The car really drove: its telemetry showed MAN FWD, both in the
   // program's output and in the log of what the car sent.
-  EXPECT_NE(out.find("car  MODE MAN  RUN 0  STA 000  SP 40  MAN FWD"), std::string::npos) << out;
+  expect_contains(out, {"link connected", "ok   press FWD", "ok   release", "ok   disconnect",
+                        "car  MODE MAN  RUN 0  STA 000  SP 40  MAN FWD"});
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(\[ *\d+\.\d{3} s\] ok   speed 40)"))) << out;
+  EXPECT_EQ(out.find("FAIL"), std::string::npos) << out;
   const std::string text = read_file(log);
-  EXPECT_NE(text.find("TX   LOGI:MV:FWD:23#"), std::string::npos) << text;
-  EXPECT_NE(text.find("RX   LOGI:FB:MV:1:"), std::string::npos) << text;
+  expect_contains(text, {"TX   LOGI:MV:FWD:23#", "RX   LOGI:FB:MV:1:"});
   EXPECT_TRUE(std::regex_search(text, std::regex("RX   LOGI:STAT:[^ ]*MAN:FWD"))) << text;
   EXPECT_TRUE(std::regex_search(text, std::regex("RX   LOGI:STAT:[^ ]*MAN:CW"))) << text;
 }
 
-TEST(LogiClientBatch, AMoveTheCarRefusesExits1WithTheReasonAndRunsNothingAfterIt) {
-  MockLogi car({"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml"});
-  ASSERT_FALSE(car.port().empty()) << car.process().output();
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "connect", "speed 50", "mode MAN",
-                                         "press FWD", "wait 1s", "release"});
-  const auto status = client.wait_exit(20s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 1) << client.output();
+TEST_F(LogiClientBatch, AMoveTheCarRefusesExits1WithTheReasonAndRunsNothingAfterIt) {
+  ASSERT_NO_FATAL_FAILURE(
+      start_car({"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml"}));
+  HilProcess client(LOGI_CLIENT_BINARY, on_port({"connect", "speed 50", "mode MAN", "press FWD",
+                                                 "wait 1s", "release"}));
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 1, 20s));
   const std::string& out = client.output();
-  EXPECT_NE(out.find("ok   mode MAN"), std::string::npos) << out;
-  EXPECT_NE(out.find("note Not in manual mode, switching to MAN"), std::string::npos) << out;
-  EXPECT_NE(out.find("FAIL press FWD: rejected by the car (FB:MV:0)"), std::string::npos) << out;
+  expect_contains(out, {"ok   mode MAN", "note Not in manual mode, switching to MAN",
+                        "FAIL press FWD: rejected by the car (FB:MV:0)"});
   EXPECT_EQ(out.find("wait 1s"), std::string::npos) << out;
 }
 
-TEST(LogiClientBatch, ContinueOnErrorRunsEveryActionAndStillExits1) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.process().output();
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--continue-on-error", "connect",
-                                         "station 7", "speed 30", "disconnect"});
-  const auto status = client.wait_exit(20s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 1) << client.output();
-  EXPECT_NE(client.output().find("FAIL station 7: rejected by the car (FB:GS:0)"),
-            std::string::npos)
-      << client.output();
-  EXPECT_NE(client.output().find("ok   speed 30"), std::string::npos) << client.output();
-  EXPECT_NE(client.output().find("ok   disconnect"), std::string::npos) << client.output();
+TEST_F(LogiClientBatch, ContinueOnErrorRunsEveryActionAndStillExits1) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
+  HilProcess client(LOGI_CLIENT_BINARY, on_port({"--continue-on-error", "connect", "station 7",
+                                                 "speed 30", "disconnect"}));
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 1, 20s));
+  expect_contains(client.output(), {"FAIL station 7: rejected by the car (FB:GS:0)",
+                                    "ok   speed 30", "ok   disconnect"});
 }
 
-TEST(LogiClientBatch, AScriptWithATypoExits2NamingFileLineAndColumn) {
-  const TempDir temp("logi-client-typo");
-  const auto& dir = temp.path();
-  const auto script = dir / "drive.txt";
-  std::ofstream(script) << "# drive\nconnect\nspeed 50\nmode MAN\npress  FORWARD\n";
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", "1", "--script", script.string()});
-  const auto status = client.wait_exit(10s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 2) << client.output();
-  EXPECT_NE(client.output().find(script.string() +
-                                 ":5:8: expected a direction (STOP, FWD, BWD, LEFT, RIGHT, LF, "
-                                 "RF, LB, RB, CW, CCW), got 'FORWARD'"),
-            std::string::npos)
-      << client.output();
-  EXPECT_EQ(client.output().find("connect"), std::string::npos) << "nothing ran";
+TEST_F(LogiClientBatch, AScriptWithATypoExits2NamingFileLineAndColumn) {
+  const auto out = expect_script_refused(
+      "drive.txt", "# drive\nconnect\nspeed 50\nmode MAN\npress  FORWARD\n",
+      ":5:8: expected a direction (STOP, FWD, BWD, LEFT, RIGHT, LF, RF, LB, RB, CW, CCW), got "
+      "'FORWARD'");
+  EXPECT_EQ(out.find("connect"), std::string::npos) << "nothing ran";
 
-  HilProcess args(LOGI_CLIENT_BINARY, {"connect", "spead 50"});
-  EXPECT_EQ(args.wait_exit(10s), 2) << args.output();
-  EXPECT_NE(args.output().find("<command line>:2:1: unknown action 'spead'"), std::string::npos)
-      << args.output();
-
-  HilProcess missing(LOGI_CLIENT_BINARY, {"--script", (dir / "nope.txt").string()});
-  EXPECT_EQ(missing.wait_exit(10s), 2) << missing.output();
-  EXPECT_NE(missing.output().find("nope.txt: cannot read the script"), std::string::npos)
-      << missing.output();
-
-  HilProcess bad_log(LOGI_CLIENT_BINARY, {"--log", "run.xml", "connect"});
-  EXPECT_EQ(bad_log.wait_exit(10s), 2) << bad_log.output();
-  EXPECT_NE(bad_log.output().find(".txt, .csv or .ndjson"), std::string::npos) << bad_log.output();
+  for (const auto& [args, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"connect", "spead 50"}, "<command line>:2:1: unknown action 'spead'"},
+           {{"--script", (dir / "nope.txt").string()}, "nope.txt: cannot read the script"},
+           {{"--log", "run.xml", "connect"}, ".txt, .csv or .ndjson"}}) {
+    HilProcess refused(LOGI_CLIENT_BINARY, args);
+    EXPECT_EQ(refused.wait_exit(10s), 2) << refused.output();
+    expect_contains(refused.output(), {says});
+  }
 }
 
-TEST(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
+TEST_F(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
   HilProcess client(LOGI_CLIENT_BINARY,
                     {"--port", free_tcp_port(), "--connect-timeout", "2s", "connect", "speed 50"});
-  const auto status = client.wait_exit(20s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 1) << client.output();
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 1, 20s));
   const std::string& out = client.output();
-  EXPECT_NE(out.find("WARN not connected (lost or refused); reconnecting"), std::string::npos)
-      << out;
-  EXPECT_NE(out.find("FAIL connect: not connected after 2s"), std::string::npos) << out;
+  expect_contains(out, {"WARN not connected (lost or refused); reconnecting",
+                        "FAIL connect: not connected after 2s"});
   EXPECT_EQ(out.find("speed 50"), std::string::npos) << out;
 }
 
-TEST(LogiClientBatch, CtrlCDuringAWaitStopsTheCarAndExits130) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.process().output();
-  const TempDir temp("logi-client-sigint");
-  const auto& dir = temp.path();
+TEST_F(LogiClientBatch, CtrlCDuringAWaitStopsTheCarAndExits130) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
   const auto log = dir / "run.ndjson";
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--log", log.string(), "connect",
-                                         "speed 50", "mode MAN", "press FWD", "wait 30s"});
+  HilProcess client(LOGI_CLIENT_BINARY, on_port({"--log", log.string(), "connect", "speed 50",
+                                                 "mode MAN", "press FWD", "wait 30s"}));
   ASSERT_TRUE(client.wait_for_line("ok   press FWD", 15s)) << client.output();
   const auto status = client.interrupt(10s);
   ASSERT_TRUE(status) << client.output();
   EXPECT_EQ(*status, 130) << client.output();
-  const std::string& out = client.output();
-  EXPECT_NE(out.find("interrupted (SIGINT): stopping"), std::string::npos) << out;
-  EXPECT_NE(out.find("FAIL wait 30s: cancelled"), std::string::npos) << out;
-  EXPECT_NE(out.find("emergency stop: MV:STOP"), std::string::npos) << out;
+  expect_contains(client.output(), {"interrupted (SIGINT): stopping", "FAIL wait 30s: cancelled",
+                                    "emergency stop: MV:STOP"});
   // The car got the MV:STOP and answered it before the client hung up.
   const std::string text = read_file(log);
   const auto stop = text.find(R"("kind":"TX","raw":"LOGI:MV:STOP:88#")");
@@ -156,18 +113,13 @@ TEST(LogiClientBatch, CtrlCDuringAWaitStopsTheCarAndExits130) {
   EXPECT_NE(text.find(R"("kind":"RX","raw":"LOGI:FB:MV:1:)", stop), std::string::npos) << text;
 }
 
-TEST(LogiClientBatch, ActionsCanComeFromStandardInput) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.process().output();
-  HilProcess client(LOGI_CLIENT_BINARY, {"--port", car.port(), "--script", "-"});
+TEST_F(LogiClientBatch, ActionsCanComeFromStandardInput) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
+  HilProcess client(LOGI_CLIENT_BINARY, on_port({"--script", "-"}));
   client.write_stdin("connect\nspeed 60\nmode AUTO\nstation 001\nstop\nwait 1200ms\ndisconnect\n");
   client.close_stdin();
-  const auto status = client.wait_exit(20s);
-  ASSERT_TRUE(status) << client.output();
-  EXPECT_EQ(*status, 0) << client.output();
-  EXPECT_NE(client.output().find("ok   station 001"), std::string::npos) << client.output();
-  EXPECT_NE(client.output().find("car  MODE AUTO  RUN 0  STA 001  SP 60"), std::string::npos)
-      << client.output();
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 0, 20s));
+  expect_contains(client.output(), {"ok   station 001", "car  MODE AUTO  RUN 0  STA 001  SP 60"});
 }
 
 // ---- the program's pieces, without a process ----

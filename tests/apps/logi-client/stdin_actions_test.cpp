@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "apps/logi-client/stdin_actions.hpp"
-#include "tests/apps/client_program_support.hpp"
+#include "tests/apps/logi-client/logi_client_support.hpp"
 
 namespace hil::test {
 namespace {
@@ -19,32 +19,46 @@ using namespace std::chrono_literals;
 namespace lc = hil::apps::logi_client;
 namespace logi = hil::client::logi;
 
-struct MockLogi : MockCar {
-  explicit MockLogi(std::vector<std::string> extra = {})
-      : MockCar(mock_on_tcp_args("logi", with_seed(std::move(extra))), kTcpReady) {}
-  static std::vector<std::string> with_seed(std::vector<std::string> extra) {
-    extra.insert(extra.begin(), {"--seed", "1"});
-    return extra;
-  }
-};
-
 HilProcess stdin_client(const std::string& port, std::vector<std::string> extra = {}) {
   std::vector<std::string> args{"--stdin-actions", "--host", "127.0.0.1", "--port", port};
   args.insert(args.end(), extra.begin(), extra.end());
   return HilProcess(LOGI_CLIENT_BINARY, args);
 }
 
+/// Closes the client's stdin, as hil does at the end of a scenario: it
+/// exits 0.
+void expect_exit_0_at_end_of_input(HilProcess& client) {
+  client.close_stdin();
+  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+}
+
+/// Lines written to the client's stdin at once, and the lines it answers
+/// them with, in order, each within `limit`.
+struct Exchange {
+  std::string input;
+  std::vector<std::string> answers;
+  std::chrono::milliseconds limit = 10s;
+};
+
+/// Each exchange in turn: its input written once the answers to the one
+/// before have come.
+void converse(HilProcess& client, const std::vector<Exchange>& exchanges) {
+  for (const Exchange& e : exchanges) {
+    if (!e.input.empty()) ASSERT_TRUE(client.write_stdin(e.input));
+    expect_lines(client, e.answers, e.limit);
+  }
+}
+
 // ---- the pieces, without a car ----
 
-TEST(LogiClientStdinActions, EventLinesNameStatesAsHilsReferenceClientRecordsThem) {
+TEST(LogiClientStdinActionLines, EventLinesNameStatesAsHilsReferenceClientRecordsThem) {
   using logi::ConnectionState;
   EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::connecting, 0}),
             "event connection connecting");
   EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::connected, 0}),
             "event connection connected");
-  EXPECT_EQ(
-      lc::contract_event_line(logi::ConnectionEvent{ConnectionState::reconnecting, 2}),
-      "event connection reconnecting");
+  EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::reconnecting, 2}),
+            "event connection reconnecting");
   EXPECT_EQ(lc::contract_event_line(logi::ConnectionEvent{ConnectionState::disconnected, 0}),
             "event connection disconnected");
   logi::CommandEvent sent{7, protocol::logi::SetSpeed{50}, logi::CommandState::sent, 1, false};
@@ -69,7 +83,7 @@ TEST(LogiClientStdinActions, EventLinesNameStatesAsHilsReferenceClientRecordsThe
   EXPECT_EQ(lc::contract_event_line(logi::StatusEvent{}), std::nullopt);
 }
 
-TEST(LogiClientStdinActions, ALineIsAnActionABlankOrCommentOrAnErrorWithItsColumn) {
+TEST(LogiClientStdinActionLines, ALineIsAnActionABlankOrCommentOrAnErrorWithItsColumn) {
   const auto action = lc::parse_action_line(3, "  speed 50   # slow\r");
   ASSERT_TRUE(action.step);
   EXPECT_EQ(action.step->line, 3);
@@ -91,66 +105,54 @@ TEST(LogiClientStdinActions, ALineIsAnActionABlankOrCommentOrAnErrorWithItsColum
 
 // ---- against the mock car ----
 
-TEST(LogiClientStdinActions, AnswersEachActionAsItArrivesAndStopsTheCarWhenStdinCloses) {
-  const TempDir temp("logi-client-stdin");
+struct LogiClientStdinActions : LogiClientTest {
+  LogiClientStdinActions() : LogiClientTest("logi-client-stdin") {}
+};
+
+TEST_F(LogiClientStdinActions, AnswersEachActionAsItArrivesAndStopsTheCarWhenStdinCloses) {
   const std::string wire = temp.file("wire.ndjson");
-  MockLogi car({"--log", wire});
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
+  ASSERT_NO_FATAL_FAILURE(start_car({"--log", wire}));
+  auto client = stdin_client(port);
 
   // Each result comes while stdin is still open, before the next action
   // is written: the actions are run as they arrive, not read to the end.
-  ASSERT_TRUE(client.write_stdin("connect\n"));
-  EXPECT_TRUE(client.wait_for_line("event connection connecting")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event connection connected")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
-
-  ASSERT_TRUE(client.write_stdin("speed 50\n"));
-  EXPECT_TRUE(client.wait_for_line("event command SP sent")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event command SP accepted")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   speed 50")) << client.output();
-
-  ASSERT_TRUE(client.write_stdin("mode MAN\n"));
-  EXPECT_TRUE(client.wait_for_line("] ok   mode MAN")) << client.output();
-  ASSERT_TRUE(client.write_stdin("press FWD\n"));
-  EXPECT_TRUE(client.wait_for_line("event command MV:FWD accepted")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   press FWD")) << client.output();
+  ASSERT_NO_FATAL_FAILURE(converse(
+      client,
+      {{"connect\n",
+        {"event connection connecting", "event connection connected", "] ok   connect"}},
+       {"speed 50\n", {"event command SP sent", "event command SP accepted", "] ok   speed 50"}},
+       {"mode MAN\n", {"] ok   mode MAN"}},
+       {"press FWD\n", {"event command MV:FWD accepted", "] ok   press FWD"}}}));
 
   // hil closes stdin at the end of a scenario; the car is still moving.
   client.close_stdin();
-  EXPECT_TRUE(client.wait_for_line("emergency stop: MV:STOP")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event command MV:STOP accepted")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event connection disconnected")) << client.output();
+  expect_lines(client, {"emergency stop: MV:STOP", "event command MV:STOP accepted",
+                        "event connection disconnected"});
   EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
 
-  ASSERT_EQ(car.stop(), 0) << car.output();
+  ASSERT_EQ(mock->stop(), 0) << mock->output();
   const auto frames = delivered_to_car(read_file(wire));
   ASSERT_FALSE(frames.empty());
   EXPECT_TRUE(contains(frames.back(), "LOGI:MV:STOP:88#")) << frames.back();
 }
 
-TEST(LogiClientStdinActions, AMoveTheCarRefusedIsNoReasonForAStopAtTheEnd) {
-  const TempDir temp("logi-client-stdin-refused");
+TEST_F(LogiClientStdinActions, AMoveTheCarRefusedIsNoReasonForAStopAtTheEnd) {
   const std::string wire = temp.file("wire.ndjson");
-  MockLogi car(
-      {"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml", "--log", wire});
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
+  ASSERT_NO_FATAL_FAILURE(start_car(
+      {"--behaviours", "scenarios/clients/logi-client/car-refuses-moves.yaml", "--log", wire}));
+  auto client = stdin_client(port);
   ASSERT_TRUE(client.write_stdin("connect\nspeed 50\nmode MAN\npress FWD\n"));
-  EXPECT_TRUE(client.wait_for_line("] FAIL press FWD: rejected by the car (FB:MV:0)"))
-      << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  expect_lines(client, {"] FAIL press FWD: rejected by the car (FB:MV:0)"});
+  expect_exit_0_at_end_of_input(client);
   EXPECT_FALSE(contains(client.output(), "emergency stop")) << client.output();
-  ASSERT_EQ(car.stop(), 0) << car.output();
+  ASSERT_EQ(mock->stop(), 0) << mock->output();
   for (const auto& frame : delivered_to_car(read_file(wire)))
     EXPECT_FALSE(contains(frame, "MV:STOP")) << frame;
 }
 
-TEST(LogiClientStdinActions, ABadLineOrARefusedActionFailsThatLineOnlyAndTheExitIsStill0) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
+TEST_F(LogiClientStdinActions, ABadLineOrARefusedActionFailsThatLineOnlyAndTheExitIsStill0) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
+  auto client = stdin_client(port);
   // All at once: the answers still come one per action line, in order.
   ASSERT_TRUE(
       client.write_stdin("connect\n"
@@ -161,132 +163,96 @@ TEST(LogiClientStdinActions, ABadLineOrARefusedActionFailsThatLineOnlyAndTheExit
                          "press FWD\n"
                          "speed 30\n"
                          "disconnect\n"));
-  EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] FAIL press FORWARD: column 7: expected a direction"))
-      << client.output();
-  EXPECT_TRUE(client.wait_for_line("] FAIL station 7: rejected by the car (FB:GS:0)"))
-      << client.output();
-  EXPECT_TRUE(client.wait_for_line(
-      "] FAIL press FWD: refused: movement needs a 'mode' and a 'speed' on this connection first"))
-      << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   speed 30")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   disconnect")) << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  expect_lines(client, {"] ok   connect", "] FAIL press FORWARD: column 7: expected a direction",
+                        "] FAIL station 7: rejected by the car (FB:GS:0)",
+                        "] FAIL press FWD: refused: movement needs a 'mode' and a 'speed' on "
+                        "this connection first",
+                        "] ok   speed 30", "] ok   disconnect"});
+  expect_exit_0_at_end_of_input(client);
 
   // Six action lines, six results: the blank and the comment line get none.
   const std::string& out = client.output();
   int results = 0;
-  for (std::size_t at = out.find("] ok   "); at != std::string::npos;
-       at = out.find("] ok   ", at + 1))
-    ++results;
-  for (std::size_t at = out.find("] FAIL "); at != std::string::npos;
-       at = out.find("] FAIL ", at + 1))
-    ++results;
+  for (const char* verdict : {"] ok   ", "] FAIL "})
+    for (std::size_t at = out.find(verdict); at != std::string::npos;
+         at = out.find(verdict, at + 1))
+      ++results;
   EXPECT_EQ(results, 6) << out;
 }
 
-TEST(LogiClientStdinActions, ConfirmSendsAgainTheRunWhoseFeedbackWasLost) {
-  const TempDir temp("logi-client-stdin-confirm");
-  const auto faults = temp.write(
-      "lost.yaml", "rules:\n  - {kind: drop, direction: to_client, match: \"FB:ST\", first: 1}\n");
-  MockLogi car({"--faults", faults.string()});
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
-  ASSERT_TRUE(client.write_stdin("connect\nspeed 50\nmode AUTO\nstation 2\nrun\n"));
-  EXPECT_TRUE(client.wait_for_line("event command ST:RUN uncertain")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] FAIL run: no feedback to ST:RUN")) << client.output();
+TEST_F(LogiClientStdinActions, ConfirmSendsAgainTheRunWhoseFeedbackWasLost) {
+  ASSERT_NO_FATAL_FAILURE(start_car_with_faults(
+      "lost.yaml", "rules:\n  - {kind: drop, direction: to_client, match: \"FB:ST\", first: 1}\n"));
+  auto client = stdin_client(port);
   // Each action has its own runner; `confirm` still knows what went unanswered.
-  ASSERT_TRUE(client.write_stdin("confirm\n"));
-  EXPECT_TRUE(client.wait_for_line("event command ST:RUN accepted")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   confirm")) << client.output();
-  ASSERT_TRUE(client.write_stdin("stop\n"));
-  EXPECT_TRUE(client.wait_for_line("] ok   stop")) << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  ASSERT_NO_FATAL_FAILURE(
+      converse(client, {{"connect\nspeed 50\nmode AUTO\nstation 2\nrun\n",
+                         {"event command ST:RUN uncertain", "] FAIL run: no feedback to ST:RUN"}},
+                        {"confirm\n", {"event command ST:RUN accepted", "] ok   confirm"}},
+                        {"stop\n", {"] ok   stop"}}}));
+  expect_exit_0_at_end_of_input(client);
 }
 
-TEST(LogiClientStdinActions, AnEmergencyStopGoesOutAtOnceBesideAnActionAwaitingFeedback) {
-  const TempDir temp("logi-client-stdin-estop");
-  const auto faults = temp.write(
-      "lost-sp.yaml", "rules:\n  - {kind: drop, direction: to_car, match: \"SP\", first: 1}\n");
-  MockLogi car({"--faults", faults.string()});
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
-  ASSERT_TRUE(client.write_stdin("connect\nmode MAN\nspeed 60\n"));
-  EXPECT_TRUE(client.wait_for_line("event command SP sent")) << client.output();
+TEST_F(LogiClientStdinActions, AnEmergencyStopGoesOutAtOnceBesideAnActionAwaitingFeedback) {
+  ASSERT_NO_FATAL_FAILURE(start_car_with_faults(
+      "lost-sp.yaml", "rules:\n  - {kind: drop, direction: to_car, match: \"SP\", first: 1}\n"));
+  auto client = stdin_client(port);
   // The SP never reached the car: it is sent again only after 800 ms. The
-  // stop does not wait for that ...
-  ASSERT_TRUE(client.write_stdin("estop\n"));
-  EXPECT_TRUE(client.wait_for_line("event command MV:STOP accepted")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event command SP sent")) << client.output();
-  // ... but its result line keeps its place after the speed's.
-  EXPECT_TRUE(client.wait_for_line("] ok   speed 60")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] ok   estop")) << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  // stop does not wait for that, but its result line keeps its place after
+  // the speed's.
+  ASSERT_NO_FATAL_FAILURE(
+      converse(client, {{"connect\nmode MAN\nspeed 60\n", {"event command SP sent"}},
+                        {"estop\n",
+                         {"event command MV:STOP accepted", "event command SP sent",
+                          "] ok   speed 60", "] ok   estop"}}}));
+  expect_exit_0_at_end_of_input(client);
 }
 
-TEST(LogiClientStdinActions, TheStaleWarningAndItsEndAreEventLines) {
-  const TempDir temp("logi-client-stdin-stale");
-  const auto faults =
-      temp.write("mute.yaml", "rules:\n  - {kind: stall, direction: to_client, at: 1s, for: 3s}\n");
-  MockLogi car({"--faults", faults.string()});
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
-  ASSERT_TRUE(client.write_stdin("connect\n"));
-  EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event stale", 15s)) << client.output();
-  EXPECT_TRUE(client.wait_for_line("event fresh", 15s)) << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+TEST_F(LogiClientStdinActions, TheStaleWarningAndItsEndAreEventLines) {
+  ASSERT_NO_FATAL_FAILURE(start_car_with_faults(
+      "mute.yaml", "rules:\n  - {kind: stall, direction: to_client, at: 1s, for: 3s}\n"));
+  auto client = stdin_client(port);
+  ASSERT_NO_FATAL_FAILURE(converse(
+      client, {{"connect\n", {"] ok   connect"}}, {"", {"event stale", "event fresh"}, 15s}}));
+  expect_exit_0_at_end_of_input(client);
 }
 
-TEST(LogiClientStdinActions, NoCarMeansAFailedConnectWithReconnectingEventsAndAStill0Exit) {
+TEST_F(LogiClientStdinActions, NoCarMeansAFailedConnectWithReconnectingEventsAndAStill0Exit) {
   auto client = stdin_client(free_tcp_port(), {"--connect-timeout", "1500ms"});
   ASSERT_TRUE(client.write_stdin("connect\n"));
-  EXPECT_TRUE(client.wait_for_line("event connection reconnecting")) << client.output();
-  EXPECT_TRUE(client.wait_for_line("] FAIL connect: not connected after 1.5s")) << client.output();
-  client.close_stdin();
-  EXPECT_EQ(client.wait_exit(10s), 0) << client.output();
+  expect_lines(client,
+               {"event connection reconnecting", "] FAIL connect: not connected after 1.5s"});
+  expect_exit_0_at_end_of_input(client);
 }
 
-TEST(LogiClientStdinActions, CtrlCCancelsTheActionUnderWayAndExits130) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.output();
-  auto client = stdin_client(car.port());
+TEST_F(LogiClientStdinActions, CtrlCCancelsTheActionUnderWayAndExits130) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
+  auto client = stdin_client(port);
   ASSERT_TRUE(client.write_stdin("connect\nwait 1m\n"));
-  EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
+  expect_lines(client, {"] ok   connect"});
   EXPECT_EQ(client.interrupt(10s), 130) << client.output();
-  EXPECT_TRUE(contains(client.output(), "] FAIL wait 1m: cancelled")) << client.output();
-  EXPECT_TRUE(contains(client.output(), "event connection disconnected")) << client.output();
+  expect_contains(client.output(), {"] FAIL wait 1m: cancelled", "event connection disconnected"});
 }
 
 // Ctrl-C can come at any moment: while an action runs, between two actions,
 // or after an action was taken but before its first turn. Every line taken
 // still gets exactly one result line.
-TEST(LogiClientStdinActions, CtrlCAtAnyMomentAnswersEveryLineOnce) {
-  MockLogi car;
-  ASSERT_FALSE(car.port().empty()) << car.output();
+TEST_F(LogiClientStdinActions, CtrlCAtAnyMomentAnswersEveryLineOnce) {
+  ASSERT_NO_FATAL_FAILURE(start_car());
   for (int round = 0; round < 5; ++round) {
-    auto client = stdin_client(car.port());
+    auto client = stdin_client(port);
     ASSERT_TRUE(client.write_stdin("connect\nwait 1m\nwait 2m\n"));
-    if (round % 2 == 0) {
-      EXPECT_TRUE(client.wait_for_line("event connection connecting")) << client.output();
-    } else {
-      EXPECT_TRUE(client.wait_for_line("] ok   connect")) << client.output();
-    }
+    expect_lines(client, {round % 2 == 0 ? "event connection connecting" : "] ok   connect"});
     EXPECT_EQ(client.interrupt(10s), 130) << client.output();
     const std::string& out = client.output();
     const int connect_results = static_cast<int>(contains(out, "] ok   connect")) +
                                 static_cast<int>(contains(out, "] FAIL connect: cancelled"));
     EXPECT_EQ(connect_results, 1) << out;
-    EXPECT_TRUE(contains(out, "] FAIL wait 1m: cancelled")) << out;
-    EXPECT_TRUE(contains(out, "] FAIL wait 2m: cancelled")) << out;
+    expect_contains(out, {"] FAIL wait 1m: cancelled", "] FAIL wait 2m: cancelled"});
   }
 }
 
-TEST(LogiClientStdinActions, StdinActionsWithAScriptOrActionsIsAUsageError) {
+TEST_F(LogiClientStdinActions, StdinActionsWithAScriptOrActionsIsAUsageError) {
   const auto result = run_to_exit(LOGI_CLIENT_BINARY, {"--stdin-actions", "connect"});
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_TRUE(contains(result.output, "--stdin-actions reads the actions from stdin"))

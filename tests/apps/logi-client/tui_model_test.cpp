@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,18 @@ class TuiModelTest : public ::testing::Test {
   void connected(Time at = ms(0)) {
     model.on_event(at, logi::ConnectionEvent{ConnectionState::connected, 0});
   }
+  /// The key held is released at `at` ms and not a millisecond before;
+  /// with `held`, the model shows that direction held until then and
+  /// nothing after.
+  void expect_released_at(long at, std::optional<Direction> held = std::nullopt) {
+    EXPECT_CALL(session, release()).Times(0);
+    model.on_time(ms(at - 1));
+    if (held) EXPECT_EQ(model.held(), *held);
+    ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
+    EXPECT_CALL(session, release()).Times(1);
+    model.on_time(ms(at));
+    if (held) EXPECT_FALSE(model.held());
+  }
   void keys(Time at, const std::string& text) {
     for (const char c : text)
       model.on_key(at, c);
@@ -98,13 +111,7 @@ TEST_F(TuiModelTest, AHeldKeyIsReleasedExactly200MsAfterItsLastRepeat) {
   ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
   EXPECT_EQ(model.next_wakeup(), ms(1700));
 
-  EXPECT_CALL(session, release()).Times(0);
-  model.on_time(ms(1699));
-  EXPECT_EQ(model.held(), Direction::fwd);
-  ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
-  EXPECT_CALL(session, release()).Times(1);
-  model.on_time(ms(1700));
-  EXPECT_FALSE(model.held());
+  ASSERT_NO_FATAL_FAILURE(expect_released_at(1700, Direction::fwd));
   EXPECT_EQ(model.next_wakeup(), std::nullopt);
 }
 
@@ -115,11 +122,7 @@ TEST_F(TuiModelTest, AShortAutoRepeatDelayIsFollowedJustAsWell) {
   for (long t = 250; t <= 1000; t += 30)
     model.on_key(ms(t), 'd');
   EXPECT_EQ(model.next_wakeup(), ms(1200));
-  EXPECT_CALL(session, release()).Times(0);
-  model.on_time(ms(1199));
-  ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
-  EXPECT_CALL(session, release()).Times(1);
-  model.on_time(ms(1200));
+  ASSERT_NO_FATAL_FAILURE(expect_released_at(1200));
 }
 
 TEST_F(TuiModelTest, ASinglePressWithoutRepeatIsReleasedAtExactly700Ms) {
@@ -127,13 +130,7 @@ TEST_F(TuiModelTest, ASinglePressWithoutRepeatIsReleasedAtExactly700Ms) {
   EXPECT_CALL(session, press(Direction::lf)).Times(1);
   model.on_key(ms(0), 'q');
   EXPECT_EQ(model.next_wakeup(), ms(700));
-  EXPECT_CALL(session, release()).Times(0);
-  model.on_time(ms(699));
-  EXPECT_EQ(model.held(), Direction::lf);
-  ASSERT_TRUE(::testing::Mock::VerifyAndClearExpectations(&session));
-  EXPECT_CALL(session, release()).Times(1);
-  model.on_time(ms(700));
-  EXPECT_FALSE(model.held());
+  ASSERT_NO_FATAL_FAILURE(expect_released_at(700, Direction::lf));
 }
 
 TEST_F(TuiModelTest, TheWindowsComeFromTheConfiguration) {

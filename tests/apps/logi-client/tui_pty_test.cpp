@@ -40,19 +40,14 @@ class PtyProgram {
     winsize size{};
     size.ws_row = static_cast<unsigned short>(rows);
     size.ws_col = static_cast<unsigned short>(columns);
-    std::vector<std::string> argv_strings{LOGI_CLIENT_BINARY};
-    argv_strings.insert(argv_strings.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_strings)
-      argv.push_back(a.data());
-    argv.push_back(nullptr);
+    hil::test::ArgvList argv(LOGI_CLIENT_BINARY, args);
     pid_ = ::forkpty(&master_, nullptr, nullptr, &size);
     if (pid_ == 0) {
       if (::chdir(cwd.c_str()) != 0) ::_exit(126);
       ::setenv("TERM", "xterm", 1);
       ::setenv("LINES", std::to_string(rows).c_str(), 1);
       ::setenv("COLUMNS", std::to_string(columns).c_str(), 1);
-      ::execv(argv[0], argv.data());
+      ::execv(LOGI_CLIENT_BINARY, argv.data());
       ::_exit(127);
     }
     if (master_ >= 0) ::fcntl(master_, F_SETFL, ::fcntl(master_, F_GETFL) | O_NONBLOCK);

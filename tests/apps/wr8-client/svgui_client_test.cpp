@@ -19,29 +19,12 @@ namespace {
 
 using namespace std::chrono_literals;
 
-struct SvguiClientCli : ::testing::Test {
-  void TearDown() override {
-    if (mock) {
-      EXPECT_EQ(mock->stop(), 0) << mock->output();
-    }
-  }
+struct SvguiClientCli : ClientProgramTest {
+  SvguiClientCli() : ClientProgramTest(WR8_CLIENT_BINARY, "hil-wr8-svgui-client", "5556") {}
 
   void start_mock(const std::string& profile) {
-    mock.emplace(mock_on_tcp_args("wr8", {"--profile", profile}), kTcpReady);
-    ASSERT_TRUE(mock->ready()) << mock->output();
-    port = mock->port();
+    ClientProgramTest::start_mock(mock_on_tcp_args("wr8", {"--profile", profile}));
   }
-
-  /// wr8-client with `--port PORT` and `args`; waits for its exit.
-  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 30s) {
-    args.insert(args.begin(), {"--port", port});
-    return run_to_exit(WR8_CLIENT_BINARY, args, limit);
-  }
-
-  TempDir temp{"hil-wr8-svgui-client"};
-  std::filesystem::path dir = temp.path();
-  std::optional<MockCar> mock;
-  std::string port = "5556";
 };
 
 TEST_F(SvguiClientCli, AHeadBatchReadsBackHoldsControlAndLogsEveryLengthByte) {
@@ -67,9 +50,9 @@ TEST_F(SvguiClientCli, AHeadBatchReadsBackHoldsControlAndLogsEveryLengthByte) {
   EXPECT_TRUE(std::regex_search(r.output, std::regex("control off +ok +released"))) << r.output;
   EXPECT_TRUE(contains(r.output, " data  high-freq  encoder ")) << r.output;  // --data
   const std::string text = read_file(log);
-  EXPECT_TRUE(contains(text, "TX   0C 01 6B 6F 6E 6E 69 63 68 69 77 61 00")) << text;
-  EXPECT_TRUE(contains(text, "RX   04 02 01 02 03  AuthReply device=1 id=2 state=WAIT")) << text;
-  EXPECT_TRUE(contains(text, "TX   01 06  SetRequest")) << text;
+  expect_contains(
+      text, {"TX   0C 01 6B 6F 6E 6E 69 63 68 69 77 61 00",
+             "RX   04 02 01 02 03  AuthReply device=1 id=2 state=WAIT", "TX   01 06  SetRequest"});
   EXPECT_TRUE(contains(text, "TX   19 0A 00 00 00 01 00 00 00 00 00 00 00 00 00 00 00 02 3F D3"))
       << text;  // CONTROL x 0, y 0.3
   EXPECT_FALSE(contains(text, "ERR")) << text;
@@ -111,11 +94,8 @@ TEST_F(SvguiClientCli, AWordOfAnotherProfileOrAScriptTypoExits2WithItsPlace) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(contains(r.output, "'signals' is not a word of profile document")) << r.output;
 
-  const auto script = temp.write("typo.wr8", "connect\ncontrol 0.5 2\n");
-  r = client({"--profile", "svgui-head", "--script", script.string()});
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(contains(r.output, script.string() + ":2:13: expected the y axis (engine)"))
-      << r.output;
+  expect_script_refused("typo.wr8", "connect\ncontrol 0.5 2\n",
+                        ":2:13: expected the y axis (engine)", {"--profile", "svgui-head"});
 }
 
 TEST_F(SvguiClientCli, AuthIsForTheDocumentProfileOnly) {
@@ -133,9 +113,7 @@ TEST(SvguiClientPorts, EachProfileHasItsDefaultPort) {
             "127.0.0.1:6000 (profile svgui-head)"}}) {
     HilProcess p(WR8_CLIENT_BINARY, args);
     ASSERT_TRUE(p.write_stdin("help\nquit\n"));
-    const auto code = p.wait_exit(20s);
-    ASSERT_TRUE(code) << p.output();
-    EXPECT_EQ(*code, 0) << p.output();
+    ASSERT_NO_FATAL_FAILURE(expect_exit_status(p, 0, 20s));
     EXPECT_TRUE(contains(p.output(), banner)) << p.output();
   }
 }

@@ -4,17 +4,12 @@
 
 #include <gtest/gtest.h>
 
-#include <memory>
-#include <optional>
-#include <sstream>
 #include <string>
 #include <utility>
 
 #include "apps/wr8-client/console.hpp"
-#include "mocks/server.hpp"
 #include "mocks/wr8_svgui.hpp"
-#include "sim/presets.hpp"
-#include "tests/client/client_test_support.hpp"
+#include "tests/apps/wr8-client/console_bench.hpp"
 
 namespace hil::apps::wr8_client {
 namespace {
@@ -23,74 +18,31 @@ using link::milliseconds;
 using link::seconds;
 namespace svgui = wr8::svgui;
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 /// The mock vehicle of `version`, a session, a runner and the console.
-class Bench {
- public:
-  Bench(svgui::Version version, ConsoleOptions options) {
-    mocks::SvguiConfig car;
-    car.version = version;
-    mocks::ServerOptions server = client::test::on_mem("car");
-    server.name = "wr8";
-    car_.start_car(sim::wr8_vehicle(), std::move(server), car);
-    wr8::SvguiConfig config;
+struct Bench
+    : ConsoleBench<mocks::SvguiFirmware, wr8::SvguiSession, wr8::SvguiRunner, SvguiConsole> {
+  Bench(svgui::Version version, ConsoleOptions options)
+      : ConsoleBench(of_version<wr8::SvguiConfig>(version), std::move(options),
+                     of_version<mocks::SvguiConfig>(version)) {}
+
+  /// A default `Config` (the client's or the car's) for `version`.
+  template <class Config>
+  static Config of_version(svgui::Version version) {
+    Config config;
     config.version = version;
-    session_ =
-        std::make_unique<wr8::SvguiSession>(car_.context, link::MemEndpoint{"car"}, config,
-                                            [this](link::Time now, const wr8::SvguiEvent& e) {
-                                              runner_->on_event(now, e);
-                                              console_->on_event(now, e);
-                                            });
-    runner_ = std::make_unique<wr8::SvguiRunner>(car_.executor, *session_);
-    console_ = std::make_unique<SvguiConsole>(car_.executor, *session_, *runner_, out_,
-                                              std::move(options), [this](int code) {
-                                                exit_code_ = code;
-                                                exit_at_ = car_.executor.now();
-                                              });
+    return config;
   }
-
-  SvguiConsole& console() { return *console_; }
-  void run_until(link::Time t) { car_.executor.run_until(t); }
-  void run_to_exit() {
-    while (!exit_code_ && car_.executor.now() < seconds(60))
-      car_.executor.run_until(car_.executor.now() + milliseconds(10));
-  }
-  std::string output() const { return out_.str(); }
-  std::optional<int> exit_code() const { return exit_code_; }
-
- private:
-  client::test::VirtualCar<mocks::SvguiFirmware> car_;
-  std::unique_ptr<wr8::SvguiSession> session_;
-  std::unique_ptr<wr8::SvguiRunner> runner_;
-  std::unique_ptr<SvguiConsole> console_;
-  std::ostringstream out_;
-  std::optional<int> exit_code_;
-  std::optional<link::Time> exit_at_;
 };
-
-ConsoleOptions interactive() {
-  ConsoleOptions o;
-  o.interactive = true;
-  return o;
-}
 
 TEST(SvguiConsole, HeadInteractiveShowsStateHelpAndAWordOfTheOtherProfile) {
   Bench bench(svgui::Version::head, interactive());
-  for (const char* line : {"connect", "wait 1.5s", "state", "forward 10", "help", "quit"})
-    bench.console().line(line);
-  bench.run_to_exit();
+  const std::string out =
+      bench.lines_to_exit({"connect", "wait 1.5s", "state", "forward 10", "help", "quit"});
   EXPECT_EQ(bench.exit_code(), kExitOk);
-  const std::string out = bench.output();
   EXPECT_TRUE(contains(out, "connect                  ok    logged in: device 1, id 2, WAIT"))
       << out;
-  EXPECT_TRUE(contains(out, "map received: ")) << out;
-  EXPECT_TRUE(contains(out, "profile:    svgui-head")) << out;
-  EXPECT_TRUE(contains(out, "high-freq:  encoder ")) << out;
-  EXPECT_TRUE(contains(out, "low-freq:   WAIT")) << out;
-  EXPECT_TRUE(contains(out, "control:    off")) << out;
+  expect_contains(out, {"map received: ", "profile:    svgui-head", "high-freq:  encoder ",
+                        "low-freq:   WAIT", "control:    off"});
   EXPECT_TRUE(contains(out, "error: column 1: 'forward' is not a word of profile svgui-head"))
       << out;
   EXPECT_TRUE(contains(out, "control X Y")) << out;  // help
@@ -102,10 +54,9 @@ TEST(SvguiConsole, HeadBatchPrintsEachDataStreamOnItsOwnSchedule) {
   ConsoleOptions o;
   o.print_data = true;
   Bench bench(svgui::Version::head, o);
-  bench.console().run_batch({wr8::op::Connect{}, wr8::op::Wait{milliseconds(2500)}});
-  bench.run_to_exit();
+  const std::string out =
+      bench.batch_to_exit({wr8::op::Connect{}, wr8::op::Wait{milliseconds(2500)}});
   EXPECT_EQ(bench.exit_code(), kExitOk);
-  const std::string out = bench.output();
   std::size_t high = 0;
   std::size_t low = 0;
   for (std::size_t at = 0; (at = out.find("data  high-freq", at)) != std::string::npos; ++at)
@@ -120,10 +71,9 @@ TEST(SvguiConsole, HeadBatchPrintsEachDataStreamOnItsOwnSchedule) {
 
 TEST(SvguiConsole, V2019SettingsSayTheyAreUnconfirmed) {
   Bench bench(svgui::Version::v2019, ConsoleOptions{});
-  bench.console().run_batch({wr8::op::Connect{}, wr8::op::Settings2019{{1, 0, 0, 90}}});
-  bench.run_to_exit();
+  const std::string out =
+      bench.batch_to_exit({wr8::op::Connect{}, wr8::op::Settings2019{{1, 0, 0, 90}}});
   EXPECT_EQ(bench.exit_code(), kExitOk);
-  const std::string out = bench.output();
   EXPECT_TRUE(contains(out,
                        "settings p=1 i=0 d=0 servo-zero=90 ok    sent under COI 1; not "
                        "confirmed: the v2019 vehicle never answers SETTINGS"))
@@ -136,11 +86,10 @@ TEST(SvguiConsole, V2019BatchStopsAtTheFirstFailureUnlessKeepGoing) {
     ConsoleOptions o;
     o.keep_going = keep_going;
     Bench bench(svgui::Version::v2019, o);
-    bench.console().run_batch({wr8::op::Connect{}, wr8::op::Settings2019{{1, 0, 0, 90}},
-                               wr8::op::Signals{}, wr8::op::Wait{milliseconds(10)}});
-    bench.run_to_exit();
+    const std::string out =
+        bench.batch_to_exit({wr8::op::Connect{}, wr8::op::Settings2019{{1, 0, 0, 90}},
+                             wr8::op::Signals{}, wr8::op::Wait{milliseconds(10)}});
     EXPECT_EQ(bench.exit_code(), kExitFailed);
-    const std::string out = bench.output();
     EXPECT_TRUE(contains(out, "signals                  FAIL  no ANSWER within 5s")) << out;
     EXPECT_EQ(contains(out, "wait 10ms"), keep_going) << out;
   }

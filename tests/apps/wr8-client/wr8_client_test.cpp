@@ -32,33 +32,10 @@ int max_odometry_cm(const std::string& log) {
 }
 
 /// The mock vehicle on a free port and a temp dir for files.
-struct Wr8ClientCli : ::testing::Test {
-  void TearDown() override {
-    if (mock) {
-      EXPECT_EQ(mock->stop(), 0) << mock->output();
-    }
-  }
+struct Wr8ClientCli : ClientProgramTest {
+  Wr8ClientCli() : ClientProgramTest(WR8_CLIENT_BINARY, "hil-wr8-client", "9100", 20s) {}
 
-  void start_mock() {
-    mock.emplace(mock_on_tcp_args("wr8"), kTcpReady);
-    ASSERT_TRUE(mock->ready()) << mock->output();
-    port = mock->port();
-  }
-
-  /// wr8-client with `--port PORT` and `args`; waits for its exit.
-  CommandResult client(std::vector<std::string> args, std::chrono::milliseconds limit = 20s) {
-    args.insert(args.begin(), {"--port", port});
-    return run_to_exit(WR8_CLIENT_BINARY, args, limit);
-  }
-
-  std::filesystem::path write(const std::string& name, const std::string& text) {
-    return temp.write(name, text);
-  }
-
-  TempDir temp{"hil-wr8-client"};
-  std::filesystem::path dir = temp.path();
-  std::optional<MockCar> mock;
-  std::string port = "9100";
+  void start_mock() { ClientProgramTest::start_mock(mock_on_tcp_args("wr8")); }
 };
 
 TEST_F(Wr8ClientCli, ABatchLogsInDrivesTurnsAndReadsTheSettings) {
@@ -107,9 +84,7 @@ TEST_F(Wr8ClientCli, InteractiveThroughAPipeDrivesShowsStateAndSavesTheLog) {
   HilProcess p(WR8_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(
       p.write_stdin("connect\ndrive 20\nbogus 1\nstate\nsave-log " + csv.string() + "\nquit\n"));
-  const auto code = p.wait_exit(20s);
-  ASSERT_TRUE(code) << p.output();
-  EXPECT_EQ(*code, 0) << p.output();
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(p, 0, 20s));
   const std::string& out = p.output();
   EXPECT_FALSE(contains(out, "wr8> ")) << out;  // no prompt for a pipe
   EXPECT_TRUE(std::regex_search(out, std::regex("task drive \\(COI 0\\) started"))) << out;
@@ -119,8 +94,7 @@ TEST_F(Wr8ClientCli, InteractiveThroughAPipeDrivesShowsStateAndSavesTheLog) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(out, m, std::regex("odometry: +([0-9]+) cm"))) << out;
   EXPECT_GE(std::stoi(m[1].str()), 19) << out;
-  EXPECT_TRUE(contains(out, "connection: connected")) << out;
-  EXPECT_TRUE(contains(out, "battery:    100 %")) << out;
+  expect_contains(out, {"connection: connected", "battery:    100 %"});
   const std::string text = read_file(csv);
   EXPECT_EQ(text.rfind("time_ms,kind,raw,description", 0), 0u) << text;
   // AUTH, its string masked: the log never holds it.
@@ -136,9 +110,7 @@ TEST_F(Wr8ClientCli, EndOfInputEndsTheInteractiveModeWithZero) {
   HilProcess p(WR8_CLIENT_BINARY, {"--port", port});
   ASSERT_TRUE(p.write_stdin("connect\nwait 200ms\nhistory\n"));
   p.close_stdin();
-  const auto code = p.wait_exit(20s);
-  ASSERT_TRUE(code) << p.output();
-  EXPECT_EQ(*code, 0) << p.output();
+  ASSERT_NO_FATAL_FAILURE(expect_exit_status(p, 0, 20s));
   EXPECT_TRUE(std::regex_search(p.output(), std::regex("wait 200ms +ok"))) << p.output();
 }
 
@@ -163,11 +135,9 @@ TEST_F(Wr8ClientCli, TheShippedExampleScriptsRunAgainstTheMock) {
 }
 
 TEST_F(Wr8ClientCli, AScriptTypoExits2WithFileLineAndColumn) {
-  const auto script = write("typo.wr8", "connect\n  drve 30\nturn 10\n");
-  const auto r = client({"--script", script.string()});
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(contains(r.output, script.string() + ":2:3: unknown action 'drve'")) << r.output;
-  EXPECT_FALSE(contains(r.output, "connect ")) << r.output;  // nothing ran
+  const auto out = expect_script_refused("typo.wr8", "connect\n  drve 30\nturn 10\n",
+                                         ":2:3: unknown action 'drve'");
+  EXPECT_FALSE(contains(out, "connect ")) << out;  // nothing ran
 }
 
 TEST_F(Wr8ClientCli, BadUsageExits2) {
