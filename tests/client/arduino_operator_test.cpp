@@ -23,6 +23,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/client/operator_test_support.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -96,12 +97,7 @@ TEST(ArduinoOperatorParse, BlankLinesAndCommentsAreNoCommand) {
 }
 
 TEST(ArduinoOperatorParse, ErrorsSayTheColumnAndWhatWasExpected) {
-  struct Case {
-    std::string line;
-    std::size_t column;
-    std::string message;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<test::SyntaxErrorCase> cases = {
       {"V 999", 3, "V needs a number 0..255, not '999'"},
       {"V -1", 3, "V needs a number 0..255, not '-1'"},
       {"V", 2, "V needs a number 0..255"},
@@ -124,11 +120,7 @@ TEST(ArduinoOperatorParse, ErrorsSayTheColumnAndWhatWasExpected) {
        "unknown command 'jump' (expected PING, STATUS, V, M, R, S, B, I, HELP, history, "
        "save-log, reconnect, wait or quit)"},
   };
-  for (const auto& c : cases) {
-    const auto error = error_of(c.line);
-    EXPECT_EQ(error.column, c.column) << c.line;
-    EXPECT_EQ(error.message, c.message) << c.line;
-  }
+  test::expect_syntax_errors(cases, test::MessageMatch::whole, error_of);
 }
 
 // One word in the raw form CMD:PAYLOAD that hil would not type goes to the
@@ -358,7 +350,7 @@ TEST_F(ArduinoOperatorRunner, AMoveScriptDrivesTheRobotForItsTimedDuration) {
 
 TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
   start();
-  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "V", .count = 1}});
+  firmware->arm(test::reject_next("V"));
   run_script("ping\nV 160\nstatus\n");
   ASSERT_EQ(outcomes.size(), 2u);
   EXPECT_EQ(describe_outcome(outcomes[1]), "V 160 -> NACK BUSY");
@@ -372,13 +364,10 @@ TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
 
 TEST_F(ArduinoOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
   start(std::nullopt, {.keep_going = true});
-  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "V", .count = 1}});
+  firmware->arm(test::reject_next("V"));
   run_script("V 160\nV 170\nstatus\n");
-  const auto out = lines();
-  ASSERT_EQ(out.size(), 3u);
-  EXPECT_EQ(out[0], "V 160 -> NACK BUSY");
-  EXPECT_EQ(out[1], "V 170 -> ACK OK");
-  EXPECT_EQ(out[2], "STATUS -> ACK STATUS:V=170,DIR=stop,MOT:IDLE");
+  EXPECT_EQ(lines(), (std::vector<std::string>{"V 160 -> NACK BUSY", "V 170 -> ACK OK",
+                                               "STATUS -> ACK STATUS:V=170,DIR=stop,MOT:IDLE"}));
   EXPECT_EQ(runner->failures(), 1u);
   EXPECT_FALSE(runner->halted());
 }

@@ -10,14 +10,10 @@
 #include <asio/io_context.hpp>
 
 #include "client/arduino/session.hpp"
-#include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
 #include "mocks/arduino.hpp"
-#include "mocks/server.hpp"
-#include "sim/presets.hpp"
-#include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
-#include "tests/mocks/serial_support.hpp"
+#include "tests/mocks/real_time_car.hpp"
 
 namespace hil::client::arduino {
 namespace {
@@ -25,20 +21,10 @@ namespace {
 namespace proto = protocol::arduino;
 
 TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) {
-  mocks::test::TempDir dir("hil-arduino-client");
-  const std::string uri = "pty://" + (dir.path / "arduino0").string() + "?baud=9600";
-  asio::io_context io;
-  link::AsioExecutor executor{io};
-  link::TransportContext context{executor, &io};
-  sim::World world(sim::WorldDef{});
-  sim::Vehicle& vehicle = world.add_vehicle(sim::arduino_robot());
-  mocks::ArduinoFirmware firmware(world, vehicle);
-  mocks::ServerOptions options;
-  options.listen = link::parse_endpoint(uri);
-  mocks::MockServer server(context, firmware, options);
-  server.start();
+  mocks::test::PtyCar<mocks::ArduinoFirmware> car("arduino0", "?baud=9600", sim::arduino_robot());
+  asio::io_context& io = car.io;
 
-  ArduinoSession session(context, link::parse_endpoint(uri));
+  ArduinoSession session(car.context, link::parse_endpoint(car.uri));
   session.open();
   ASSERT_TRUE(link::test::run_until(io, [&] {
     return session.state() == ConnectionState::connected;
@@ -64,7 +50,7 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   EXPECT_EQ(bad.nack, (proto::Nack{proto::NackCode::bad_v}));
   auto turn = run([](auto& s, auto cb) { return s.raw("R:-90", cb); });
   EXPECT_EQ(turn.info, "ACCEPTED");
-  EXPECT_EQ(firmware.state().pwm, 180);
+  EXPECT_EQ(car.firmware.state().pwm, 180);
 
   const auto entries = session.log().entries();
   ASSERT_GE(entries.size(), 8u);

@@ -69,6 +69,18 @@ struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFir
   Time done_at{0};
 };
 
+/// Server options whose link corrupts the checksum of each of the first
+/// `count` frames going `direction`.
+mocks::ServerOptions checksum_corrupted(link::DirectionFilter direction, std::uint64_t count) {
+  mocks::ServerOptions options;
+  link::FaultRule rule;
+  rule.direction = direction;
+  rule.trigger.first = count;
+  rule.action = link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1};
+  options.faults.rules.push_back(rule);
+  return options;
+}
+
 ClientConfig quiet() {
   ClientConfig c;
   c.health_check_interval = Duration::zero();
@@ -112,7 +124,7 @@ TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
 
 TEST_F(ArduinoSessionOnMem, ARejectedMoveComesBackAsItsNack) {
   start(quiet());
-  firmware->arm({.name = "", .when = {}, .action = mocks::Reject{.match = "M", .count = 1}});
+  firmware->arm(test::reject_next("M"));
   auto r = run([](auto& s, auto cb) { return s.move_cm(20, cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::nack);
@@ -121,13 +133,7 @@ TEST_F(ArduinoSessionOnMem, ARejectedMoveComesBackAsItsNack) {
 }
 
 TEST_F(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
-  mocks::ServerOptions options;
-  link::FaultRule rule;
-  rule.direction = link::DirectionFilter::to_client;
-  rule.trigger.first = 2;
-  rule.action = link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1};
-  options.faults.rules.push_back(rule);
-  start(quiet(), options);
+  start(quiet(), checksum_corrupted(link::DirectionFilter::to_client, 2));
   const Time t0 = executor.now();
   auto r = run([](auto& s, auto cb) { return s.ping(cb); });
   ASSERT_TRUE(r);
@@ -142,13 +148,7 @@ TEST_F(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms)
 }
 
 TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
-  mocks::ServerOptions options;
-  link::FaultRule rule;
-  rule.direction = link::DirectionFilter::to_car;
-  rule.trigger.first = 1;
-  rule.action = link::Corrupt{.target = link::CorruptTarget::checksum, .field = "", .bits = 1};
-  options.faults.rules.push_back(rule);
-  start(quiet(), options);
+  start(quiet(), checksum_corrupted(link::DirectionFilter::to_car, 1));
   auto r = run([](auto& s, auto cb) { return s.set_v(200, cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::ok);

@@ -20,6 +20,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/client/operator_test_support.hpp"
 
 namespace hil::client::leka {
 namespace {
@@ -128,14 +129,8 @@ TEST(LekaOperatorLine, WaitsCommentsAndBlankLines) {
   EXPECT_EQ(line.commands, 1u);
 }
 
-struct ErrorCase {
-  std::string line;
-  std::size_t column;
-  std::string message;
-};
-
 TEST(LekaOperatorLine, EveryRangeErrorNamesTheFieldAndItsColumn) {
-  const std::vector<ErrorCase> cases = {
+  const std::vector<test::SyntaxErrorCase> cases = {
       {"ear all 256 0 0", 9, "ear all: red must be 0..255, got 256"},
       {"ear all 0 300 0", 11, "ear all: green must be 0..255, got 300"},
       {"ear all 0 0 999", 13, "ear all: blue must be 0..255, got 999"},
@@ -162,15 +157,11 @@ TEST(LekaOperatorLine, EveryRangeErrorNamesTheFieldAndItsColumn) {
       // The column is the command's own, later in the line.
       {"ear all 1 2 3; belt single 25 0 0 0", 28, "belt single: led must be 0..19, got 25"},
   };
-  for (const auto& c : cases) {
-    const auto e = parse_error(c.line);
-    EXPECT_EQ(e.column, c.column) << c.line;
-    EXPECT_EQ(e.message, c.message) << c.line;
-  }
+  test::expect_syntax_errors(cases, test::MessageMatch::whole, parse_error);
 }
 
 TEST(LekaOperatorLine, SyntaxErrorsSayWhatWasExpectedWhere) {
-  const std::vector<ErrorCase> cases = {
+  const std::vector<test::SyntaxErrorCase> cases = {
       {"blink 1", 1,
        "unknown command 'blink' (expected info, stop, ear, belt, motor, motivator, guidance or "
        "wait)"},
@@ -198,11 +189,7 @@ TEST(LekaOperatorLine, SyntaxErrorsSayWhatWasExpectedWhere) {
       {"wait 1s 2s", 9, "wait: unexpected '2s'; it takes one duration such as 500ms or 1s"},
       {"info; wait 1s", 7, "wait must be alone on its line"},
   };
-  for (const auto& c : cases) {
-    const auto e = parse_error(c.line);
-    EXPECT_EQ(e.column, c.column) << c.line;
-    EXPECT_EQ(e.message, c.message) << c.line;
-  }
+  test::expect_syntax_errors(cases, test::MessageMatch::whole, parse_error);
 }
 
 TEST(LekaOperatorLine, TheBeltLimitFollowsTheValueLimits) {

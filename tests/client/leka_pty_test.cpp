@@ -9,34 +9,22 @@
 #include <asio/io_context.hpp>
 
 #include "client/leka/session.hpp"
-#include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
 #include "mocks/leka.hpp"
-#include "mocks/server.hpp"
-#include "sim/presets.hpp"
-#include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
-#include "tests/mocks/serial_support.hpp"
+#include "tests/mocks/real_time_car.hpp"
 
 namespace hil::client::leka {
 namespace {
 
 TEST(LekaSessionOverPty, APacedBurstAndAnInfoReachTheRobotWhole) {
-  mocks::test::TempDir dir("hil-leka-client");
-  const std::string uri = "pty://" + (dir.path / "leka0").string() + "?baud=115200";
-  asio::io_context io;
-  link::AsioExecutor executor{io};
-  link::TransportContext context{executor, &io};
-  sim::World world(sim::WorldDef{});
-  sim::Vehicle& vehicle = world.add_vehicle(sim::leka_robot());
-  mocks::LekaFirmware firmware(world, vehicle);
-  mocks::ServerOptions server_options;
-  server_options.listen = link::parse_endpoint(uri);
-  mocks::MockServer server(context, firmware, server_options);
-  server.start();
+  mocks::test::PtyCar<mocks::LekaFirmware> car("leka0", "?baud=115200", sim::leka_robot());
+  asio::io_context& io = car.io;
+  const auto& firmware = car.firmware;
 
   // A timeout that a loaded machine cannot miss.
-  LekaSession session(context, link::parse_endpoint(uri), {.info_timeout = link::seconds(5)});
+  LekaSession session(car.context, link::parse_endpoint(car.uri),
+                      {.info_timeout = link::seconds(5)});
   session.open();
   ASSERT_TRUE(link::test::run_until(io, [&] { return session.is_open(); }))
       << "the port never opened";

@@ -53,7 +53,17 @@ struct LekaSessionOnMem : ::testing::Test, test::VirtualCar<mocks::LekaFirmware>
     return b;
   }
 
+  /// Asks for INFO now; its result goes to `info` and its time to `info_at`.
+  void ask_info() {
+    session->info([this](const InfoResult& r) {
+      info = r;
+      info_at = executor.now();
+    });
+  }
+
   std::unique_ptr<LekaSession> session;
+  std::optional<InfoResult> info;
+  std::optional<Time> info_at;
 };
 
 TEST_F(LekaSessionOnMem, AMultiCommandGroupChangesLedsAndMotorsAtTheNextPass) {
@@ -104,20 +114,15 @@ TEST_F(LekaSessionOnMem, TheSameBurstUnpacedOverrunsTheSerialBuffer) {
 TEST_F(LekaSessionOnMem, InfoIsAnsweredAtTheNextPassAndParsed) {
   start();
   executor.run_until(at_ms(4));
-  std::optional<InfoResult> result;
-  std::optional<Time> when;
-  session->info([&](const InfoResult& r) {
-    result = r;
-    when = executor.now();
-  });
+  ask_info();
   executor.run_until(at_ms(300));
-  ASSERT_TRUE(result.has_value());
-  EXPECT_EQ(result->status, InfoStatus::ok);
-  EXPECT_EQ(when, at_ms(10));
-  EXPECT_EQ(result->reply->name, "leka");
-  EXPECT_EQ(result->reply->firmware, "1.0.0");
-  EXPECT_EQ(result->reply->buffer_bytes, 128);
-  EXPECT_EQ(result->reply->state, "ok");
+  ASSERT_TRUE(info.has_value());
+  EXPECT_EQ(info->status, InfoStatus::ok);
+  EXPECT_EQ(info_at, at_ms(10));
+  EXPECT_EQ(info->reply->name, "leka");
+  EXPECT_EQ(info->reply->firmware, "1.0.0");
+  EXPECT_EQ(info->reply->buffer_bytes, 128);
+  EXPECT_EQ(info->reply->state, "ok");
   const auto entries = session->log().entries();
   ASSERT_EQ(entries.size(), 2u);
   EXPECT_EQ(entries[1].kind, LogKind::rx);
@@ -128,18 +133,13 @@ TEST_F(LekaSessionOnMem, AnIgnoredInfoTimesOut200msAfterItWentOut) {
   start();
   firmware->arm(mocks::Behaviour{"", mocks::When{}, mocks::Ignore{"info", 1, std::nullopt}});
   executor.run_until(at_ms(5));
-  std::optional<InfoResult> result;
-  std::optional<Time> when;
-  session->info([&](const InfoResult& r) {
-    result = r;
-    when = executor.now();
-  });
+  ask_info();
   executor.run_until(at_ms(204));
-  EXPECT_FALSE(result.has_value());
+  EXPECT_FALSE(info.has_value());
   executor.run_until(at_ms(400));
-  ASSERT_TRUE(result.has_value());
-  EXPECT_EQ(result->status, InfoStatus::timeout);
-  EXPECT_EQ(when, at_ms(205));
+  ASSERT_TRUE(info.has_value());
+  EXPECT_EQ(info->status, InfoStatus::timeout);
+  EXPECT_EQ(info_at, at_ms(205));
   EXPECT_EQ(firmware->state().counters.info_answers, 0u);
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "protocol/logi/codec.hpp"
+#include "tests/client/client_test_support.hpp"
 
 namespace hil::client::logi {
 namespace {
@@ -57,6 +58,11 @@ class Harness {
     }
     now = t;
   }
+  /// Records what the core did, then hands `r` back.
+  SubmitResult then_drain(SubmitResult r) {
+    drain();
+    return r;
+  }
   void drain() {
     for (auto& a : core.take_actions()) {
       if (std::holds_alternative<OpenConnection>(a)) {
@@ -71,9 +77,33 @@ class Harness {
     for (auto& e : core.take_events())
       events.emplace_back(now, std::move(e));
   }
+  /// Runs until `t`; when the latest connection attempt by then started.
+  std::optional<Time> last_open_by(Time t) {
+    run_until(t);
+    if (open_times.empty()) return std::nullopt;
+    return open_times.back();
+  }
+  SubmitResult submit(const proto::Message& command) {
+    return then_drain(core.submit(now, command));
+  }
+  SubmitResult press(Direction direction) { return then_drain(core.press(now, direction)); }
+  SubmitResult release() { return then_drain(core.release(now)); }
+  SubmitResult emergency_stop() { return then_drain(core.emergency_stop(now)); }
+  void connect() {
+    core.connect(now);
+    drain();
+  }
   void connected() {
     core.connect(now);
     core.on_connected(now);
+    drain();
+  }
+  void closed() {
+    core.on_closed(now);
+    drain();
+  }
+  void connect_failed() {
+    core.on_connect_failed(now);
     drain();
   }
   /// Connected, with mode and speed confirmed and answered.
@@ -101,11 +131,7 @@ class Harness {
   }
   template <class E>
   std::vector<std::pair<Time, E>> of() const {
-    std::vector<std::pair<Time, E>> out;
-    for (auto& [t, e] : events) {
-      if (auto* x = std::get_if<E>(&e)) out.emplace_back(t, *x);
-    }
-    return out;
+    return test::timed_events_of<E>(events);
   }
   std::vector<CommandEvent> commands(CommandState state) const {
     std::vector<CommandEvent> out;
@@ -124,8 +150,7 @@ std::string f(std::string_view payload) {
 
 TEST(LogiClientCore, ConnectAndDisconnectOnRequestReportTheirStates) {
   Harness h;
-  h.core.connect(h.now);
-  h.drain();
+  h.connect();
   EXPECT_EQ(h.opens, 1);
   EXPECT_EQ(h.core.state(), ConnectionState::connecting);
   h.core.on_connected(h.now);
@@ -149,8 +174,7 @@ TEST(LogiClientCore, ReconnectsAfterADropAt1s2s3sThen3sForever) {
   Harness h;
   h.connected();
   h.now = seconds(10);
-  h.core.on_closed(h.now);
-  h.drain();
+  h.closed();
   EXPECT_EQ(h.core.state(), ConnectionState::reconnecting);
   for (Time at : {seconds(11), seconds(13), seconds(16), seconds(19), seconds(22)}) {
     const int before = h.opens;
@@ -160,45 +184,36 @@ TEST(LogiClientCore, ReconnectsAfterADropAt1s2s3sThen3sForever) {
     ASSERT_EQ(h.opens, before + 1) << "attempt due at " << link::format_ms(at);
     EXPECT_EQ(h.open_times.back(), at);
     EXPECT_EQ(h.core.state(), ConnectionState::connecting);
-    h.core.on_connect_failed(h.now);
-    h.drain();
+    h.connect_failed();
   }
   // A connection over which the car spoke starts the series again at 1 s.
   h.run_until(seconds(25));
   h.core.on_connected(h.now);
   h.feed(stat_frame());
   h.now = seconds(30);
-  h.core.on_closed(h.now);
-  h.drain();
-  h.run_until(seconds(31));
-  EXPECT_EQ(h.open_times.back(), seconds(31));
+  h.closed();
+  EXPECT_EQ(h.last_open_by(seconds(31)), seconds(31));
 }
 
 TEST(LogiClientCore, ACarThatHangsUpBeforeSayingAnythingDoesNotRestartTheSeries) {
   Harness h;
   h.connected();
   h.feed(stat_frame());
-  h.core.on_closed(h.now);
-  h.drain();
+  h.closed();
   // Each attempt connects and is closed at once, with no frame from the car:
   // the delays still grow 1 s, 2 s, 3 s, 3 s.
   for (Time at : {seconds(1), seconds(3), seconds(6), seconds(9)}) {
-    h.run_until(at);
-    ASSERT_EQ(h.open_times.back(), at);
+    ASSERT_EQ(h.last_open_by(at), at);
     h.core.on_connected(h.now);
-    h.core.on_closed(h.now);
-    h.drain();
+    h.closed();
   }
-  h.run_until(seconds(12));
-  EXPECT_EQ(h.open_times.back(), seconds(12));
+  EXPECT_EQ(h.last_open_by(seconds(12)), seconds(12));
 }
 
 TEST(LogiClientCore, AFailedFirstConnectIsRetriedAfter1s) {
   Harness h;
-  h.core.connect(h.now);
-  h.drain();
-  h.core.on_connect_failed(h.now);
-  h.drain();
+  h.connect();
+  h.connect_failed();
   h.run_until(seconds(1));
   EXPECT_EQ(h.open_times, (std::vector<Time>{Time{0}, seconds(1)}));
 }
@@ -218,8 +233,7 @@ TEST(LogiClientCore, CommandsAreRefusedWhileNotConnected) {
 TEST(LogiClientCore, StickyAndSplitFramesAllComeOutTyped) {
   Harness h;
   h.connected();
-  h.core.submit(h.now, proto::SetSpeed{30});
-  h.drain();
+  h.submit(proto::SetSpeed{30});
   // FB and STAT stuck together, then a STAT one byte at a time.
   h.feed(f("FB:SP:1") + stat_frame());
   for (char c : stat_frame(Mode::manual))
@@ -237,8 +251,7 @@ TEST(LogiClientCore, StickyAndSplitFramesAllComeOutTyped) {
 TEST(LogiClientCore, AnInvalidFrameIsDroppedAndLoggedWithItsRawText) {
   Harness h;
   h.connected();
-  h.core.submit(h.now, proto::SetSpeed{30});
-  h.drain();
+  h.submit(proto::SetSpeed{30});
   h.feed("LOGI:FB:SP:1:00#");  // wrong checksum
   EXPECT_TRUE(h.of<FeedbackEvent>().empty());
   ASSERT_EQ(h.of<ParseErrorEvent>().size(), 1u);
@@ -258,9 +271,8 @@ TEST(LogiClientCore, AnInvalidFrameIsDroppedAndLoggedWithItsRawText) {
 TEST(LogiClientCore, OneCommandInFlightTheNextWaitsForItsFeedback) {
   Harness h;
   h.connected();
-  const auto sp = h.core.submit(h.now, proto::SetSpeed{50});
-  const auto md = h.core.submit(h.now, proto::SetMode{Mode::manual});
-  h.drain();
+  const auto sp = h.submit(proto::SetSpeed{50});
+  const auto md = h.submit(proto::SetMode{Mode::manual});
   EXPECT_NE(sp.request, md.request);
   EXPECT_EQ(h.frames(), (std::vector<std::string>{"LOGI:SP:050:D7#"}));
   h.now = ms(120);
@@ -277,9 +289,8 @@ TEST(LogiClientCore, OneCommandInFlightTheNextWaitsForItsFeedback) {
 TEST(LogiClientCore, UnansweredSpIsSentThreeTimes800msApartThenUncertain) {
   Harness h;
   h.connected();
-  const auto sp = h.core.submit(h.now, proto::SetSpeed{80});
-  h.core.submit(h.now, proto::SetStation{2});
-  h.drain();
+  const auto sp = h.submit(proto::SetSpeed{80});
+  h.submit(proto::SetStation{2});
   h.run_until(ms(2399));
   EXPECT_TRUE(h.commands(CommandState::uncertain).empty());
   h.run_until(ms(2400));
@@ -300,8 +311,7 @@ TEST(LogiClientCore, MdAndMvStopAreRetriedToo) {
                            proto::Message{proto::Move{Direction::stop}}}) {
     Harness h;
     h.connected();
-    h.core.submit(h.now, m);
-    h.drain();
+    h.submit(m);
     h.run_until(ms(1600));
     h.reply(std::holds_alternative<proto::SetMode>(m) ? "FB:MD:1" : "FB:MV:1");
     EXPECT_EQ(h.sent.size(), 3u);
@@ -313,8 +323,7 @@ TEST(LogiClientCore, MdAndMvStopAreRetriedToo) {
 TEST(LogiClientCore, TimedOutRunAndGsAreResentOnlyWhenTheOperatorConfirms) {
   Harness h;
   h.ready(Mode::automatic);
-  const auto gs = h.core.submit(h.now, proto::SetStation{2});
-  h.drain();
+  const auto gs = h.submit(proto::SetStation{2});
   h.run_until(ms(800));
   auto unc = h.commands(CommandState::uncertain);
   ASSERT_EQ(unc.size(), 1u);
@@ -332,8 +341,7 @@ TEST(LogiClientCore, TimedOutRunAndGsAreResentOnlyWhenTheOperatorConfirms) {
   ASSERT_EQ(h.commands(CommandState::accepted).size(), 1u);
   EXPECT_EQ(h.commands(CommandState::accepted)[0].request, gs.request);
 
-  const auto run = h.core.submit(h.now, proto::SetRun{true});
-  h.drain();
+  const auto run = h.submit(proto::SetRun{true});
   h.run_until(seconds(10) + ms(800));
   unc = h.commands(CommandState::uncertain);
   ASSERT_EQ(unc.size(), 2u);
@@ -345,8 +353,7 @@ TEST(LogiClientCore, TimedOutRunAndGsAreResentOnlyWhenTheOperatorConfirms) {
 TEST(LogiClientCore, AMoveOtherThanStopIsNotRetried) {
   Harness h;
   h.ready();
-  h.core.press(h.now, Direction::fwd);
-  h.drain();
+  h.press(Direction::fwd);
   h.run_until(seconds(5));
   EXPECT_EQ(h.frames(), (std::vector<std::string>{"LOGI:MV:FWD:23#"}));
   ASSERT_EQ(h.commands(CommandState::uncertain).size(), 1u);
@@ -358,13 +365,11 @@ TEST(LogiClientCore, AMoveOtherThanStopIsNotRetried) {
 TEST(LogiClientCore, ReleasingAHeldDirectionSendsStop) {
   Harness h;
   h.ready();
-  h.core.press(h.now, Direction::ccw);
-  h.drain();
+  h.press(Direction::ccw);
   h.reply("FB:MV:1");
   EXPECT_EQ(h.core.held(), Direction::ccw);
   h.now = ms(700);
-  h.core.release(h.now);
-  h.drain();
+  h.release();
   EXPECT_FALSE(h.core.held());
   ASSERT_EQ(h.sent.size(), 2u);
   EXPECT_EQ(h.sent[1], (std::pair<Time, std::string>{ms(700), "LOGI:MV:STOP:88#"}));
@@ -383,25 +388,19 @@ TEST(LogiClientCore, NoStatFor2sRaisesStaleAndAFreshStatClearsIt) {
   h.run_until(ms(3500));
   h.feed(stat_frame());
   EXPECT_FALSE(h.core.stale());
-  const auto st = h.of<StaleEvent>();
-  ASSERT_EQ(st.size(), 2u);
-  EXPECT_EQ(st[0].first, ms(3000));
-  EXPECT_TRUE(st[0].second.stale);
-  EXPECT_EQ(st[1].first, ms(3500));
-  EXPECT_FALSE(st[1].second.stale);
+  EXPECT_EQ(test::stale_flags(h.of<StaleEvent>()),
+            (std::vector<std::pair<Time, bool>>{{ms(3000), true}, {ms(3500), false}}));
 }
 
 TEST(LogiClientCore, EmergencyStopInAutoWritesStopsAheadOfTheQueue) {
   Harness h;
   h.ready(Mode::automatic);
   h.feed(stat_frame(Mode::automatic));
-  h.core.submit(h.now, proto::SetStation{1});  // in flight, unanswered
-  h.core.submit(h.now, proto::SetSpeed{80});   // queued, kept
-  h.core.submit(h.now, proto::SetRun{true});   // queued movement, cancelled
-  h.drain();
+  h.submit(proto::SetStation{1});  // in flight, unanswered
+  h.submit(proto::SetSpeed{80});   // queued, kept
+  h.submit(proto::SetRun{true});   // queued movement, cancelled
   h.now = ms(100);
-  const auto stop = h.core.emergency_stop(h.now);
-  h.drain();
+  const auto stop = h.emergency_stop();
   ASSERT_TRUE(stop);
   ASSERT_EQ(h.sent.size(), 3u);
   EXPECT_EQ(h.sent[1], (std::pair<Time, std::string>{ms(100), "LOGI:MV:STOP:88#"}));
@@ -422,11 +421,9 @@ TEST(LogiClientCore, EmergencyStopInAutoWritesStopsAheadOfTheQueue) {
 TEST(LogiClientCore, EmergencyStopInManSendsOnlyMvStopAndReleasesTheHeldDirection) {
   Harness h;
   h.ready(Mode::manual);
-  h.core.press(h.now, Direction::fwd);
-  h.drain();
+  h.press(Direction::fwd);
   h.reply("FB:MV:1");
-  h.core.emergency_stop(h.now);
-  h.drain();
+  h.emergency_stop();
   EXPECT_EQ(h.frames(), (std::vector<std::string>{"LOGI:MV:FWD:23#", "LOGI:MV:STOP:88#"}));
   EXPECT_FALSE(h.core.held());
 }
@@ -434,8 +431,7 @@ TEST(LogiClientCore, EmergencyStopInManSendsOnlyMvStopAndReleasesTheHeldDirectio
 TEST(LogiClientCore, FbMv0SwitchesToManAndRetriesTheMoveOnce) {
   Harness h;
   h.ready(Mode::manual);
-  const auto mv = h.core.press(h.now, Direction::left);
-  h.drain();
+  const auto mv = h.press(Direction::left);
   h.reply("FB:MV:0");
   ASSERT_EQ(h.of<NoticeEvent>().size(), 1u);
   EXPECT_EQ(h.of<NoticeEvent>()[0].second.text, "Not in manual mode, switching to MAN");
@@ -452,11 +448,9 @@ TEST(LogiClientCore, ADropEntersTheSafeStateAndMovementNeedsMdAndSpAgain) {
   Harness h;
   h.ready(Mode::manual);
   EXPECT_TRUE(h.core.movement_enabled());
-  h.core.press(h.now, Direction::fwd);
-  h.core.submit(h.now, proto::SetSpeed{60});
-  h.drain();
-  h.core.on_closed(h.now);
-  h.drain();
+  h.press(Direction::fwd);
+  h.submit(proto::SetSpeed{60});
+  h.closed();
   EXPECT_FALSE(h.core.held());
   EXPECT_EQ(h.core.queued(), 0u);
   EXPECT_EQ(h.core.in_flight(), 0u);
@@ -484,8 +478,7 @@ TEST(LogiClientCore, KeepaliveRepeatsTheHeldMoveEvery300ms) {
   config.keepalive = true;
   Harness h(config);
   h.ready();
-  h.core.press(h.now, Direction::rf);
-  h.drain();
+  h.press(Direction::rf);
   h.reply("FB:MV:1");
   h.run_until(ms(299));
   EXPECT_EQ(h.sent.size(), 1u);
@@ -494,8 +487,7 @@ TEST(LogiClientCore, KeepaliveRepeatsTheHeldMoveEvery300ms) {
   h.run_until(ms(600));
   h.reply("FB:MV:1");
   h.now = ms(700);
-  h.core.release(h.now);
-  h.drain();
+  h.release();
   h.reply("FB:MV:1");
   h.run_until(seconds(2));
   ASSERT_EQ(h.sent.size(), 4u);
@@ -507,8 +499,7 @@ TEST(LogiClientCore, KeepaliveRepeatsTheHeldMoveEvery300ms) {
 TEST(LogiClientCore, WithoutKeepaliveAHeldMoveIsSentOnce) {
   Harness h;
   h.ready();
-  h.core.press(h.now, Direction::rf);
-  h.drain();
+  h.press(Direction::rf);
   h.reply("FB:MV:1");
   h.run_until(seconds(3));
   EXPECT_EQ(h.sent.size(), 1u);
@@ -519,8 +510,7 @@ TEST(LogiClientCore, WithoutKeepaliveAHeldMoveIsSentOnce) {
 TEST(LogiCommLog, RecordsTxRxAndErrorsAndExportsThem) {
   Harness h;
   h.connected();
-  h.core.submit(h.now, proto::SetSpeed{50});
-  h.drain();
+  h.submit(proto::SetSpeed{50});
   h.now = ms(5);
   h.feed(f("FB:SP:1") + "xx");
   std::vector<LogKind> kinds;

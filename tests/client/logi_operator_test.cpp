@@ -20,6 +20,7 @@
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/client/operator_test_support.hpp"
 
 namespace hil::client::logi {
 namespace {
@@ -92,12 +93,7 @@ TEST(OperatorParser, BlankLinesAndCommentsAreNoAction) {
 }
 
 TEST(OperatorParser, EveryErrorNamesItsColumnAndWhatWasExpected) {
-  struct Case {
-    const char* line;
-    std::size_t column;
-    const char* says;
-  };
-  const Case cases[] = {
+  const std::vector<test::SyntaxErrorCase> cases = {
       {"spead 50", 1, "unknown action 'spead'"},
       {"  fly", 3, "expected one of connect, disconnect, speed"},
       {"speed", 6, "expected a speed 0..100 after 'speed'"},
@@ -129,11 +125,7 @@ TEST(OperatorParser, EveryErrorNamesItsColumnAndWhatWasExpected) {
       {"release FWD", 9, "unexpected 'FWD' after 'release'"},
       {"estop  x", 8, "unexpected 'x'"},
   };
-  for (const auto& c : cases) {
-    const auto e = parse_error(c.line);
-    EXPECT_EQ(e.column, c.column) << c.line << ": " << e.message;
-    EXPECT_NE(e.message.find(c.says), std::string::npos) << c.line << ": " << e.message;
-  }
+  test::expect_syntax_errors(cases, test::MessageMatch::part, parse_error);
 }
 
 TEST(OperatorParser, DurationsAreExactAndPrintTheirShortestForm) {
@@ -184,22 +176,14 @@ TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsTheFirstErrorAsFileLineColu
 // ---- runner ----
 
 /// The mock car on mem://car, a session and a runner, in virtual time.
-class RunnerBench {
+class RunnerBench : public test::SessionOnMem<LogiSession, mocks::LogiFirmware, Event> {
  public:
-  RunnerBench() {
-    mocks::ServerOptions options = test::on_mem("car");
-    options.name = "logi";
-    car_.start_car(sim::logi_car(), std::move(options));
-    session_ = std::make_unique<LogiSession>(car_.context, link::MemEndpoint{"car"}, ClientConfig{},
-                                             [this](Time now, const Event& e) {
-                                               if (runner_) runner_->on_event(now, e);
-                                             });
+  RunnerBench() : SessionOnMem("logi", sim::logi_car(), {}, ClientConfig{}) {
+    forward_events([this](Time now, const Event& e) {
+      if (runner_) runner_->on_event(now, e);
+    });
   }
 
-  mocks::LogiFirmware& firmware() { return *car_.firmware; }
-  mocks::MockServer& server() { return *car_.server; }
-  link::VirtualExecutor& executor() { return car_.executor; }
-  LogiSession& session() { return *session_; }
   OperatorRunner& runner() { return *runner_; }
 
   /// Starts `script`; run() then runs it to its end.
@@ -207,25 +191,30 @@ class RunnerBench {
     const auto parsed = parse_operator_script(script, "test");
     ASSERT_TRUE(parsed.ok()) << parsed.error->to_string();
     runner_ = std::make_unique<OperatorRunner>(
-        *session_, car_.executor, parsed.steps, options,
+        session(), executor(), parsed.steps, options,
         [this](const ActionResult& r) { results_.push_back(r); },
         [this](const RunSummary& s) { summary_ = s; });
     runner_->start();
   }
   /// Runs until the runner is done (at most `limit` of virtual time).
   bool run(link::Duration limit = seconds(120)) {
-    const Time end = car_.executor.now() + limit;
-    while (!summary_ && car_.executor.now() < end) {
-      car_.executor.run_one();
+    const Time end = now() + limit;
+    while (!summary_ && now() < end) {
+      executor().run_one();
     }
     return summary_.has_value();
   }
   const std::vector<ActionResult>& results() const { return results_; }
+  /// Runs until `t`; how many actions have a result by then.
+  std::size_t results_by(Time t) {
+    run_until(t);
+    return results_.size();
+  }
   const std::optional<RunSummary>& summary() const { return summary_; }
 
   /// Time of the first received frame whose raw text contains `text`.
   std::optional<Time> rx_time(const std::string& text, Time after = Time{0}) const {
-    for (const auto& e : session_->log()->entries()) {
+    for (const auto& e : session().log()->entries()) {
       if (e.kind == LogKind::rx && e.at >= after && e.raw.find(text) != std::string::npos)
         return e.at;
     }
@@ -233,15 +222,13 @@ class RunnerBench {
   }
   std::vector<std::string> sent() const {
     std::vector<std::string> out;
-    for (const auto& e : session_->log()->entries()) {
+    for (const auto& e : session().log()->entries()) {
       if (e.kind == LogKind::tx) out.push_back(e.raw);
     }
     return out;
   }
 
  private:
-  test::VirtualCar<mocks::LogiFirmware> car_;
-  std::unique_ptr<LogiSession> session_;
   std::unique_ptr<OperatorRunner> runner_;
   std::vector<ActionResult> results_;
   std::optional<RunSummary> summary_;
@@ -415,8 +402,7 @@ TEST(OperatorRunner, CancelEndsTheActionUnderWayAndStartsNoOther) {
   ASSERT_EQ(b.results().size(), 2u);
   EXPECT_EQ(b.results()[1].reason, "cancelled");
   EXPECT_EQ(b.results()[1].ended, seconds(2));
-  b.executor().run_until(seconds(40));
-  EXPECT_EQ(b.results().size(), 2u);
+  EXPECT_EQ(b.results_by(seconds(40)), 2u);
   EXPECT_TRUE(b.sent().empty());
 }
 
@@ -434,8 +420,7 @@ TEST(OperatorRunner, CancelBeforeTheFirstTurnReportsTheFirstAction) {
   EXPECT_EQ(b.results()[0].reason, "cancelled");
   EXPECT_EQ(b.results()[0].started, Time{0});
   EXPECT_EQ(b.results()[0].ended, Time{0});
-  b.executor().run_until(seconds(40));
-  EXPECT_EQ(b.results().size(), 1u);
+  EXPECT_EQ(b.results_by(seconds(40)), 1u);
   EXPECT_TRUE(b.sent().empty());
 }
 
@@ -457,8 +442,7 @@ TEST(OperatorRunner, CancelBetweenTwoActionsReportsTheNextOne) {
   EXPECT_EQ(b.results()[1].reason, "cancelled");
   EXPECT_EQ(b.results()[1].started, at);
   EXPECT_EQ(b.results()[1].ended, at);
-  b.executor().run_until(seconds(40));
-  EXPECT_EQ(b.results().size(), 2u);
+  EXPECT_EQ(b.results_by(seconds(40)), 2u);
 }
 
 // The example scripts of scenarios/clients/logi-client/ run to the end

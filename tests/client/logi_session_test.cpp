@@ -28,50 +28,29 @@ using proto::Direction;
 using proto::Mode;
 
 /// The mock car on mem://car and a session pointed at it, in virtual time.
-class VirtualBench {
+class VirtualBench : public test::SessionOnMem<LogiSession, mocks::LogiFirmware, Event> {
  public:
-  explicit VirtualBench(mocks::ServerOptions options = {}, ClientConfig config = {}) {
-    options = test::on_mem("car", std::move(options));
-    options.name = "logi";
-    car_.start_car(sim::logi_car(), std::move(options));
-    session_ = std::make_unique<LogiSession>(
-        car_.context, link::MemEndpoint{"car"}, std::move(config),
-        [this](Time now, const Event& e) { events_.emplace_back(now, e); });
-  }
+  explicit VirtualBench(mocks::ServerOptions options = {}, ClientConfig config = {})
+      : SessionOnMem("logi", sim::logi_car(), std::move(options), std::move(config)) {}
 
-  LogiSession& session() { return *session_; }
-  mocks::LogiFirmware& firmware() { return *car_.firmware; }
-  mocks::MockServer& server() { return *car_.server; }
-  link::VirtualExecutor& executor() { return car_.executor; }
-  Time now() const { return car_.executor.now(); }
-  void run_until(Time t) { car_.executor.run_until(t); }
-  void run_for(link::Duration d) { car_.executor.run_for(d); }
-
+  using SessionOnMem::run_until;
   /// Runs until `done()` holds, in 10 ms steps, for at most `limit`.
   template <class Pred>
   bool run_until(Pred done, link::Duration limit) {
     const Time end = now() + limit;
     while (!done()) {
       if (now() >= end) return false;
-      car_.executor.run_for(milliseconds(10));
+      run_for(milliseconds(10));
     }
     return true;
   }
 
   void connect() {
-    session_->connect();
-    car_.executor.run_for(milliseconds(1));
-    ASSERT_EQ(session_->core().state(), ConnectionState::connected);
+    session().connect();
+    run_for(milliseconds(1));
+    ASSERT_EQ(session().core().state(), ConnectionState::connected);
   }
 
-  template <class E>
-  std::vector<std::pair<Time, E>> of() const {
-    std::vector<std::pair<Time, E>> out;
-    for (auto& [t, e] : events_) {
-      if (auto* x = std::get_if<E>(&e)) out.emplace_back(t, *x);
-    }
-    return out;
-  }
   std::vector<std::pair<Time, CommandEvent>> commands(CommandState state) const {
     std::vector<std::pair<Time, CommandEvent>> out;
     for (auto& [t, e] : of<CommandEvent>()) {
@@ -82,16 +61,11 @@ class VirtualBench {
   /// (time, raw) of every frame the client sent.
   std::vector<std::pair<Time, std::string>> sent() const {
     std::vector<std::pair<Time, std::string>> out;
-    for (const auto& e : session_->log()->entries()) {
+    for (const auto& e : session().log()->entries()) {
       if (e.kind == LogKind::tx) out.emplace_back(e.at, e.raw);
     }
     return out;
   }
-
- private:
-  test::VirtualCar<mocks::LogiFirmware> car_;
-  std::unique_ptr<LogiSession> session_;
-  std::vector<std::pair<Time, Event>> events_;
 };
 
 TEST(LogiSession, AutoTransportFlowToStation002Completes) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/client/client_test_support.hpp"
+
 namespace hil::client::wr8 {
 namespace {
 
@@ -20,35 +22,11 @@ protocol::Bytes packet(const proto::Message& m) {
   return proto::encode(m);
 }
 
-template <class E>
-std::vector<E> events_of(const std::vector<Event>& events) {
-  std::vector<E> out;
-  for (const auto& e : events) {
-    if (const auto* x = std::get_if<E>(&e)) out.push_back(*x);
-  }
-  return out;
-}
+using test::events_of;
+using test::has;
 
 std::vector<protocol::Bytes> sent(const std::vector<Action>& actions) {
-  std::vector<protocol::Bytes> out;
-  for (const auto& a : actions) {
-    if (const auto* s = std::get_if<SendBytes>(&a)) out.push_back(s->bytes);
-  }
-  return out;
-}
-
-bool has_open(const std::vector<Action>& actions) {
-  for (const auto& a : actions) {
-    if (std::holds_alternative<OpenConnection>(a)) return true;
-  }
-  return false;
-}
-
-bool has_close(const std::vector<Action>& actions) {
-  for (const auto& a : actions) {
-    if (std::holds_alternative<CloseConnection>(a)) return true;
-  }
-  return false;
+  return test::sent_bytes<SendBytes>(actions);
 }
 
 /// A core logged in at 0 ms, its actions and events so far taken.
@@ -69,7 +47,7 @@ void feed(Wr8ClientCore& core, Time now, const proto::Message& m) {
 TEST(Wr8ClientCore, ConnectSendsTheProfilesAuthStringAndLogsInOnAuthReply) {
   Wr8ClientCore core;
   core.connect(Time{0});
-  EXPECT_TRUE(has_open(core.take_actions()));
+  EXPECT_TRUE(has(core.take_actions(), OpenConnection{}));
   EXPECT_EQ(core.state(), ConnectionState::connecting);
   core.on_connected(milliseconds(1));
   const auto out = sent(core.take_actions());
@@ -92,16 +70,13 @@ TEST(Wr8ClientCore, ConnectSendsTheProfilesAuthStringAndLogsInOnAuthReply) {
 
 TEST(Wr8ClientCore, NoAuthReplyWithinTwoSecondsIsAFailedConnectionRetriedWithBackoff) {
   Wr8ClientCore core;
-  core.connect(Time{0});
-  core.on_connected(Time{0});
-  core.take_actions();
-  core.take_events();
+  test::connected_at_zero(core);
 
   core.on_timer(milliseconds(1999));
   EXPECT_EQ(core.state(), ConnectionState::authenticating);
   core.on_timer(seconds(2));
   auto actions = core.take_actions();
-  EXPECT_TRUE(has_close(actions));
+  EXPECT_TRUE(has(actions, CloseConnection{}));
   const auto failed = events_of<LoginFailedEvent>(core.take_events());
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_EQ(failed[0].reason, "AUTH-REPLY timeout");
@@ -112,10 +87,10 @@ TEST(Wr8ClientCore, NoAuthReplyWithinTwoSecondsIsAFailedConnectionRetriedWithBac
   for (const auto delay : {seconds(1), seconds(2), seconds(4), seconds(8), seconds(8)}) {
     EXPECT_EQ(core.next_wakeup(), t + delay);
     core.on_timer(t + delay - milliseconds(1));
-    EXPECT_FALSE(has_open(core.take_actions()));
+    EXPECT_FALSE(has(core.take_actions(), OpenConnection{}));
     t += delay;
     core.on_timer(t);
-    EXPECT_TRUE(has_open(core.take_actions()));
+    EXPECT_TRUE(has(core.take_actions(), OpenConnection{}));
     core.on_connect_failed(t);
     EXPECT_EQ(core.state(), ConnectionState::reconnecting);
   }

@@ -151,17 +151,12 @@ TEST(Wr8OperatorParse, ShippedExampleScriptsParse) {
 }
 
 /// The mock vehicle on mem://car, a session and a runner, in virtual time.
-class Bench {
+class Bench : public test::SessionOnMem<Wr8Session, mocks::Wr8Firmware, Event> {
  public:
-  explicit Bench(mocks::Wr8Config car = {}, ClientConfig config = {}) {
-    mocks::ServerOptions options = test::on_mem("car");
-    options.name = "wr8";
-    car_.start_car(sim::wr8_vehicle(), std::move(options), car);
-    session_ = std::make_unique<Wr8Session>(car_.context, link::MemEndpoint{"car"},
-                                            std::move(config), [this](Time now, const Event& e) {
-                                              if (runner_) runner_->on_event(now, e);
-                                            });
-    runner_ = std::make_unique<OperatorRunner>(car_.executor, *session_);
+  explicit Bench(mocks::Wr8Config car = {}, ClientConfig config = {})
+      : SessionOnMem("wr8", sim::wr8_vehicle(), {}, std::move(config), car),
+        runner_(std::make_unique<OperatorRunner>(executor(), session())) {
+    forward_events([this](Time now, const Event& e) { runner_->on_event(now, e); });
   }
 
   /// Runs `script` from the current time until it ends (at most 60 s).
@@ -176,39 +171,38 @@ class Bench {
     runner_->run(
         actions, keep_going, [&](const ActionResult& r) { results.push_back(r); },
         [this](bool ok) { finished_ = ok; });
-    const Time limit = car_.executor.now() + seconds(60);
-    while (!finished_ && car_.executor.now() < limit)
-      car_.executor.run_until(car_.executor.now() + milliseconds(10));
+    const Time limit = now() + seconds(60);
+    while (!finished_ && now() < limit)
+      run_until(now() + milliseconds(10));
     EXPECT_TRUE(finished_.has_value()) << "the script did not end";
     return results;
   }
 
   std::optional<bool> finished() const { return finished_; }
-  Wr8Session& session() { return *session_; }
-  mocks::Wr8Firmware& firmware() { return *car_.firmware; }
-  Time now() const { return car_.executor.now(); }
 
  private:
-  test::VirtualCar<mocks::Wr8Firmware> car_;
-  std::unique_ptr<Wr8Session> session_;
   std::unique_ptr<OperatorRunner> runner_;
   std::optional<bool> finished_;
 };
+
+/// `r` ended ok (or not) with `detail` at `finished`.
+void expect_end(const ActionResult& r, bool ok, const std::string& detail, Time finished) {
+  EXPECT_EQ(r.ok, ok) << r.detail;
+  EXPECT_EQ(r.detail, detail);
+  EXPECT_EQ(r.finished, finished);
+}
 
 TEST(Wr8OperatorRunner, ConnectsWaitsExactlyAndWaitsForData) {
   Bench bench;
   const auto r = bench.run("connect\nwait 1s\nwait-data\nwait 250ms\n");
   ASSERT_EQ(r.size(), 4u);
-  EXPECT_TRUE(r[0].ok) << r[0].detail;
-  EXPECT_EQ(r[0].detail, "logged in: device 8, id 1, STOP");
-  EXPECT_EQ(r[0].finished, Time{0});  // mem:// answers in the same instant
+  // mem:// answers in the same instant.
+  expect_end(r[0], true, "logged in: device 8, id 1, STOP", Time{0});
   EXPECT_EQ(r[1].started, Time{0});
   EXPECT_EQ(r[1].finished, seconds(1));
   // DATA comes on the 100 ms grid: the packet due at 1000 ms is sent after
   // the wait's timer in that same instant, so it ends the wait-data.
-  EXPECT_TRUE(r[2].ok);
-  EXPECT_EQ(r[2].finished, milliseconds(1000));
-  EXPECT_EQ(r[2].detail, "DATA STOP at 1000 ms");
+  expect_end(r[2], true, "DATA STOP at 1000 ms", milliseconds(1000));
   EXPECT_EQ(r[3].finished, milliseconds(1250));
   EXPECT_EQ(bench.finished(), true);
 }
@@ -243,27 +237,73 @@ TEST(Wr8OperatorRunner, SettingsAreSetThenReadBack) {
   const auto r = bench.run("connect\nset p=2 servo-zero=92\nget-settings\n");
   ASSERT_EQ(r.size(), 3u);
   EXPECT_TRUE(r[1].ok) << r[1].detail;
-  EXPECT_TRUE(r[2].ok) << r[2].detail;
-  EXPECT_EQ(r[2].detail, "p=2 i=0.25 d=0.05 servo-zero=92");
-  EXPECT_EQ(r[2].finished, Time{0});
+  expect_end(r[2], true, "p=2 i=0.25 d=0.05 servo-zero=92", Time{0});
   EXPECT_EQ(bench.firmware().state().servo_zero_deg, 92.0);
 }
 
-TEST(Wr8OperatorRunner, ARawBlinkTaskEndsAfterTwoSeconds) {
+/// A script run on a fresh bench and how one of its actions must end; an
+/// empty field is not checked.
+struct ScriptEnd {
+  const char* what;
+  const char* script;
+  std::size_t actions_run;
+  std::size_t step;
+  bool ok;
+  std::optional<std::string> detail;
+  std::optional<Time> finished;
+  std::optional<bool> script_ok;  ///< what the runner reported at the end
+};
+
+void expect_script_end(const ScriptEnd& c) {
   Bench bench;
-  const auto r = bench.run("connect\ntask blink\n");
-  ASSERT_EQ(r.size(), 2u);
-  EXPECT_TRUE(r[1].ok) << r[1].detail;
-  EXPECT_EQ(r[1].finished, seconds(2));
+  const auto r = bench.run(c.script);
+  ASSERT_EQ(r.size(), c.actions_run);
+  EXPECT_EQ(r[c.step].ok, c.ok) << r[c.step].detail;
+  if (c.detail) EXPECT_EQ(r[c.step].detail, *c.detail);
+  if (c.finished) EXPECT_EQ(r[c.step].finished, *c.finished);
+  if (c.script_ok) EXPECT_EQ(bench.finished(), *c.script_ok);
 }
 
-TEST(Wr8OperatorRunner, ARefusedTaskFailsWithTheReasonAndStopsTheScript) {
-  Bench bench;
-  const auto r = bench.run("connect\nturn 45\nwait 1s\n");
-  ASSERT_EQ(r.size(), 2u);  // the wait never ran
-  EXPECT_FALSE(r[1].ok);
-  EXPECT_EQ(r[1].detail, "the vehicle answered error");
-  EXPECT_EQ(bench.finished(), false);
+TEST(Wr8OperatorRunner, EachActionEndsAsItsAnswerSays) {
+  const ScriptEnd cases[] = {
+      {"a raw blink task ends after two seconds",
+       "connect\ntask blink\n",
+       2,
+       1,
+       true,
+       {},
+       seconds(2),
+       {}},
+      // The wait never runs.
+      {"a refused task fails with the reason and stops the script",
+       "connect\nturn 45\nwait 1s\n",
+       2,
+       1,
+       false,
+       "the vehicle answered error",
+       {},
+       false},
+      {"a task before connect is refused as not connected",
+       "drive 10\n",
+       1,
+       0,
+       false,
+       "refused: not connected",
+       Time{0},
+       {}},
+      {"a raw task the profile cannot encode is refused as bad request",
+       "connect\ntask drive\n",
+       2,
+       1,
+       false,
+       "refused: bad request",
+       {},
+       {}},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    expect_script_end(c);
+  }
 }
 
 TEST(Wr8OperatorRunner, KeepGoingRunsTheRestAfterAFailure) {
@@ -276,32 +316,14 @@ TEST(Wr8OperatorRunner, KeepGoingRunsTheRestAfterAFailure) {
   EXPECT_EQ(bench.finished(), false);
 }
 
-TEST(Wr8OperatorRunner, ATaskBeforeConnectIsRefusedAsNotConnected) {
-  Bench bench;
-  const auto r = bench.run("drive 10\n");
-  ASSERT_EQ(r.size(), 1u);
-  EXPECT_FALSE(r[0].ok);
-  EXPECT_EQ(r[0].detail, "refused: not connected");
-  EXPECT_EQ(r[0].finished, Time{0});
-}
-
-TEST(Wr8OperatorRunner, ARawTaskTheProfileCannotEncodeIsRefusedAsBadRequest) {
-  Bench bench;
-  const auto r = bench.run("connect\ntask drive\n");
-  ASSERT_EQ(r.size(), 2u);
-  EXPECT_FALSE(r[1].ok);
-  EXPECT_EQ(r[1].detail, "refused: bad request");
-}
-
 TEST(Wr8OperatorRunner, ARejectedLoginFailsConnectWithTheReasonAndStopsRetrying) {
   ClientConfig config;
   config.profile.auth_text = {'W', 'R', 'O', 'N', 'G', '-', 'A', 'U', 'T', 'H'};
   Bench bench({}, config);
   const auto r = bench.run("connect\n");
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_FALSE(r[0].ok);
-  EXPECT_EQ(r[0].detail, "closed before AUTH-REPLY");
-  EXPECT_EQ(r[0].finished, seconds(1));  // the mock closes 1 s after a wrong string
+  // The mock closes 1 s after a wrong string.
+  expect_end(r[0], false, "closed before AUTH-REPLY", seconds(1));
   bench.run("wait 10s\n");
   EXPECT_EQ(bench.session().core().state(), ConnectionState::disconnected);
 }
@@ -312,9 +334,7 @@ TEST(Wr8OperatorRunner, AnIgnoredTaskFailsExactly500MsAfterItWasSent) {
   bench.firmware().arm({.name = "", .when = {}, .action = mocks::Ignore{"TASK", 1, {}}});
   const auto r = bench.run("drive 20\n");
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_FALSE(r[0].ok);
-  EXPECT_EQ(r[0].detail, "no answer within 500ms");
-  EXPECT_EQ(r[0].finished, milliseconds(1500));
+  expect_end(r[0], false, "no answer within 500ms", milliseconds(1500));
 }
 
 TEST(Wr8OperatorRunner, WaitDataFailsWhenNotConnectedAndAfterDisconnect) {

@@ -30,30 +30,11 @@ std::pair<Time, RequestState> at(Time t, RequestState s) {
 }
 
 /// The mock vehicle on mem://car and a session pointed at it, in virtual time.
-class VirtualBench {
+class VirtualBench : public test::SessionOnMem<Wr8Session, mocks::Wr8Firmware, Event> {
  public:
-  explicit VirtualBench(mocks::Wr8Config car = {}, ClientConfig config = {}) {
-    mocks::ServerOptions options = test::on_mem("car");
-    options.name = "wr8";
-    car_.start_car(sim::wr8_vehicle(), std::move(options), car);
-    session_ = std::make_unique<Wr8Session>(
-        car_.context, link::MemEndpoint{"car"}, std::move(config),
-        [this](Time now, const Event& e) { events_.emplace_back(now, e); });
-  }
+  explicit VirtualBench(mocks::Wr8Config car = {}, ClientConfig config = {})
+      : SessionOnMem("wr8", sim::wr8_vehicle(), {}, std::move(config), car) {}
 
-  Wr8Session& session() { return *session_; }
-  mocks::Wr8Firmware& firmware() { return *car_.firmware; }
-  Time now() const { return car_.executor.now(); }
-  void run_until(Time t) { car_.executor.run_until(t); }
-
-  template <class E>
-  std::vector<std::pair<Time, E>> of() const {
-    std::vector<std::pair<Time, E>> out;
-    for (const auto& [t, e] : events_) {
-      if (const auto* x = std::get_if<E>(&e)) out.emplace_back(t, *x);
-    }
-    return out;
-  }
   /// The request events of one COI, with their times.
   std::vector<std::pair<Time, RequestState>> request(std::uint8_t coi) const {
     std::vector<std::pair<Time, RequestState>> out;
@@ -62,11 +43,11 @@ class VirtualBench {
     }
     return out;
   }
-
- private:
-  test::VirtualCar<mocks::Wr8Firmware> car_;
-  std::unique_ptr<Wr8Session> session_;
-  std::vector<std::pair<Time, Event>> events_;
+  /// Runs until `t`; the request events of one COI by then.
+  std::vector<std::pair<Time, RequestState>> request_by(std::uint8_t coi, Time t) {
+    run_until(t);
+    return request(coi);
+  }
 };
 
 /// Logs in at 0 ms and runs to 1 ms.
@@ -100,8 +81,7 @@ TEST(Wr8Session, A100CmDriveStartsAtOnceAndCompletesAtTheDistance) {
   login(bench);
   const auto r = bench.session().drive(100);
   ASSERT_TRUE(r);
-  bench.run_until(seconds(5));
-  const auto states = bench.request(r.coi);
+  const auto states = bench.request_by(r.coi, seconds(5));
   ASSERT_EQ(states.size(), 3u);
   EXPECT_EQ(states[0], at(milliseconds(1), RequestState::sent));
   EXPECT_EQ(states[1], at(milliseconds(1), RequestState::started));
@@ -121,8 +101,7 @@ TEST(Wr8Session, ATurnTo15DegreesCompletesWhenTheWheelsGetThere) {
   login(bench);
   bench.run_until(seconds(1));
   const auto r = bench.session().turn(15);
-  bench.run_until(seconds(2));
-  const auto states = bench.request(r.coi);
+  const auto states = bench.request_by(r.coi, seconds(2));
   ASSERT_EQ(states.size(), 3u);
   EXPECT_EQ(states[1], at(seconds(1), RequestState::started));
   // The servo reaches 15 degrees at 1083.3 ms; the next control tick is 1090 ms.
@@ -166,10 +145,9 @@ TEST(Wr8Session, SettingsSetThenReadBackGiveTheNewValues) {
 TEST(Wr8Session, ATaskRejectedByTheVehicleEndsInError) {
   VirtualBench bench;
   login(bench);
-  bench.firmware().arm({.name = "", .when = {}, .action = mocks::Reject{"TASK", 1}});
+  bench.firmware().arm(test::reject_next("TASK"));
   const auto r = bench.session().drive(100);
-  bench.run_until(milliseconds(100));
-  const auto states = bench.request(r.coi);
+  const auto states = bench.request_by(r.coi, milliseconds(100));
   ASSERT_EQ(states.size(), 2u);
   EXPECT_EQ(states[1], at(milliseconds(1), RequestState::error));
   EXPECT_EQ(bench.firmware().state().drive, std::nullopt);
@@ -181,8 +159,7 @@ TEST(Wr8Session, AnIgnoredTaskTimesOutExactly500MsAfterItWasSent) {
   bench.firmware().arm({.name = "", .when = {}, .action = mocks::Ignore{"TASK", 1, {}}});
   bench.run_until(milliseconds(200));
   const auto r = bench.session().turn(10);
-  bench.run_until(seconds(1));
-  const auto states = bench.request(r.coi);
+  const auto states = bench.request_by(r.coi, seconds(1));
   ASSERT_EQ(states.size(), 2u);
   EXPECT_EQ(states[1], at(milliseconds(700), RequestState::timed_out));
   // The next task is answered again, under the next COI.
@@ -226,13 +203,10 @@ TEST(Wr8Session, DataGoesStale500MsAfterTheLastPacketWhileTelemetryIsMuted) {
   bench.run_until(milliseconds(250));
   bench.firmware().arm({.name = "", .when = {}, .action = mocks::MuteTelemetry{seconds(1)}});
   bench.run_until(seconds(2));
-  const auto stale = bench.of<StaleEvent>();
-  ASSERT_EQ(stale.size(), 2u);
   // Last DATA at 200 ms; stale at 700 ms; DATA again on the grid at 1300 ms.
-  EXPECT_EQ(stale[0].first, milliseconds(700));
-  EXPECT_TRUE(stale[0].second.stale);
-  EXPECT_EQ(stale[1].first, milliseconds(1300));
-  EXPECT_FALSE(stale[1].second.stale);
+  EXPECT_EQ(
+      test::stale_flags(bench.of<StaleEvent>()),
+      (std::vector<std::pair<Time, bool>>{{milliseconds(700), true}, {milliseconds(1300), false}}));
 }
 
 }  // namespace

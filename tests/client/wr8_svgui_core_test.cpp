@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/client/client_test_support.hpp"
+
 namespace hil::client::wr8 {
 namespace {
 
@@ -27,28 +29,11 @@ protocol::Bytes hex(std::string_view text) {
   return b.value_or(protocol::Bytes{});
 }
 
-template <class E>
-std::vector<E> events_of(const std::vector<SvguiEvent>& events) {
-  std::vector<E> out;
-  for (const auto& e : events) {
-    if (const auto* x = std::get_if<E>(&e)) out.push_back(*x);
-  }
-  return out;
-}
+using test::events_of;
+using test::has;
 
 std::vector<protocol::Bytes> sent(const std::vector<Action>& actions) {
-  std::vector<protocol::Bytes> out;
-  for (const auto& a : actions) {
-    if (const auto* s = std::get_if<SendBytes>(&a)) out.push_back(s->bytes);
-  }
-  return out;
-}
-
-bool has(const std::vector<Action>& actions, const Action& wanted) {
-  for (const auto& a : actions) {
-    if (a == wanted) return true;
-  }
-  return false;
+  return test::sent_bytes<SendBytes>(actions);
 }
 
 SvguiConfig config_for(Version version) {
@@ -164,10 +149,7 @@ TEST(SvguiCore, HeadAuthCarriesTheTrailingNul) {
 
 TEST(SvguiCore, NoReplyWithinTheLoginTimeoutClosesAndRetriesOnTheBackoff) {
   SvguiClientCore core(config_for(Version::head));
-  core.connect(Time{0});
-  core.on_connected(Time{0});
-  core.take_actions();
-  core.take_events();
+  test::connected_at_zero(core);
   core.on_timer(milliseconds(2999));
   EXPECT_EQ(core.state(), ConnectionState::authenticating);
   core.on_timer(seconds(3));

@@ -16,10 +16,8 @@ void check_items(const std::vector<arduino::Item>& items) {
     if (const auto* f = std::get_if<Frame<arduino::Message>>(&item)) {
       // Frames arrive in non-canonical spellings too (+25, lowercase hex), so
       // the re-encoded frame must decode to the same message, not the same bytes.
-      const auto round = arduino::decode_frame(arduino::encode(f->message));
-      const auto* g = std::get_if<Frame<arduino::Message>>(&round);
-      hil::fuzz::check(g != nullptr && g->message == f->message,
-                       "re-encoded frame does not decode the same");
+      hil::fuzz::check_decodes_the_same(arduino::decode_frame(arduino::encode(f->message)),
+                                        f->message);
       hil::fuzz::check(f->raw.size() <= arduino::kMaxFrameBytes, "frame longer than the bound");
     } else {
       const auto& e = std::get<DecodeError>(item);
@@ -38,14 +36,8 @@ void check_items(const std::vector<arduino::Item>& items) {
 
 void run(const arduino::DecoderOptions& options, std::span<const std::uint8_t> plan,
          std::span<const std::uint8_t> stream) {
-  arduino::Decoder chunked(options);
-  const auto items = hil::fuzz::feed_and_check<arduino::Decoder, arduino::Message>(
-      chunked, plan, stream, options.max_frame_bytes);
-  arduino::Decoder whole(options);
-  const auto again = hil::fuzz::feed_and_check<arduino::Decoder, arduino::Message>(
-      whole, {}, stream, options.max_frame_bytes);
-  hil::fuzz::check(items == again, "chunked and whole decoding differ");
-  check_items(items);
+  check_items(hil::fuzz::decode_chunked_and_whole<arduino::Decoder, arduino::Message>(
+      plan, stream, options.max_frame_bytes, options));
 }
 
 }  // namespace

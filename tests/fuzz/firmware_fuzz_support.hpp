@@ -110,20 +110,14 @@ void drive_firmware(mocks::Firmware& firmware, MakeDecoder make_decoder,
   };
   // Runs every wakeup due up to `until`, as the driver's timer would.
   const auto run_until = [&](link::Time until) {
-    int at_one_instant = 0;
-    link::Time last{};
-    while (const auto due = firmware.next_wakeup()) {
-      if (*due > until) break;
-      const link::Time at = std::max(*due, now);
-      at_one_instant = at == last ? at_one_instant + 1 : 0;
-      check(at_one_instant < kMaxWakesAtOneInstant, "the firmware keeps waking at one instant");
-      last = at;
-      now = at;
-      firmware.wake(now);
-      collect();
-      close_if_asked();
-    }
-    now = std::max(now, until);
+    run_wakeups(
+        now, until, [&] { return firmware.next_wakeup(); },
+        [&] {
+          firmware.wake(now);
+          collect();
+          close_if_asked();
+        },
+        kMaxWakesAtOneInstant, "the firmware keeps waking at one instant");
   };
 
   firmware.connect(now);

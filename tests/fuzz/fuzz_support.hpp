@@ -1,7 +1,9 @@
 #pragma once
-// Shared by the decoder fuzz targets: split the fuzzer's input into a
-// chunking plan and a byte stream, and check the decoder contract.
+// Shared by the fuzz targets: split the fuzzer's input into a chunking
+// plan and a byte stream, check the decoder contract, and run the wakeups a
+// sans-I/O component asks for on a virtual clock.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -9,6 +11,7 @@
 #include <variant>
 #include <vector>
 
+#include "link/time.hpp"
 #include "protocol/common/decode.hpp"
 
 namespace hil::fuzz {
@@ -49,6 +52,49 @@ std::vector<protocol::DecodeItem<Message>> feed_and_check(Decoder& decoder,
   check(joined.size() == stream.size() && std::equal(joined.begin(), joined.end(), stream.begin()),
         "item bytes differ from the input stream");
   return items;
+}
+
+/// feed_and_check() of `stream` twice, in the pieces `plan` gives and whole,
+/// each into a fresh Decoder(options...); both must give the same items,
+/// which are returned.
+template <class Decoder, class Message, class... Options>
+std::vector<protocol::DecodeItem<Message>> decode_chunked_and_whole(
+    std::span<const std::uint8_t> plan, std::span<const std::uint8_t> stream, std::size_t bound,
+    const Options&... options) {
+  Decoder chunked(options...);
+  auto items = feed_and_check<Decoder, Message>(chunked, plan, stream, bound);
+  Decoder whole(options...);
+  const auto again = feed_and_check<Decoder, Message>(whole, {}, stream, bound);
+  check(items == again, "chunked and whole decoding differ");
+  return items;
+}
+
+/// `round`, what decoding the re-encoded `message` gave, is a frame of that
+/// same message.
+template <class Message>
+void check_decodes_the_same(const protocol::DecodeItem<Message>& round, const Message& message) {
+  const auto* g = std::get_if<protocol::Frame<Message>>(&round);
+  check(g != nullptr && g->message == message, "re-encoded frame does not decode the same");
+}
+
+/// Runs every wakeup `next_due()` reports up to `until` as a driver's timer
+/// would: `now` moves to each (never back) and `wake()` runs there. Waking
+/// `limit` times at one instant is a crash reported as `spinning`. Leaves
+/// `now` at `until` at least.
+template <class NextDue, class Wake>
+void run_wakeups(link::Time& now, link::Time until, NextDue&& next_due, Wake&& wake, int limit,
+                 const char* spinning) {
+  int at_one_instant = 0;
+  link::Time last{};
+  while (const auto due = next_due()) {
+    if (*due > until) break;
+    const link::Time at = std::max(*due, now);
+    at_one_instant = at == last ? at_one_instant + 1 : 0;
+    check(at_one_instant < limit, spinning);
+    last = now = at;
+    wake();
+  }
+  now = std::max(now, until);
 }
 
 /// The first input byte gives the length of the chunking plan.

@@ -73,18 +73,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::size_t len = std::min<std::size_t>(data[pos + 2], size - pos - 3);
     const protocol::ByteView bytes(data + pos + 3, len);
     pos += 3 + len;
-    int at_one_instant = 0;
-    link::Time last{};
-    while (const auto due = core.next_wakeup()) {
-      if (*due > at) break;
-      const link::Time t = std::max(*due, now);
-      at_one_instant = t == last ? at_one_instant + 1 : 0;
-      fuzz::check(at_one_instant < 64, "the client keeps waking at one instant");
-      last = now = t;
-      core.on_timer(now);
-      check_actions(core);
-    }
-    now = std::max(now, at);
+    fuzz::run_wakeups(
+        now, at, [&] { return core.next_wakeup(); },
+        [&] {
+          core.on_timer(now);
+          check_actions(core);
+        },
+        64, "the client keeps waking at one instant");
     operate(core, now, op);
     check_actions(core);
     core.on_bytes(now, bytes);

@@ -12,16 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "link/asio_executor.hpp"
-#include "link/endpoint.hpp"
-#include "link/transport.hpp"
 #include "mocks/logi.hpp"
-#include "mocks/server.hpp"
 #include "protocol/logi/codec.hpp"
-#include "sim/presets.hpp"
-#include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
 #include "tests/mocks/mock_test_support.hpp"
+#include "tests/mocks/real_time_car.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -32,20 +27,14 @@ using std::chrono::seconds;
 /// The car on a real TCP port and one upper-computer client connected to it.
 class TcpCar {
  public:
-  TcpCar()
-      : world_({sim::default_warehouse_arena()}),
-        vehicle_(world_.add_vehicle(sim::logi_car())),
-        firmware_(world_, vehicle_),
-        server_(context_, firmware_, options()) {
-    server_.start();
-    test::connect_client(context_, server_, pipe_,
-                         {[this](protocol::ByteView b) { decoder_.feed(b, items_); },
-                          [this](std::error_code) { closed_ = true; }});
-    EXPECT_TRUE(link::test::run_until(io_, [&] { return pipe_ && firmware_.connected(); }));
+  TcpCar() {
+    EXPECT_TRUE(test::connect_and_wait(car_, pipe_,
+                                       {[this](protocol::ByteView b) { decoder_.feed(b, items_); },
+                                        [this](std::error_code) { closed_ = true; }}));
   }
   ~TcpCar() {
     if (pipe_) pipe_->close();
-    server_.close();
+    car_.server.close();
   }
 
   bool connected() const { return pipe_ != nullptr && !closed_; }
@@ -58,7 +47,7 @@ class TcpCar {
   std::string command(std::string_view payload) {
     send(payload);
     std::optional<logi::Feedback> answer;
-    const bool got = link::test::run_until(io_, [&] {
+    const bool got = link::test::run_until(car_.io, [&] {
       collect();
       if (!feedback_.empty()) {
         answer = feedback_.front();
@@ -74,7 +63,7 @@ class TcpCar {
                                           std::chrono::milliseconds limit) {
     std::optional<logi::Status> found;
     link::test::run_until(
-        io_,
+        car_.io,
         [&] {
           collect();
           for (auto it = status_.begin(); it != status_.end(); ++it) {
@@ -93,18 +82,11 @@ class TcpCar {
 
   std::size_t status_seen() const { return status_count_; }
   std::uint64_t decode_errors() const { return decode_errors_; }
-  LogiFirmware& firmware() { return firmware_; }
-  sim::Vehicle& vehicle() { return vehicle_; }
-  asio::io_context& io() { return io_; }
+  LogiFirmware& firmware() { return car_.firmware; }
+  sim::Vehicle& vehicle() { return car_.vehicle; }
+  asio::io_context& io() { return car_.io; }
 
  private:
-  static ServerOptions options() {
-    ServerOptions o;
-    o.listen = link::parse_endpoint("tcp://127.0.0.1:0");
-    o.name = "logi";
-    return o;
-  }
-
   void collect() {
     for (auto& item : items_) {
       if (auto* f = std::get_if<protocol::Frame<logi::Message>>(&item)) {
@@ -120,13 +102,8 @@ class TcpCar {
     items_.clear();
   }
 
-  asio::io_context io_;
-  link::AsioExecutor executor_{io_};
-  link::TransportContext context_{executor_, &io_};
-  sim::World world_;
-  sim::Vehicle& vehicle_;
-  LogiFirmware firmware_;
-  MockServer server_;
+  test::RealTimeCar<LogiFirmware> car_{sim::logi_car(),
+                                       test::listening_on("tcp://127.0.0.1:0", "logi")};
   link::BytePipePtr pipe_;
   bool closed_ = false;
   logi::Decoder decoder_;

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <string_view>
+
 #include "mocks/firmware.hpp"
 #include "mocks/server.hpp"
 #include "tests/mocks/mock_test_support.hpp"
@@ -68,13 +71,18 @@ Car make_car(ServerOptions options = {}) {
       std::move(options));
 }
 
+/// Writes `text` from `client`, runs 1 ms and returns what came back.
+std::string exchange(Car& car, test::ClientEnd& client, std::string_view text) {
+  client.write(text);
+  car.run_for(milliseconds(1));
+  return client.take_text();
+}
+
 TEST(MockServer, JoinsAClientToTheFirmwareAndBack) {
   auto car = make_car();
   auto client = car.connect();
   ASSERT_TRUE(car.server().client_connected());
-  client->write("ab");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "EaEb");
+  EXPECT_EQ(exchange(car, *client, "ab"), "EaEb");
   EXPECT_EQ(car.firmware().stats().frames_in, 2u);
   EXPECT_EQ(car.firmware().stats().bytes_in, 2u);
 }
@@ -106,9 +114,7 @@ TEST(MockServer, ASecondClientIsClosedAndTheFirstKeepsItsSession) {
   ASSERT_TRUE(second->closed.has_value());
   EXPECT_EQ(*second->closed, link::end_of_stream());
   EXPECT_EQ(car.server().turned_away(), 1u);
-  first->write("x");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(first->take_text(), "Ex");
+  EXPECT_EQ(exchange(car, *first, "x"), "Ex");
   EXPECT_FALSE(first->closed.has_value());
 }
 
@@ -120,9 +126,7 @@ TEST(MockServer, AClientThatLeavesDisconnectsTheFirmwareAndTheNextIsServed) {
   EXPECT_FALSE(car.firmware().connected());
   EXPECT_EQ(car.firmware().disconnects, 1);
   auto second = car.connect();
-  second->write("y");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(second->take_text(), "Ey");
+  EXPECT_EQ(exchange(car, *second, "y"), "Ey");
   EXPECT_EQ(car.server().clients_served(), 2u);
   EXPECT_EQ(car.firmware().stats().connections, 2u);
 }
@@ -131,9 +135,7 @@ TEST(MockServer, ARejectBehaviourAnswersTheNextNCommandsOfItsKindNegatively) {
   auto car = make_car();
   auto client = car.connect();
   car.firmware().arm(Behaviour{"", When{}, Reject{"a", 2}});
-  client->write("abaa");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "RaEbRaEa");
+  EXPECT_EQ(exchange(car, *client, "abaa"), "RaEbRaEa");
   EXPECT_EQ(car.firmware().stats().rejected, 2u);
 }
 
@@ -145,9 +147,7 @@ TEST(MockServer, AnIgnoreBehaviourSwallowsCommandsForItsDuration) {
   car.run_for(milliseconds(30));
   EXPECT_EQ(client->take_text(), "");
   car.run_for(milliseconds(30));
-  client->write("b");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "Eb");
+  EXPECT_EQ(exchange(car, *client, "b"), "Eb");
   EXPECT_EQ(car.firmware().stats().ignored, 1u);
 }
 
@@ -165,9 +165,7 @@ TEST(MockServer, AfterFrameBehavioursFireOnTheNthMatchingFrame) {
   auto car = make_car();
   auto client = car.connect();
   car.firmware().arm(Behaviour{"hello", When{std::nullopt, "z", 2}, SendBytes{{'!', '!'}}});
-  client->write("zaz");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "EzEaEz!!");
+  EXPECT_EQ(exchange(car, *client, "zaz"), "EzEaEz!!");
 }
 
 TEST(MockServer, ACloseBehaviourHangsUpAndTheCarServesTheNextClient) {
@@ -182,9 +180,7 @@ TEST(MockServer, ACloseBehaviourHangsUpAndTheCarServesTheNextClient) {
   EXPECT_EQ(*client->closed, link::end_of_stream());
   EXPECT_FALSE(car.firmware().connected());
   auto next = car.connect();
-  next->write("r");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(next->take_text(), "Er");
+  EXPECT_EQ(exchange(car, *next, "r"), "Er");
 }
 
 TEST(MockServer, FaultAndClearFaultReachTheFirmwareOnce) {
@@ -214,18 +210,14 @@ TEST(MockServer, LinkFaultsApplyToTheCarsTraffic) {
   auto client = car.connect();
   client->write("a");
   car.run_for(milliseconds(1));
-  client->write("b");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "Eb");
+  EXPECT_EQ(exchange(car, *client, "b"), "Eb");
   EXPECT_EQ(car.server().faults_injected(), 1u);
 }
 
 TEST(MockServer, SetFaultsActsOnTheLinkAtOnceAndOnLaterLinksAndAnEmptyProfileEndsThem) {
   auto car = make_car();
   auto client = car.connect();
-  client->write("a");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "Ea");
+  EXPECT_EQ(exchange(car, *client, "a"), "Ea");
 
   link::FaultProfile drop_answers;
   link::FaultRule drop;
@@ -233,22 +225,16 @@ TEST(MockServer, SetFaultsActsOnTheLinkAtOnceAndOnLaterLinksAndAnEmptyProfileEnd
   drop.action = link::Drop{};  // raw frames: every write the car makes
   drop_answers.rules.push_back(drop);
   car.server().set_faults(drop_answers);
-  client->write("b");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(client->take_text(), "") << "the running link drops the answer";
+  EXPECT_EQ(exchange(car, *client, "b"), "") << "the running link drops the answer";
   EXPECT_EQ(car.server().faults_injected(), 1u);
 
   client->pipe->close();
   car.run_for(milliseconds(1));
   auto second = car.connect();
-  second->write("c");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(second->take_text(), "") << "the next link starts with the new rules";
+  EXPECT_EQ(exchange(car, *second, "c"), "") << "the next link starts with the new rules";
 
   car.server().set_faults({});
-  second->write("d");
-  car.run_for(milliseconds(1));
-  EXPECT_EQ(second->take_text(), "Ed");
+  EXPECT_EQ(exchange(car, *second, "d"), "Ed");
   EXPECT_EQ(car.server().faults_injected(), 2u);
 }
 

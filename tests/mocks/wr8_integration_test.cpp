@@ -13,16 +13,12 @@
 #include <system_error>
 #include <vector>
 
-#include "link/asio_executor.hpp"
 #include "link/endpoint.hpp"
-#include "link/transport.hpp"
-#include "mocks/server.hpp"
 #include "mocks/wr8.hpp"
 #include "protocol/wr8/codec.hpp"
-#include "sim/presets.hpp"
-#include "sim/world.hpp"
 #include "tests/link/transports/real_time.hpp"
 #include "tests/mocks/mock_test_support.hpp"
+#include "tests/mocks/real_time_car.hpp"
 
 namespace hil::mocks {
 namespace {
@@ -36,23 +32,18 @@ class TcpCar {
  public:
   explicit TcpCar(Wr8Config config = {})
       : config_(config),
-        vehicle_(world_.add_vehicle(sim::wr8_vehicle())),
-        firmware_(world_, vehicle_, config),
-        server_(context_, firmware_, server_options()) {
-    server_.start();
-    test::connect_client(context_, server_, pipe_,
-                         {[this](protocol::ByteView b) { on_data(b); },
-                          [this](std::error_code why) { closed_ = why; }},
-                         [this](std::error_code ec) { closed_ = ec; });
-    EXPECT_TRUE(link::test::run_until(io_, [&] { return pipe_ || closed_; }));
-    EXPECT_TRUE(pipe_) << "could not connect to " << server_.address();
-    EXPECT_TRUE(link::test::run_until(io_, [&] { return firmware_.connected(); }));
+        car_(sim::wr8_vehicle(), test::listening_on("tcp://127.0.0.1:0", "wr8"), config) {
+    EXPECT_TRUE(test::connect_and_wait(car_, pipe_,
+                                       {[this](protocol::ByteView b) { on_data(b); },
+                                        [this](std::error_code why) { closed_ = why; }},
+                                       [this](std::error_code ec) { closed_ = ec; }))
+        << "could not connect to " << car_.server.address();
   }
 
   ~TcpCar() {
     if (pipe_) pipe_->close();
-    server_.close();
-    link::test::run_for(io_, std::chrono::milliseconds(20));
+    car_.server.close();
+    link::test::run_for(car_.io, std::chrono::milliseconds(20));
   }
 
   void send(const wr8::Message& m) {
@@ -60,9 +51,9 @@ class TcpCar {
   }
 
   bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = seconds(10)) {
-    return link::test::run_until(io_, done, limit);
+    return link::test::run_until(car_.io, done, limit);
   }
-  void run_for(std::chrono::milliseconds d) { link::test::run_for(io_, d); }
+  void run_for(std::chrono::milliseconds d) { link::test::run_for(car_.io, d); }
 
   /// The first response with this COI and code, if it has come.
   std::optional<std::size_t> response_index(std::uint8_t coi, wr8::ResponseCode code) const {
@@ -84,18 +75,11 @@ class TcpCar {
   const std::vector<wr8::Message>& received() const { return received_; }
   std::size_t decode_errors() const { return decode_errors_; }
   const std::optional<std::error_code>& closed() const { return closed_; }
-  Wr8Firmware& firmware() { return firmware_; }
-  sim::Vehicle& vehicle() { return vehicle_; }
+  Wr8Firmware& firmware() { return car_.firmware; }
+  sim::Vehicle& vehicle() { return car_.vehicle; }
   const Wr8Config& config() const { return config_; }
 
  private:
-  static ServerOptions server_options() {
-    ServerOptions options;
-    options.listen = link::TcpEndpoint{"127.0.0.1", 0};
-    options.name = "wr8";
-    return options;
-  }
-
   void on_data(protocol::ByteView bytes) {
     std::vector<wr8::Item> items;
     decoder_.feed(bytes, items);
@@ -109,13 +93,7 @@ class TcpCar {
   }
 
   Wr8Config config_;
-  asio::io_context io_;
-  link::AsioExecutor executor_{io_};
-  link::TransportContext context_{executor_, &io_};
-  sim::World world_{sim::WorldDef{}};
-  sim::Vehicle& vehicle_;
-  Wr8Firmware firmware_;
-  MockServer server_;
+  test::RealTimeCar<Wr8Firmware> car_;
   link::BytePipePtr pipe_;
   std::optional<std::error_code> closed_;
   wr8::Decoder decoder_{wr8::DecoderOptions{config_.profile, wr8::Sender::vehicle, 0}};

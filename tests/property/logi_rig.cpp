@@ -1,9 +1,11 @@
 #include "tests/property/logi_rig.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 
@@ -112,6 +114,18 @@ bool is_movement(const proto::Message& m) {
   if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
   return false;
 }
+/// The signs of the forward, leftward and anticlockwise motion `d` asks for.
+std::array<int, 3> motion_signs(Direction d) {
+  const auto one_of = [d](std::initializer_list<Direction> ds) {
+    return std::find(ds.begin(), ds.end(), d) != ds.end() ? 1 : 0;
+  };
+  return {one_of({Direction::fwd, Direction::lf, Direction::rf}) -
+              one_of({Direction::bwd, Direction::lb, Direction::rb}),
+          one_of({Direction::left, Direction::lf, Direction::lb}) -
+              one_of({Direction::right, Direction::rf, Direction::rb}),
+          one_of({Direction::ccw}) - one_of({Direction::cw})};
+}
+
 bool is_stop(const proto::Message& m) {
   if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction == Direction::stop;
   if (const auto* st = std::get_if<proto::SetRun>(&m)) return !st->run;
@@ -148,44 +162,30 @@ class Rig::Observer final : public link::LinkObserver {
     to_client_sent_ = proto::Decoder{};
   }
   void on_sent(Time at, link::Direction d, protocol::ByteView bytes) override {
-    if (!rig_ || rig_->links.empty()) return;
-    auto& l = rig_->links.back();
-    if (d == link::Direction::to_car) {
-      l.to_car_sent.insert(l.to_car_sent.end(), bytes.begin(), bytes.end());
-      return;
-    }
+    LinkRecord* l = watched();
+    if (l == nullptr) return;
+    if (d == link::Direction::to_car) return append(l->to_car_sent, bytes);
     // The car's answers as it writes them: what the car did with a command.
-    items_.clear();
-    to_client_sent_.feed(bytes, items_);
-    std::map<proto::Command, int> per_code;
-    for (const auto& item : items_) {
-      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
-      if (f == nullptr) continue;
-      if (const auto* fb = std::get_if<proto::Feedback>(&f->message)) ++per_code[fb->command];
+    std::vector<proto::Feedback> feedback;
+    for (const auto& m : messages_of(to_client_sent_, bytes)) {
+      if (const auto* fb = std::get_if<proto::Feedback>(&m)) feedback.push_back(*fb);
     }
-    for (const auto& item : items_) {
-      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
-      if (f == nullptr) continue;
-      const auto* fb = std::get_if<proto::Feedback>(&f->message);
+    std::map<proto::Command, int> per_code;
+    for (const auto& fb : feedback)
+      ++per_code[fb.command];
+    for (const auto& fb : feedback) {
       // Two answers of one code in one write: which command each is for is
       // not known here, so neither is judged.
-      if (fb == nullptr || !fb->accepted || per_code[fb->command] > 1) continue;
-      rig_->on_car_accepted(at, *fb);
+      if (!fb.accepted || per_code[fb.command] > 1) continue;
+      rig_->on_car_accepted(at, fb);
     }
   }
   void on_delivered(Time at, link::Direction d, protocol::ByteView bytes) override {
-    if (!rig_ || rig_->links.empty()) return;
-    auto& l = rig_->links.back();
-    if (d == link::Direction::to_client) {
-      l.to_client_delivered.insert(l.to_client_delivered.end(), bytes.begin(), bytes.end());
-      return;
-    }
-    items_.clear();
-    l.to_car_decoder.feed(bytes, items_);
-    for (const auto& item : items_) {
-      const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item);
-      if (f == nullptr) continue;
-      CarFrame cf{at, rig_->links.size() - 1, f->message, rig_->firmware().state().mode};
+    LinkRecord* l = watched();
+    if (l == nullptr) return;
+    if (d == link::Direction::to_client) return append(l->to_client_delivered, bytes);
+    for (const auto& m : messages_of(l->to_car_decoder, bytes)) {
+      CarFrame cf{at, rig_->links.size() - 1, m, rig_->firmware().state().mode};
       rig_->car_frames.push_back(cf);
     }
   }
@@ -193,9 +193,29 @@ class Rig::Observer final : public link::LinkObserver {
     if (rig_) rig_->faults.push_back(e);
   }
   void on_close(Time at, const link::LinkClose& c) override {
-    if (!rig_ || rig_->links.empty()) return;
-    rig_->links.back().closed = at;
-    rig_->links.back().closed_by = c.by;
+    LinkRecord* l = watched();
+    if (l == nullptr) return;
+    l->closed = at;
+    l->closed_by = c.by;
+  }
+
+ private:
+  /// The connection being watched: the latest, while the rig is there.
+  LinkRecord* watched() { return rig_ && !rig_->links.empty() ? &rig_->links.back() : nullptr; }
+  static void append(protocol::Bytes& record, protocol::ByteView bytes) {
+    record.insert(record.end(), bytes.begin(), bytes.end());
+  }
+  /// The messages of the frames `decoder` makes of `bytes`; what does not
+  /// decode is passed over.
+  std::vector<proto::Message> messages_of(proto::Decoder& decoder, protocol::ByteView bytes) {
+    items_.clear();
+    decoder.feed(bytes, items_);
+    std::vector<proto::Message> out;
+    for (const auto& item : items_) {
+      if (const auto* f = std::get_if<protocol::Frame<proto::Message>>(&item))
+        out.push_back(f->message);
+    }
+    return out;
   }
 };
 
@@ -337,45 +357,7 @@ void Rig::on_car_accepted(Time at, const proto::Feedback& fb) {
       const auto* m = vehicle().mecanum();
       const sim::Twist tw = m != nullptr ? m->target() : sim::Twist{};
       auto sign = [](double v) { return std::abs(v) < 1e-9 ? 0 : (v > 0 ? 1 : -1); };
-      int vx = 0, vy = 0, wz = 0;
-      switch (mv->direction) {
-        case Direction::fwd:
-          vx = 1;
-          break;
-        case Direction::bwd:
-          vx = -1;
-          break;
-        case Direction::left:
-          vy = 1;
-          break;
-        case Direction::right:
-          vy = -1;
-          break;
-        case Direction::lf:
-          vx = 1;
-          vy = 1;
-          break;
-        case Direction::rf:
-          vx = 1;
-          vy = -1;
-          break;
-        case Direction::lb:
-          vx = -1;
-          vy = 1;
-          break;
-        case Direction::rb:
-          vx = -1;
-          vy = -1;
-          break;
-        case Direction::cw:
-          wz = -1;
-          break;
-        case Direction::ccw:
-          wz = 1;
-          break;
-        case Direction::stop:
-          break;
-      }
+      const auto [vx, vy, wz] = motion_signs(mv->direction);
       if (sign(tw.vx_mps) != vx || sign(tw.vy_mps) != vy || sign(tw.wz_radps) != wz) rec.ok = false;
     }
   } else if (const auto* st = std::get_if<proto::SetRun>(cmd)) {

@@ -133,11 +133,7 @@ struct Wr8Rig {
 
   template <class E>
   std::vector<std::pair<Time, E>> of() const {
-    std::vector<std::pair<Time, E>> out;
-    for (const auto& [t, e] : events) {
-      if (const auto* x = std::get_if<E>(&e)) out.emplace_back(t, *x);
-    }
-    return out;
+    return test::timed_events_of<E>(events);
   }
 
   // The records come first: the car and the session report into them until

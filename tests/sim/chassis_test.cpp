@@ -15,6 +15,7 @@ namespace {
 
 using test::open_field;
 using test::seconds;
+using test::starting_at;
 
 constexpr double kTolerance = 0.01;  // 1 % of the expected value once at speed
 
@@ -42,10 +43,13 @@ Motion measure(World& world, Vehicle& car, double window_s) {
   return {rotate(after.position() - before.position(), -before.heading_rad), turned, window_s};
 }
 
-VehicleDef mecanum_def() {
-  VehicleDef def = logi_car();
-  def.start = Pose{20, 20, 0.3};
-  return def;
+/// How a mecanum car moves over two seconds with its wheels turning at
+/// `targets` (rad/s).
+Motion mecanum_motion(const MecanumWheels& targets) {
+  World world({open_field()});
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{20, 20, 0.3}));
+  car.mecanum()->set_wheel_targets(targets);
+  return measure(world, car, 2.0);
 }
 
 TEST(MecanumKinematics, InverseThenForwardIsIdentity) {
@@ -58,37 +62,33 @@ TEST(MecanumKinematics, InverseThenForwardIsIdentity) {
   EXPECT_NEAR(back.wz_radps, twist.wz_radps, 1e-12);
 }
 
-TEST(MecanumKinematics, AllWheelsForwardDrivesStraightAtWheelSurfaceSpeed) {
-  World world({open_field()});
-  Vehicle& car = world.add_vehicle(mecanum_def());
+TEST(MecanumKinematics, ForwardAndStrafeGoStraightAtWheelSurfaceSpeedWithoutTurning) {
   const double w = 8.0;  // rad/s
-  car.mecanum()->set_wheel_targets({w, w, w, w});
-  const Motion m = measure(world, car, 2.0);
   const double r = MecanumDef{}.wheel_radius_m;
-  EXPECT_NEAR(m.moved_body.x_m / m.seconds, r * w, kTolerance * r * w);
-  EXPECT_NEAR(m.moved_body.y_m, 0.0, 1e-3);
-  EXPECT_NEAR(m.turned_rad, 0.0, 1e-3);
-}
-
-TEST(MecanumKinematics, CrossedWheelsStrafeLeftWithoutTurning) {
-  World world({open_field()});
-  Vehicle& car = world.add_vehicle(mecanum_def());
-  const double w = 8.0;
-  // Textbook strafe: front-left and rear-right backwards, the other two forwards.
-  car.mecanum()->set_wheel_targets({-w, w, w, -w});
-  const Motion m = measure(world, car, 2.0);
-  const double r = MecanumDef{}.wheel_radius_m;
-  EXPECT_NEAR(m.moved_body.y_m / m.seconds, r * w, kTolerance * r * w);
-  EXPECT_NEAR(m.moved_body.x_m, 0.0, 1e-3);
-  EXPECT_NEAR(m.turned_rad, 0.0, 1e-3);
+  struct Case {
+    const char* what;
+    MecanumWheels wheels;
+    bool sideways;  // the car goes left rather than forwards
+  };
+  const Case cases[] = {
+      {"all wheels forward", {w, w, w, w}, false},
+      // Textbook strafe: front-left and rear-right backwards, the other two forwards.
+      {"crossed wheels strafe left", {-w, w, w, -w}, true},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const Motion m = mecanum_motion(c.wheels);
+    const double along = c.sideways ? m.moved_body.y_m : m.moved_body.x_m;
+    const double across = c.sideways ? m.moved_body.x_m : m.moved_body.y_m;
+    EXPECT_NEAR(along / m.seconds, r * w, kTolerance * r * w);
+    EXPECT_NEAR(across, 0.0, 1e-3);
+    EXPECT_NEAR(m.turned_rad, 0.0, 1e-3);
+  }
 }
 
 TEST(MecanumKinematics, OpposedSidesTurnInPlaceAtROverLxPlusLy) {
-  World world({open_field()});
-  Vehicle& car = world.add_vehicle(mecanum_def());
   const double w = 8.0;
-  car.mecanum()->set_wheel_targets({-w, w, -w, w});
-  const Motion m = measure(world, car, 2.0);
+  const Motion m = mecanum_motion({-w, w, -w, w});
   const MecanumDef def;
   const double expected = def.wheel_radius_m * w / (def.half_wheelbase_m + def.half_track_m);
   EXPECT_NEAR(m.turned_rad / m.seconds, expected, kTolerance * expected);
@@ -96,11 +96,8 @@ TEST(MecanumKinematics, OpposedSidesTurnInPlaceAtROverLxPlusLy) {
 }
 
 TEST(MecanumKinematics, OneDiagonalPairMovesAtFortyFiveDegrees) {
-  World world({open_field()});
-  Vehicle& car = world.add_vehicle(mecanum_def());
   const double w = 8.0;
-  car.mecanum()->set_wheel_targets({0, w, w, 0});  // front-right and rear-left: forward-left
-  const Motion m = measure(world, car, 2.0);
+  const Motion m = mecanum_motion({0, w, w, 0});  // front-right and rear-left: forward-left
   const double r = MecanumDef{}.wheel_radius_m;
   EXPECT_NEAR(m.moved_body.x_m / m.seconds, r * w / 2, kTolerance * r * w / 2);
   EXPECT_NEAR(m.moved_body.y_m / m.seconds, r * w / 2, kTolerance * r * w / 2);
@@ -147,9 +144,7 @@ TEST(MecanumChassis, MotorRpmIsReportedInTheFirmwareOrderLrLfRfRr) {
 
 TEST(AckermannKinematics, SteadyTurnFollowsTheBicycleModelRadius) {
   World world({open_field()});
-  VehicleDef def = wr8_vehicle();
-  def.start = Pose{20, 20, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(wr8_vehicle(), Pose{20, 20, 0}));
   AckermannChassis& chassis = *car.ackermann();
   const double steer = 0.35;  // rad
   const double v = 0.6;       // m/s
@@ -178,9 +173,7 @@ TEST(AckermannChassis, SteeringIsClampedAndSlewsAtItsRate) {
 
 TEST(AckermannChassis, DrivesACommandedDistanceAndStopsOnIt) {
   World world({open_field()});
-  VehicleDef def = wr8_vehicle();
-  def.start = Pose{10, 20, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(wr8_vehicle(), Pose{10, 20, 0}));
   const Pose start = car.pose();
   car.ackermann()->drive_distance(1.0, 0.5);
   world.advance_by(seconds(1.0));
@@ -204,9 +197,7 @@ TEST(AckermannChassis, DrivesBackwardsForANegativeDistance) {
 
 TEST(DifferentialKinematics, UnequalSidesFollowTheDifferentialDriveFormulas) {
   World world({open_field()});
-  VehicleDef def = arduino_robot();
-  def.start = Pose{20, 20, 1.0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(arduino_robot(), Pose{20, 20, 1.0}));
   car.differential()->set_pwm(100, 160);
   const Motion m = measure(world, car, 2.0);
   const DifferentialDef d;
@@ -222,9 +213,7 @@ TEST(DifferentialKinematics, UnequalSidesFollowTheDifferentialDriveFormulas) {
 TEST(DifferentialChassis, ArduinoTimedMovesLandOnTheirTargetsAtBasePwm) {
   // The firmware drives M:50 for 50 * 18 ms and R:90 for 90 * 6 ms at PWM 140.
   World world({open_field()});
-  VehicleDef def = arduino_robot();
-  def.start = Pose{20, 20, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(arduino_robot(), Pose{20, 20, 0}));
   car.differential()->set_pwm(140, 140);
   world.advance_by(std::chrono::milliseconds(50 * 18));
   car.differential()->set_pwm(0, 0);
@@ -248,9 +237,7 @@ TEST(DifferentialChassis, PwmIsClampedToItsRange) {
 
 TEST(Collisions, AWallStopsTheChassisAndIsReportedOnce) {
   World world({open_field(4.0)});
-  VehicleDef def = logi_car();
-  def.start = Pose{2.0, 2.0, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{2.0, 2.0, 0}));
   car.mecanum()->set_target({0.5, 0, 0});
   world.advance_by(seconds(8.0));
   // Pressed against the east wall: at rest there, the wheels still turning.
@@ -269,9 +256,8 @@ TEST(Collisions, AWallStopsTheChassisAndIsReportedOnce) {
 
 TEST(Collisions, AnAngledWallDeflectsTheChassisAlongIt) {
   World world({open_field(4.0)});
-  VehicleDef def = logi_car();
-  def.start = Pose{2.0, 2.0, 0.5};  // heading 29 degrees toward the east wall
-  Vehicle& car = world.add_vehicle(def);
+  // Heading 29 degrees, toward the east wall.
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{2.0, 2.0, 0.5}));
   car.mecanum()->set_target({0.4, 0, 0});
   world.advance_by(seconds(5.0));
   const Pose p = car.pose();
@@ -284,9 +270,7 @@ TEST(Collisions, ObstacleContactsNameTheObstacleAndEnd) {
   Arena arena = open_field(4.0);
   arena.obstacles.push_back(CircleObstacle{"pillar", {3.0, 2.0}, 0.1});
   World world({arena});
-  VehicleDef def = logi_car();
-  def.start = Pose{2.0, 2.0, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{2.0, 2.0, 0}));
   car.mecanum()->set_target({0.3, 0, 0});
   world.advance_by(seconds(4.0));
   car.mecanum()->set_target({-0.3, 0, 0});

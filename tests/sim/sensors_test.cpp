@@ -13,12 +13,11 @@ namespace {
 
 using test::open_field;
 using test::seconds;
+using test::starting_at;
 
 TEST(Sonar, MeasuresTheDistanceFromItsMountToTheWallAhead) {
   World world({open_field(4.0)});
-  VehicleDef def = logi_car();
-  def.start = Pose{1.0, 2.0, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{1.0, 2.0, 0}));
   // Mount 0.14 m ahead of the centre; wall face at x = 4.
   const SonarReading r = car.sonar();
   EXPECT_TRUE(r.echo);
@@ -30,8 +29,7 @@ TEST(Sonar, TheConeSeesAPillarOffTheAxis) {
   Arena arena = open_field(6.0);
   arena.obstacles.push_back(CircleObstacle{"pillar", {2.0, 3.2}, 0.05});
   World world({arena});
-  VehicleDef def = logi_car();
-  def.start = Pose{1.0, 3.0, 0};
+  VehicleDef def = starting_at(logi_car(), Pose{1.0, 3.0, 0});
   Vehicle& car = world.add_vehicle(def);
   // 10 to 16 degrees off the axis: only the cone's edge ray finds it.
   const double d = car.sonar().distance_m;
@@ -192,9 +190,7 @@ TEST(Ir, AnalogRisesAndDigitalTripsAsAnObstacleNears) {
   Arena arena = open_field(4.0);
   arena.obstacles.push_back(BoxObstacle{"crate", {2.0, 2.15}, 0.1, 0.1, 0});
   World world({arena});
-  VehicleDef def = arduino_robot();
-  def.start = Pose{1.4, 2.0, 0};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(arduino_robot(), Pose{1.4, 2.0, 0}));
   const IrReading far = car.ir();
   EXPECT_EQ(far.left_analog, 0);
   EXPECT_FALSE(far.left_obstacle);
@@ -222,9 +218,7 @@ TEST(Odometry, WheelSlipMakesTheWheelsOverstateTheDistance) {
 
 TEST(Odometry, DeadReckoningMatchesTheTruthWithoutSlipOrContacts) {
   World world({open_field(10.0)});
-  VehicleDef def = logi_car();
-  def.start = Pose{5.0, 5.0, 0.4};
-  Vehicle& car = world.add_vehicle(def);
+  Vehicle& car = world.add_vehicle(starting_at(logi_car(), Pose{5.0, 5.0, 0.4}));
   car.mecanum()->set_target({0.3, 0.1, 0.6});
   world.advance_by(seconds(6.0));
   const Pose truth = car.pose();
@@ -237,8 +231,7 @@ TEST(Odometry, DeadReckoningMatchesTheTruthWithoutSlipOrContacts) {
 TEST(Battery, DrainsFasterUnderLoadAndSagsWithCurrent) {
   World idle_world({open_field(40.0)});
   World busy_world({open_field(40.0)});
-  VehicleDef def = logi_car();
-  def.start = Pose{5.0, 20.0, 0};
+  const VehicleDef def = starting_at(logi_car(), Pose{5.0, 20.0, 0});
   Vehicle& idle = idle_world.add_vehicle(def);
   Vehicle& busy = busy_world.add_vehicle(def);
   busy.mecanum()->set_target({0, 0, 3.0});  // spin in place: every wheel near full speed

@@ -16,6 +16,12 @@ inline Arena open_field(double size_m = 40.0) {
   return arena;
 }
 
+/// `def` starting at `start`.
+inline VehicleDef starting_at(VehicleDef def, Pose start) {
+  def.start = start;
+  return def;
+}
+
 inline Duration seconds(double s) {
   return Duration{static_cast<std::int64_t>(s * 1e9)};
 }

@@ -61,12 +61,7 @@ struct Arbitrary<hil::protocol::arduino::Body> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::arduino::Message> {
-  static Gen<hil::protocol::arduino::Message> arbitrary() {
-    namespace ard = hil::protocol::arduino;
-    return gen::build<ard::Message>(gen::set(&ard::Message::seq), gen::set(&ard::Message::body));
-  }
-};
+HIL_ARBITRARY_FIELDS(hil::protocol::arduino::Message, &hil::protocol::arduino::Message::seq,
+                     &hil::protocol::arduino::Message::body);
 
 }  // namespace rc

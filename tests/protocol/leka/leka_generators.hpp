@@ -11,6 +11,7 @@
 
 #include "protocol/leka/codec.hpp"
 #include "protocol/leka/message.hpp"
+#include "tests/protocol/arbitrary_support.hpp"
 
 namespace hil::test::leka {
 
@@ -25,13 +26,8 @@ rc::Gen<protocol::leka::Command> command_from(rc::Gen<Fields>... fields) {
 
 namespace rc {
 
-template <>
-struct Arbitrary<hil::protocol::leka::Rgb> {
-  static Gen<hil::protocol::leka::Rgb> arbitrary() {
-    using hil::protocol::leka::Rgb;
-    return gen::build<Rgb>(gen::set(&Rgb::red), gen::set(&Rgb::green), gen::set(&Rgb::blue));
-  }
-};
+HIL_ARBITRARY_FIELDS(hil::protocol::leka::Rgb, &hil::protocol::leka::Rgb::red,
+                     &hil::protocol::leka::Rgb::green, &hil::protocol::leka::Rgb::blue);
 
 template <>
 struct Arbitrary<hil::protocol::leka::Command> {

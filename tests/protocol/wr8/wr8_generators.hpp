@@ -40,14 +40,9 @@ struct Arbitrary<hil::protocol::wr8::Auth> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::wr8::AuthReply> {
-  static Gen<hil::protocol::wr8::AuthReply> arbitrary() {
-    using hil::protocol::wr8::AuthReply;
-    return gen::build<AuthReply>(gen::set(&AuthReply::device_code), gen::set(&AuthReply::device_id),
-                                 gen::set(&AuthReply::state));
-  }
-};
+HIL_ARBITRARY_FIELDS(hil::protocol::wr8::AuthReply, &hil::protocol::wr8::AuthReply::device_code,
+                     &hil::protocol::wr8::AuthReply::device_id,
+                     &hil::protocol::wr8::AuthReply::state);
 
 template <>
 struct Arbitrary<hil::protocol::wr8::Task> {
@@ -65,13 +60,8 @@ struct Arbitrary<hil::protocol::wr8::Task> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::wr8::Setting> {
-  static Gen<hil::protocol::wr8::Setting> arbitrary() {
-    using hil::protocol::wr8::Setting;
-    return gen::build<Setting>(gen::set(&Setting::code), gen::set(&Setting::value));
-  }
-};
+HIL_ARBITRARY_FIELDS(hil::protocol::wr8::Setting, &hil::protocol::wr8::Setting::code,
+                     &hil::protocol::wr8::Setting::value);
 
 template <>
 struct Arbitrary<hil::protocol::wr8::Settings> {
@@ -83,13 +73,8 @@ struct Arbitrary<hil::protocol::wr8::Settings> {
   }
 };
 
-template <>
-struct Arbitrary<hil::protocol::wr8::Response> {
-  static Gen<hil::protocol::wr8::Response> arbitrary() {
-    using hil::protocol::wr8::Response;
-    return gen::build<Response>(gen::set(&Response::coi), gen::set(&Response::code));
-  }
-};
+HIL_ARBITRARY_FIELDS(hil::protocol::wr8::Response, &hil::protocol::wr8::Response::coi,
+                     &hil::protocol::wr8::Response::code);
 
 template <>
 struct Arbitrary<hil::protocol::wr8::DataValue> {
