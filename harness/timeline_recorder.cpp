@@ -234,9 +234,7 @@ void WireRecorder::on_fault(const link::FaultEvent& event) {
                       {"rule", event.rule},
                       {"detail", event.detail}};
   if (event.frame != 0) data["frame_number"] = event.frame;
-  // The injector names each event's kind with link::to_string(FaultKind).
-  timeline_.add_at(event.at, link::parse_fault_kind(event.kind).value_or(link::FaultKind::drop),
-                   std::move(data));
+  timeline_.add_at(event.at, event.kind, std::move(data));
 }
 
 void WireRecorder::on_close(Time at, const link::LinkClose& close) {

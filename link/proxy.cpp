@@ -18,7 +18,7 @@ class TerminalObserver final : public LinkObserver {
   TerminalObserver(std::string id, std::function<void(const std::string&)> log)
       : id_(std::move(id)), log_(std::move(log)) {}
   void on_fault(const FaultEvent& e) override {
-    log_(id_ + " " + format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " +
+    log_(id_ + " " + format_ms(e.at) + " fault " + std::string(to_string(e.kind)) + " (" + e.rule + ", " +
          std::string(to_string(e.direction)) + "): " + e.detail);
   }
   void on_sent(Time /*at*/, Direction d, protocol::ByteView bytes) override {

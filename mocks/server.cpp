@@ -16,7 +16,7 @@ class FaultLogger final : public link::LinkObserver {
   FaultLogger(std::string id, std::function<void(const std::string&)> log)
       : id_(std::move(id)), log_(std::move(log)) {}
   void on_fault(const link::FaultEvent& e) override {
-    log_(id_ + " " + link::format_ms(e.at) + " fault " + e.kind + " (" + e.rule + ", " +
+    log_(id_ + " " + link::format_ms(e.at) + " fault " + std::string(link::to_string(e.kind)) + " (" + e.rule + ", " +
          std::string(link::to_string(e.direction)) + "): " + e.detail);
   }
 

@@ -186,7 +186,8 @@ void WireWatch::on_delivered(link::Time at, link::Direction d, protocol::ByteVie
 }
 
 void WireWatch::on_fault(const link::FaultEvent& event) {
-  faults_.push_back(Fault{event.at, event.direction, event.kind, event.rule, event.detail});
+  faults_.push_back(
+      Fault{event.at, event.direction, std::string(link::to_string(event.kind)), event.rule, event.detail});
   while (faults_.size() > kFaultsKept)
     faults_.pop_front();
 }

@@ -151,7 +151,7 @@ void PcapWriter::on_delivered(Time at, Direction d, protocol::ByteView bytes) {
 }
 
 void PcapWriter::on_fault(const FaultEvent& event) {
-  if (event.kind == "reset") reset_seen_ = true;
+  if (event.kind == FaultKind::reset) reset_seen_ = true;
 }
 
 void PcapWriter::on_close(Time at, const LinkClose& close) {

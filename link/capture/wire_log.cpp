@@ -150,7 +150,7 @@ void WireLog::on_bytes(const char* event, std::size_t kind_index, Time at, Direc
 void WireLog::on_fault(const FaultEvent& event) {
   auto r = record("fault", event.at);
   r["dir"] = std::string(to_string(event.direction));
-  r["kind"] = event.kind;
+  r["kind"] = to_string(event.kind);
   r["rule"] = event.rule;
   r["detail"] = event.detail;
   nlohmann::ordered_json before;

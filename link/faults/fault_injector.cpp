@@ -212,7 +212,7 @@ void FaultInjector::State::emit(Time at, std::size_t rule, std::uint64_t frame, 
   FaultEvent e;
   e.at = at;
   e.direction = direction_;
-  e.kind = std::string(to_string(rules_.rule(rule).kind()));
+  e.kind = rules_.rule(rule).kind();
   e.rule = rules_.name(rule);
   e.frame = frame;
   e.before = std::move(before);

@@ -26,7 +26,7 @@ namespace hil::link {
 struct FaultEvent {
   Time at{0};
   Direction direction = Direction::to_car;
-  std::string kind;         ///< "fragment", "drop", "corrupt", ... (the rule's kind)
+  FaultKind kind = FaultKind::drop;  ///< the kind of the rule that acted
   std::string rule;         ///< the rule's name in the profile (or its index)
   std::uint64_t frame = 0;  ///< the frame acted on (1-based in this direction); 0: none
   protocol::Bytes before;   ///< the bytes the rule acted on

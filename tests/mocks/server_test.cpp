@@ -256,7 +256,7 @@ TEST(MockServer, ARefusedConnectionIsAFaultTheObserversSee) {
   car.run_for(milliseconds(1));
   EXPECT_TRUE(client->closed.has_value());
   ASSERT_EQ(faults->seen.size(), 1u);
-  EXPECT_EQ(faults->seen[0].kind, "refuse");
+  EXPECT_EQ(faults->seen[0].kind, link::FaultKind::refuse);
   EXPECT_EQ(faults->seen[0].rule, "closed");
   EXPECT_EQ(car.server().turned_away(), 1u);
 }

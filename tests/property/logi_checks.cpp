@@ -896,7 +896,7 @@ bool exercised(Prop p, const Rig& rig) {
     case Prop::stream_gives_every_frame:
       return std::any_of(rig.faults.begin(), rig.faults.end(), [](const link::FaultEvent& f) {
         return f.direction == link::Direction::to_client &&
-               (f.kind == "fragment" || f.kind == "coalesce");
+               (f.kind == link::FaultKind::fragment || f.kind == link::FaultKind::coalesce);
       });
     case Prop::chassis_rests_after_stop:
       return rig.stop_claims > 0;

@@ -318,7 +318,7 @@ void Rig::check_rest(Time due, std::size_t op_index) {
   std::size_t stops_destroyed = 0;
   for (const auto& f : faults) {
     if (f.direction != link::Direction::to_car || f.at < t || f.at > t + kLastStopAttempt) continue;
-    if (f.kind != "drop" && f.kind != "corrupt") continue;
+    if (f.kind != link::FaultKind::drop && f.kind != link::FaultKind::corrupt) continue;
     if (text_of(f.before).find(in_auto ? "ST:STOP" : "STOP") != std::string::npos) {
       ++stops_destroyed;
     }

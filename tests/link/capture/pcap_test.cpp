@@ -184,7 +184,7 @@ TEST_F(PcapTest, ResetFaultEndsWithRstWhateverTheReason) {
   auto w = make();
   w->on_open(Time{0}, "client", "car");
   FaultEvent e;
-  e.kind = "reset";
+  e.kind = FaultKind::reset;
   w->on_fault(e);
   w->on_close(milliseconds(1), {LinkClose::By::hil, CloseMode::graceful, "closed by hil"});
   const auto rows = tshark(file.path(), "-T fields -e tcp.flags");

@@ -176,7 +176,7 @@ TEST_F(WireLogTest, FaultRecordShowsRuleAndBytesBeforeAndAfter) {
   FaultEvent e;
   e.at = Time{2'500'000};
   e.direction = Direction::to_client;
-  e.kind = "corrupt";
+  e.kind = FaultKind::corrupt;
   e.rule = "flip-checksum";
   e.before = to_bytes("LOGI:FB:SP:1:35#");
   e.after = protocol::Bytes{'L', 'O', 0x00};
@@ -198,7 +198,7 @@ TEST_F(WireLogTest, FaultRecordShowsRuleAndBytesBeforeAndAfter) {
 TEST_F(WireLogTest, DropFaultHasEmptyAfter) {
   auto log = make();
   FaultEvent e;
-  e.kind = "drop";
+  e.kind = FaultKind::drop;
   e.before = to_bytes("LOGI:SP:050:D7#");
   log->on_fault(e);
   const auto r = records();

@@ -118,7 +118,7 @@ TEST_F(LinkTest, FaultRulesChangeWhileTheLinkRuns) {
   ex.run_until_idle();
   EXPECT_EQ(at_car.data, "LOGI:MV:FWD:23#LOGI:MV:CW:DC#");
   ASSERT_EQ(recorder->faults.size(), 1u);
-  EXPECT_EQ(recorder->faults[0].kind, "drop");
+  EXPECT_EQ(recorder->faults[0].kind, link::FaultKind::drop);
   EXPECT_EQ(recorder->faults[0].at, seconds(1));
 }
 

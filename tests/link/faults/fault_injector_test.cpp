@@ -62,7 +62,7 @@ TEST(FaultInjector, DelayWithoutJitterDeliversExactlyThatLater) {
   EXPECT_EQ(run.deliveries()[0].at, Time{1100ms});
   EXPECT_EQ(run.delivered(), sp(50));
   ASSERT_EQ(run.events.size(), 1U);
-  EXPECT_EQ(run.events[0].kind, "delay");
+  EXPECT_EQ(run.events[0].kind, FaultKind::delay);
   EXPECT_EQ(run.events[0].at, Time{1s});
   EXPECT_EQ(run.events[0].frame, 1U);
 }
@@ -112,7 +112,7 @@ TEST(FaultInjector, FragmentPiecesStayInTheirSizeRangeAndGap) {
     EXPECT_EQ(d[i].at, Time{2ms} * static_cast<int>(i));
   }
   EXPECT_EQ(run.delivered(), frame);
-  ASSERT_EQ(run.events_of("fragment").size(), 1U);
+  ASSERT_EQ(run.events_of(FaultKind::fragment).size(), 1U);
 }
 
 TEST(FaultInjector, CoalesceByCountDeliversThreeFramesInOneWrite) {
@@ -217,7 +217,7 @@ TEST(FaultInjector, DropTheFirstFeedbackOfAKind) {
   const auto run = run_injector("logi", profile_of({rule(Drop{}, t)}), writes);
   EXPECT_EQ(run.delivered(), concat({stat(), fb_sp(), fb_st()}));
   ASSERT_EQ(run.events.size(), 1U);
-  EXPECT_EQ(run.events[0].kind, "drop");
+  EXPECT_EQ(run.events[0].kind, FaultKind::drop);
   EXPECT_EQ(run.events[0].frame, 2U);
   EXPECT_EQ(run.events[0].at, Time{10ms});
   EXPECT_EQ(run.events[0].before, fb_st());
@@ -302,8 +302,8 @@ TEST(FaultInjector, StallHoldsEverythingUntilItEnds) {
   EXPECT_EQ(d[1].at, Time{1500ms});
   EXPECT_EQ(d[2].at, Time{1500ms});
   EXPECT_EQ(d[3].at, Time{1600ms});
-  ASSERT_EQ(run.events_of("stall").size(), 1U);
-  EXPECT_EQ(run.events_of("stall")[0].at, Time{1s});
+  ASSERT_EQ(run.events_of(FaultKind::stall).size(), 1U);
+  EXPECT_EQ(run.events_of(FaultKind::stall)[0].at, Time{1s});
 }
 
 TEST(FaultInjector, StallChosenByAFrameHoldsThatFrameAndWhatIsQueued) {
@@ -328,7 +328,7 @@ TEST(FaultInjector, BandwidthPacesWritesByTheirSize) {
   EXPECT_EQ(d[0].at, Time{10ms});
   EXPECT_EQ(d[1].at, Time{20ms});
   EXPECT_EQ(d[2].at, Time{30ms});
-  EXPECT_EQ(run.events_of("bandwidth").size(), 3U);
+  EXPECT_EQ(run.events_of(FaultKind::bandwidth).size(), 3U);
 }
 
 TEST(FaultInjector, ResetAfterFiveFrames) {
@@ -341,8 +341,8 @@ TEST(FaultInjector, ResetAfterFiveFrames) {
   EXPECT_TRUE(run.link_break()->reset);
   EXPECT_TRUE(std::holds_alternative<LinkBreak>(run.outputs.back().what));
   EXPECT_EQ(run.outputs.back().at, Time{40ms});
-  ASSERT_EQ(run.events_of("reset").size(), 1U);
-  EXPECT_EQ(run.events_of("reset")[0].frame, 5U);
+  ASSERT_EQ(run.events_of(FaultKind::reset).size(), 1U);
+  EXPECT_EQ(run.events_of(FaultKind::reset)[0].frame, 5U);
 }
 
 TEST(FaultInjector, DisconnectAtATimeLosesWhatIsStillInFlight) {
@@ -356,7 +356,7 @@ TEST(FaultInjector, DisconnectAtATimeLosesWhatIsStillInFlight) {
   ASSERT_NE(run.link_break(), nullptr);
   EXPECT_FALSE(run.link_break()->reset);
   EXPECT_EQ(run.outputs.back().at, Time{2s});
-  const auto e = run.events_of("disconnect");
+  const auto e = run.events_of(FaultKind::disconnect);
   ASSERT_EQ(e.size(), 1U);
   EXPECT_EQ(e[0].at, Time{2s});
   EXPECT_EQ(e[0].before, sp(3))
@@ -373,7 +373,7 @@ TEST(FaultInjector, RefuseIsActiveForItsDurationAndRecordsEachRefusal) {
   EXPECT_TRUE(injector->refuse_connection(2999ms));
   EXPECT_FALSE(injector->refuse_connection(3s));
   ASSERT_EQ(events.size(), 2U);
-  EXPECT_EQ(events[0].kind, "refuse");
+  EXPECT_EQ(events[0].kind, FaultKind::refuse);
   EXPECT_EQ(injector->faults_injected(), 2U);
 }
 
@@ -516,7 +516,7 @@ TEST(FaultInjector, SvguiFragmentCutsTheMatchedPacketWithItsLengthByte) {
   for (std::size_t i = 1; i < d.size(); ++i)
     EXPECT_EQ(d[i].at, Time{10ms} + Time{1ms} * static_cast<int>(i - 1));
   EXPECT_EQ(run.delivered(), concat({program_reply(), high}));
-  const auto events = run.events_of("fragment");
+  const auto events = run.events_of(FaultKind::fragment);
   ASSERT_EQ(events.size(), 1U);
   EXPECT_EQ(events[0].before, high);
   EXPECT_EQ(events[0].frame, 2U);
@@ -637,7 +637,7 @@ TEST(FaultInjector, ReplacingTheRulesReleasesABatchBeingGatheredUnderTheOldOnes)
   auto after = drive(*injector, {{Duration(5ms), sp(7)}}, true);
   EXPECT_EQ(after.delivered(), concat({sp(0), sp(1), sp(7)}));
   ASSERT_EQ(events.size(), 1U);
-  EXPECT_EQ(events[0].kind, "coalesce");
+  EXPECT_EQ(events[0].kind, FaultKind::coalesce);
   EXPECT_NE(events[0].detail.find("2 frames in one write (fault rules replaced)"),
             std::string::npos)
       << events[0].detail;

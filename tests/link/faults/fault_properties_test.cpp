@@ -361,8 +361,9 @@ void assert_one_break_at_the_end(const Run& run) {
     RC_ASSERT(run.outputs[i].at >= run.outputs[i - 1].at);
 }
 
-bool changes_bytes(const std::string& kind) {
-  return kind == "drop" || kind == "corrupt" || kind == "duplicate" || kind == "garbage";
+bool changes_bytes(FaultKind kind) {
+  return kind == FaultKind::drop || kind == FaultKind::corrupt || kind == FaultKind::duplicate ||
+         kind == FaultKind::garbage;
 }
 
 RC_GTEST_PROP(FaultProperties, EventsAccountForEveryDeliveredByte, ()) {
@@ -385,7 +386,7 @@ RC_GTEST_PROP(FaultProperties, EventsAccountForEveryDeliveredByte, ()) {
       RC_ASSERT(e.frame >= 1 && e.frame <= frames_seen);
       RC_ASSERT(e.before == now[e.frame - 1]);
       now[e.frame - 1] = e.after;
-    } else if ((e.kind == "disconnect" || e.kind == "reset") && e.frame == 0) {
+    } else if ((e.kind == FaultKind::disconnect || e.kind == FaultKind::reset) && e.frame == 0) {
       lost_at_break = e.before;
     } else {
       RC_ASSERT(e.before == e.after);
@@ -409,8 +410,8 @@ RC_GTEST_PROP(FaultProperties, FarSideDecodesExactlyTheFramesTheEventsLeave, ())
   std::set<std::uint64_t> gone;
   std::map<std::uint64_t, std::size_t> copies;  // a second duplicate rule copies the copies
   for (const auto& e : run.events) {
-    if (e.kind == "drop" || e.kind == "corrupt") gone.insert(e.frame);
-    if (e.kind == "duplicate") {
+    if (e.kind == FaultKind::drop || e.kind == FaultKind::corrupt) gone.insert(e.frame);
+    if (e.kind == FaultKind::duplicate) {
       auto [it, fresh] = copies.try_emplace(e.frame, 1);
       it->second *= e.after.size() / e.before.size();
     }

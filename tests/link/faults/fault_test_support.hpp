@@ -54,7 +54,7 @@ struct Run {
     }
     return nullptr;
   }
-  std::vector<FaultEvent> events_of(std::string_view kind) const {
+  std::vector<FaultEvent> events_of(FaultKind kind) const {
     std::vector<FaultEvent> out;
     for (const auto& e : events) {
       if (e.kind == kind) out.push_back(e);
