@@ -24,10 +24,10 @@ const std::string* program_command(const ClientSetup& setup) {
   return nullptr;
 }
 
-std::unique_ptr<ReferenceSession> make_reference(const ClientSetup& setup) {
+std::unique_ptr<ScenarioClient> make_reference(const ClientSetup& setup) {
   const Scenario& scenario = setup.scenario;
   const auto* reference = std::get_if<ReferenceClient>(&scenario.client);
-  return make_reference_session(scenario.car, setup.context, setup.car, setup.timeline,
+  return make_reference_client(scenario.car, setup.context, setup.car, setup.timeline,
                                 reference ? reference->settings : nlohmann::json::object(),
                                 scenario.profile);
 }
@@ -68,7 +68,7 @@ Placeholders placeholders(const ClientSetup& setup) {
   return values;
 }
 
-std::unique_ptr<ReferenceSession> make_program(const ClientSetup& setup,
+std::unique_ptr<ScenarioClient> make_program(const ClientSetup& setup,
                                                const std::string& command) {
   ExecOptions o;
   o.environment = placeholders(setup);
@@ -80,7 +80,7 @@ std::unique_ptr<ReferenceSession> make_program(const ClientSetup& setup,
   if (const auto* exec = std::get_if<ExecClient>(&setup.scenario.client))
     o.startup_timeout = exec->startup_timeout;
   if (setup.options.on_client_command) setup.options.on_client_command(o.command);
-  return make_exec_session(setup.context, std::move(o), setup.timeline);
+  return make_exec_client(setup.context, std::move(o), setup.timeline);
 }
 
 }  // namespace

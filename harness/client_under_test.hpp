@@ -44,7 +44,7 @@ class ClientUnderTest {
   /// the command names a placeholder it cannot have.
   explicit ClientUnderTest(const ClientSetup& setup);
 
-  ReferenceSession& session() { return *session_; }
+  ScenarioClient& session() { return *session_; }
   /// An external program (else the reference client).
   bool external() const { return external_; }
 
@@ -57,7 +57,7 @@ class ClientUnderTest {
   link::Executor& executor_;
   RunTimeline& timeline_;
   bool external_ = false;
-  std::unique_ptr<ReferenceSession> session_;
+  std::unique_ptr<ScenarioClient> session_;
 };
 
 }  // namespace hil::harness

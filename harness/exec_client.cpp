@@ -128,7 +128,7 @@ std::string exit_text(const nlohmann::json& exit) {
   return "the client was ended by signal " + exit.value("signal", nlohmann::json(0)).dump();
 }
 
-class ExecSession final : public ReferenceSession {
+class ExecSession final : public ScenarioClient {
  public:
   ExecSession(link::TransportContext& context, ExecOptions options, RunTimeline& timeline)
       : executor_(context.executor),
@@ -515,7 +515,7 @@ ClientLine parse_client_line(std::string_view raw) {
   return line;
 }
 
-std::unique_ptr<ReferenceSession> make_exec_session(link::TransportContext& context,
+std::unique_ptr<ScenarioClient> make_exec_client(link::TransportContext& context,
                                                     ExecOptions options, RunTimeline& timeline) {
   if (context.io == nullptr)
     throw std::logic_error("an external client needs the real-time driver");

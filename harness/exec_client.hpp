@@ -53,7 +53,7 @@ struct ExecOptions {
 };
 
 /// Starts and talks to the program; `context` must be a real-time one.
-std::unique_ptr<ReferenceSession> make_exec_session(link::TransportContext& context,
+std::unique_ptr<ScenarioClient> make_exec_client(link::TransportContext& context,
                                                     ExecOptions options, RunTimeline& timeline);
 
 }  // namespace hil::harness

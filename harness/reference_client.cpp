@@ -60,7 +60,7 @@ void later(link::Executor& executor, std::shared_ptr<bool> alive, std::function<
 
 // What every car's reference session keeps: the executor, the timeline it
 // records to, and the flag that drops what is still due once it is gone.
-class RecordingSession : public ReferenceSession {
+class RecordingSession : public ScenarioClient {
  public:
   ~RecordingSession() override { *alive_ = false; }
 
@@ -386,8 +386,9 @@ class LekaReference final : public RecordingSession {
 
   void execute(const std::string& text, Done done) override {
     auto parsed = client::leka::parse_script(text, "scenario");
-    if (const auto* e = std::get_if<client::leka::ScriptError>(&parsed)) {
-      done_later(done, false, column_message(e->column, e->message));
+    if (!parsed.ok()) {
+      const auto& e = parsed.errors.front();
+      done_later(done, false, column_message(e.column, e.message));
       return;
     }
     if (!session_.is_open()) {
@@ -400,7 +401,7 @@ class LekaReference final : public RecordingSession {
     const std::uint64_t generation = ++generation_;
     auto failure = std::make_shared<std::string>();
     runner_.run(
-        std::get<client::leka::Script>(std::move(parsed)),
+        std::move(parsed),
         [failure](const client::leka::LineResult& r) {
           if (!r.ok) *failure = r.error;
         },
@@ -439,7 +440,7 @@ class LekaReference final : public RecordingSession {
 
 }  // namespace
 
-std::unique_ptr<ReferenceSession> make_reference_session(
+std::unique_ptr<ScenarioClient> make_reference_client(
     mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
     RunTimeline& timeline, const nlohmann::json& settings, std::string_view profile) {
   const protocol::CarProfile& named = protocol::find_car_profile(mocks::to_string(car), profile);
@@ -469,27 +470,6 @@ std::unique_ptr<ReferenceSession> make_reference_session(
     }
   }
   return nullptr;
-}
-
-std::optional<std::string> action_problem(mocks::CarKind car, std::string_view text) {
-  switch (car) {
-    case mocks::CarKind::logi:
-      return line_problem(client::logi::parse_operator_action(text));
-    case mocks::CarKind::wr8:
-      return line_problem(client::wr8::parse_operator_line(text));
-    case mocks::CarKind::arduino:
-      return line_problem(client::arduino::parse_operator_line(text));
-    case mocks::CarKind::leka: {
-      const auto parsed = client::leka::parse_operator_line(text);
-      if (const auto* e = std::get_if<client::leka::OperatorError>(&parsed))
-        return column_message(e->column, e->message);
-      if (std::get<client::leka::OperatorLine>(parsed).kind ==
-          client::leka::OperatorLine::Kind::empty)
-        return "no action";
-      return std::nullopt;
-    }
-  }
-  return "unknown car";
 }
 
 }  // namespace hil::harness

@@ -167,7 +167,7 @@ struct ReferenceClient {
   bool real_time = false;
   /// Options of the car's client library by name, as the scenario wrote
   /// them ({"auth": "WRONG-AUTH", "max_retries": "0"}, a list as an array);
-  /// reference_settings() in harness/reference_client.hpp lists them.
+  /// reference_settings() in harness/reference_settings.hpp lists them.
   nlohmann::json settings = nlohmann::json::object();
   friend bool operator==(const ReferenceClient&, const ReferenceClient&) = default;
 };

@@ -240,7 +240,7 @@ void StepSequencer::begin_obstacle(std::size_t index, const ObstacleStep& step) 
 // A client that takes actions side by side gets each at once (a scheduled
 // emergency stop beside the sequence's action); others one at a time.
 void StepSequencer::pump_actions() {
-  ReferenceSession& client = targets_.client;
+  ScenarioClient& client = targets_.client;
   while (!actions_.empty() && !closed_ && (actions_under_way_ == 0 || client.concurrent())) {
     const std::size_t index = actions_.front();
     actions_.pop_front();

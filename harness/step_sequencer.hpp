@@ -29,7 +29,7 @@ struct StepTargets {
   RunTimeline& timeline;
   mocks::MockCar& car;
   mocks::MockServer& server;
-  ReferenceSession& client;
+  ScenarioClient& client;
 };
 
 class StepSequencer {
