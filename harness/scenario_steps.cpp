@@ -51,12 +51,8 @@ std::optional<std::pair<int, std::string>> check_action(mocks::CarKind car,
     }
     case mocks::CarKind::leka: {
       const auto r = client::leka::parse_operator_line(text);
-      if (const auto* e = std::get_if<client::leka::OperatorError>(&r)) {
-        return std::pair{static_cast<int>(e->column), e->message};
-      }
-      if (std::get<client::leka::OperatorLine>(r).kind == client::leka::OperatorLine::Kind::empty) {
-        return std::pair{1, std::string("an empty action")};
-      }
+      if (r.error) return std::pair{static_cast<int>(r.error->column), r.error->message};
+      if (!r.action) return std::pair{1, std::string("an empty action")};
       return std::nullopt;
     }
   }

@@ -121,13 +121,16 @@ std::optional<leka::LogFormat> log_format_for(const std::string& path) {
   return client::log_format_for(path);
 }
 
-std::variant<leka::Script, leka::ScriptError> load_script(const AppOptions& options,
-                                                          std::istream& in) {
+leka::Script load_script(const AppOptions& options, std::istream& in) {
   if (options.script.empty()) return leka::parse_lines(options.groups, "arg");
   const auto text = read_script_text(options.script, in);
-  if (!text)
-    return leka::ScriptError{options.script, 0, 0,
-                             std::string("cannot read the script: ") + std::strerror(errno)};
+  if (!text) {
+    leka::Script unread;
+    unread.source = options.script;
+    unread.errors.push_back(
+        {options.script, 0, 0, std::string("cannot read the script: ") + std::strerror(errno)});
+    return unread;
+  }
   return leka::parse_script(*text, options.script == "-" ? "stdin" : options.script);
 }
 
@@ -259,15 +262,11 @@ class Run {
 }  // namespace
 
 int run(const AppOptions& options) {
-  auto loaded = load_script(options, std::cin);
-  if (auto* e = std::get_if<leka::ScriptError>(&loaded)) {
-    if (e->line == 0)
-      warn("leka-client: " + e->source + ": " + e->message);
-    else
-      warn(e->to_string());
-    return 2;
-  }
-  auto& script = std::get<leka::Script>(loaded);
+  auto script = load_script(options, std::cin);
+  // Every line that does not parse, then nothing is sent.
+  for (const auto& e : script.errors)
+    warn(e.line == 0 ? "leka-client: " + e.to_string() : e.to_string());
+  if (!script.ok()) return 2;
   if (options.dry_run) {
     std::cout << dry_run_text(script, config_for(options)) << std::flush;
     return 0;

@@ -5,7 +5,6 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "apps/common/program.hpp"
@@ -41,9 +40,10 @@ using apps::endpoint_for_port;
 /// The log format for a file name: .txt, .csv or .ndjson; nullopt otherwise.
 std::optional<client::leka::LogFormat> log_format_for(const std::string& path);
 
-/// The groups of the arguments, or the script (read from `in` for "-").
-std::variant<client::leka::Script, client::leka::ScriptError> load_script(const AppOptions& options,
-                                                                          std::istream& in);
+/// The groups of the arguments, or the script (read from `in` for "-"),
+/// with every line that does not parse; a script that cannot be read is
+/// one error at line 0.
+client::leka::Script load_script(const AppOptions& options, std::istream& in);
 
 /// The one line of output for a line's result, e.g.
 /// "demo.leka:3: ok, 2 frames, 22 bytes; info name=leka firmware=1.0.0 buffer=128 state=ok".

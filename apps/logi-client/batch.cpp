@@ -20,15 +20,12 @@ LoadedScript load_script_file(const std::string& path) {
   LoadedScript loaded;
   const auto text = read_script_text(path, std::cin);
   if (!text) {
-    loaded.error = path + ": cannot read the script";
+    loaded.errors.push_back({path, 0, 0, "cannot read the script"});
     return loaded;
   }
   auto script = logi::parse_operator_script(*text, path == "-" ? "<stdin>" : path);
-  if (!script.ok()) {
-    loaded.error = script.error->to_string();
-    return loaded;
-  }
-  loaded.steps = std::move(script.steps);
+  loaded.errors = std::move(script.errors);
+  if (loaded.ok()) loaded.steps = std::move(script.steps);
   return loaded;
 }
 
@@ -37,17 +34,15 @@ LoadedScript load_script_arguments(const std::vector<std::string>& actions) {
   for (std::size_t i = 0; i < actions.size(); ++i) {
     const int number = static_cast<int>(i) + 1;
     if (actions[i].find('\n') != std::string::npos) {
-      loaded.error = "<command line>:" + std::to_string(number) +
-                     ":1: one action per argument (this one has a line break)";
-      return loaded;
+      loaded.errors.push_back(
+          {"<command line>", i + 1, 1, "one action per argument (this one has a line break)"});
+      continue;
     }
     const auto parsed = logi::parse_operator_action(actions[i]);
     if (parsed.error) {
-      loaded.error =
-          logi::OperatorScriptError{"<command line>", number,
-                                    static_cast<int>(parsed.error->column), parsed.error->message}
-              .to_string();
-      return loaded;
+      loaded.errors.push_back(
+          {"<command line>", i + 1, parsed.error->column, parsed.error->message});
+      continue;
     }
     if (!parsed.action) continue;  // an empty or comment-only argument
     const std::string text(

@@ -36,11 +36,12 @@ inline constexpr int kExitActionFailed = kExitFailed;
 
 /// The actions of a script file ("-": standard input) or of command-line
 /// arguments (one action each; errors name them "<command line>:N:col").
-/// On error the message is "file:line:col: what was wrong".
+/// Every line that does not parse is an error, "file:line:col: what was
+/// wrong"; a script that cannot be read is one error at line 0.
 struct LoadedScript {
   std::vector<logi::OperatorStep> steps;
-  std::string error;
-  bool ok() const { return error.empty(); }
+  std::vector<client::ScriptError> errors;
+  bool ok() const { return errors.empty(); }
 };
 LoadedScript load_script_file(const std::string& path);
 LoadedScript load_script_arguments(const std::vector<std::string>& actions);

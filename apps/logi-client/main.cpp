@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
   const auto loaded =
       script.empty() ? lc::load_script_arguments(actions) : lc::load_script_file(script);
   if (!loaded.ok()) {
-    std::cerr << loaded.error << '\n';
+    for (const auto& e : loaded.errors)
+      std::cerr << e.to_string() << '\n';
     return lc::kExitUsage;
   }
   return lc::run_batch(options, loaded.steps, std::cout, std::cerr);

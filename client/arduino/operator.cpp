@@ -178,11 +178,6 @@ OperatorLine parse_typed_line(std::string_view line, const std::vector<Word>& wo
 }
 }  // namespace
 
-std::string ScriptError::to_string() const {
-  if (line == 0) return file + ": " + message;
-  return format_location(file, line, column, message);
-}
-
 std::vector<OperatorCommand> Script::commands() const {
   std::vector<OperatorCommand> out;
   out.reserve(steps.size());

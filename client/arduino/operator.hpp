@@ -80,18 +80,9 @@ struct ScriptStep {
   std::size_t line = 0;  ///< 1-based
 };
 
-struct ScriptError {
-  std::string file;
-  std::size_t line = 0;    ///< 1-based; 0 when the file could not be read
-  std::size_t column = 0;  ///< 1-based; 0 with line 0
-  std::string message;
-  /// "file:line:col: message" ("file: message" when the file could not be read).
-  std::string to_string() const;
-};
-
 struct Script {
   std::vector<ScriptStep> steps;
-  std::vector<ScriptError> errors;  ///< every line that did not parse, in order
+  std::vector<client::ScriptError> errors;  ///< every line that did not parse, in order
   bool ok() const { return errors.empty(); }
   std::vector<OperatorCommand> commands() const;
 };

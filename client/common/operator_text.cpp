@@ -182,4 +182,9 @@ std::string format_location(std::string_view file, std::size_t line, std::size_t
          std::string(message);
 }
 
+std::string ScriptError::to_string() const {
+  if (line == 0) return file + ": " + message;
+  return format_location(file, line, column, message);
+}
+
 }  // namespace hil::client

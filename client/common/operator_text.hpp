@@ -1,7 +1,7 @@
 #pragma once
 // The text handling every operator language shares: words with their
 // columns, letter case, whole numbers and durations, script lines, and the
-// "file:line:col: message" form of an error.
+// "file:line:col: message" form of a script's errors.
 
 #include <cstddef>
 #include <cstdint>
@@ -110,5 +110,17 @@ std::vector<std::string_view> split_lines(std::string_view text);
 /// "file:line:col: message".
 std::string format_location(std::string_view file, std::size_t line, std::size_t column,
                             std::string_view message);
+
+/// A script line that did not parse, or a script that could not be read.
+/// Every script parser lists one per wrong line, in order.
+struct ScriptError {
+  std::string file;        ///< the script's name as a person reads it
+  std::size_t line = 0;    ///< 1-based; 0 when the script could not be read
+  std::size_t column = 0;  ///< 1-based; 0 with line 0
+  std::string message;
+  /// "file:line:col: message" ("file: message" when the script could not be read).
+  std::string to_string() const;
+  friend bool operator==(const ScriptError&, const ScriptError&) = default;
+};
 
 }  // namespace hil::client

@@ -267,58 +267,62 @@ class CommandParser {
 };
 
 template <class Parse>
-std::variant<Script, ScriptError> parse_each(const std::vector<std::string_view>& texts,
-                                             const std::string& source, Parse parse) {
+Script parse_each(const std::vector<std::string_view>& texts, const std::string& source,
+                  Parse parse) {
   Script script;
   script.source = source;
   for (std::size_t i = 0; i < texts.size(); ++i) {
     auto parsed = parse(texts[i]);
-    if (auto* e = std::get_if<OperatorError>(&parsed))
-      return ScriptError{source, i + 1, e->column, e->message};
-    auto& line = std::get<OperatorLine>(parsed);
-    if (line.kind == OperatorLine::Kind::empty) continue;
+    if (parsed.error) {
+      script.errors.push_back({source, i + 1, parsed.error->column, parsed.error->message});
+      continue;
+    }
+    if (!parsed.action) continue;
     // The line as shown in results: without its comment or trailing blanks.
     std::string text(trim_end(texts[i].substr(0, texts[i].find('#')), " \t\r"));
-    script.lines.push_back({i + 1, std::move(text), std::move(line)});
+    script.lines.push_back({i + 1, std::move(text), std::move(*parsed.action)});
   }
   return script;
 }
 
+ParseResult<OperatorLine> error_at(std::size_t column, std::string message) {
+  return {.action = std::nullopt, .error = OperatorError{column, std::move(message)}};
+}
+
 }  // namespace
 
-std::variant<OperatorLine, OperatorError> parse_operator_line(std::string_view text,
-                                                              const proto::ValueLimits& limits) {
+ParseResult<OperatorLine> parse_operator_line(std::string_view text,
+                                              const proto::ValueLimits& limits) {
   auto commands = split_commands(text);
   OperatorLine line;
   const bool all_empty = std::all_of(commands.begin(), commands.end(),
                                      [](const CommandWords& c) { return c.words.empty(); });
-  if (all_empty && commands.size() == 1) return line;
+  if (all_empty && commands.size() == 1) return {};
   // wait stands alone.
   if (commands.size() == 1 && commands[0].words[0].text == "wait") {
     const auto& words = commands[0].words;
     if (words.size() < 2)
-      return OperatorError{commands[0].end_column, "wait: expected a duration such as 500ms or 1s"};
+      return error_at(commands[0].end_column, "wait: expected a duration such as 500ms or 1s");
     if (words.size() > 2)
-      return OperatorError{words[2].column, "wait: unexpected '" + words[2].text +
-                                                "'; it takes one duration such as 500ms or 1s"};
+      return error_at(words[2].column, "wait: unexpected '" + words[2].text +
+                                           "'; it takes one duration such as 500ms or 1s");
     const auto d = parse_wait(words[1].text);
     if (!d)
-      return OperatorError{words[1].column,
-                           "wait: expected a duration such as 500ms or 1s "
-                           "(at most 3600s), got '" +
-                               words[1].text + "'"};
+      return error_at(words[1].column,
+                      "wait: expected a duration such as 500ms or 1s "
+                      "(at most 3600s), got '" +
+                          words[1].text + "'");
     line.kind = OperatorLine::Kind::wait;
     line.wait = *d;
-    return line;
+    return {.action = std::move(line), .error = std::nullopt};
   }
   line.kind = OperatorLine::Kind::group;
   GroupBuilder builder(limits);
   for (std::size_t i = 0; i < commands.size(); ++i) {
     const auto& c = commands[i];
     if (c.words.empty()) {
-      return OperatorError{c.end_column, i + 1 == commands.size()
-                                             ? "expected a command after ';'"
-                                             : "expected a command before ';'"};
+      return error_at(c.end_column, i + 1 == commands.size() ? "expected a command after ';'"
+                                                             : "expected a command before ';'");
     }
     if (c.words[0].text == "info" && c.words.size() == 1) {
       if (!builder.group().commands.empty())
@@ -328,26 +332,21 @@ std::variant<OperatorLine, OperatorError> parse_operator_line(std::string_view t
       continue;
     }
     CommandParser parser(limits, builder);
-    if (auto error = parser.parse(c)) return *error;
+    if (auto error = parser.parse(c)) return {.action = std::nullopt, .error = std::move(*error)};
     ++line.commands;
   }
   if (!builder.group().commands.empty()) line.parts.emplace_back(std::move(builder));
-  return line;
+  return {.action = std::move(line), .error = std::nullopt};
 }
 
-std::string ScriptError::to_string() const {
-  return format_location(source, line, column, message);
-}
-
-std::variant<Script, ScriptError> parse_script(std::string_view text, const std::string& source,
-                                               const proto::ValueLimits& limits) {
+Script parse_script(std::string_view text, const std::string& source,
+                    const proto::ValueLimits& limits) {
   return parse_each(split_lines(text), source,
                     [&](std::string_view line) { return parse_operator_line(line, limits); });
 }
 
-std::variant<Script, ScriptError> parse_lines(const std::vector<std::string>& lines,
-                                              const std::string& source,
-                                              const proto::ValueLimits& limits) {
+Script parse_lines(const std::vector<std::string>& lines, const std::string& source,
+                   const proto::ValueLimits& limits) {
   std::vector<std::string_view> views(lines.begin(), lines.end());
   return parse_each(views, source,
                     [&](std::string_view line) { return parse_operator_line(line, limits); });

@@ -27,10 +27,10 @@ struct InfoPart {
 /// Consecutive non-info commands of a line, sent as one group.
 using LinePart = std::variant<GroupBuilder, InfoPart>;
 
-/// One parsed line: nothing (blank or comment), a group, or a wait.
+/// One line that does something: a group or a wait.
 struct OperatorLine {
-  enum class Kind : std::uint8_t { empty, group, wait };
-  Kind kind = Kind::empty;
+  enum class Kind : std::uint8_t { group, wait };
+  Kind kind = Kind::group;
   std::vector<LinePart> parts;  ///< kind == group: in the order written
   Duration wait{0};             ///< kind == wait
   std::size_t commands = 0;     ///< commands in the line, infos included
@@ -40,9 +40,10 @@ struct OperatorLine {
 /// "belt single: led must be 0..19, got 25".
 using OperatorError = client::LineError;
 
-/// Parses one line. Never throws on input.
-std::variant<OperatorLine, OperatorError> parse_operator_line(
-    std::string_view text, const proto::ValueLimits& limits = {});
+/// Parses one line: a line (`action`), nothing (blank or a `#` comment), or
+/// an error. Never throws on input.
+client::ParseResult<OperatorLine> parse_operator_line(std::string_view text,
+                                                      const proto::ValueLimits& limits = {});
 
 /// One line of a script, with where it came from.
 struct ScriptLine {
@@ -54,24 +55,16 @@ struct ScriptLine {
 struct Script {
   std::string source;             ///< file name, "-" for stdin, "arg" for command-line groups
   std::vector<ScriptLine> lines;  ///< blank and comment lines left out
+  std::vector<client::ScriptError> errors;  ///< every line that did not parse, in order
+  bool ok() const { return errors.empty(); }
 };
 
-struct ScriptError {
-  std::string source;
-  std::size_t line = 0;
-  std::size_t column = 0;
-  std::string message;
-  /// "file:line:col: message"
-  std::string to_string() const;
-};
-
-/// Parses a whole script; the first wrong line is the error.
-std::variant<Script, ScriptError> parse_script(std::string_view text, const std::string& source,
-                                               const proto::ValueLimits& limits = {});
+/// Parses a whole script; every wrong line is an error.
+Script parse_script(std::string_view text, const std::string& source,
+                    const proto::ValueLimits& limits = {});
 /// Each string is one line (command-line groups); line numbers count them.
-std::variant<Script, ScriptError> parse_lines(const std::vector<std::string>& lines,
-                                              const std::string& source,
-                                              const proto::ValueLimits& limits = {});
+Script parse_lines(const std::vector<std::string>& lines, const std::string& source,
+                   const proto::ValueLimits& limits = {});
 
 /// The frames a line sends, exactly as the core splits them under `config`.
 std::vector<Bytes> frames_of(const OperatorLine& line, const ClientConfig& config);

@@ -143,11 +143,6 @@ OperatorParseResult parse_operator_action(std::string_view line) {
   return r;
 }
 
-std::string OperatorScriptError::to_string() const {
-  return format_location(file, static_cast<std::size_t>(line), static_cast<std::size_t>(column),
-                         message);
-}
-
 OperatorScript parse_operator_script(std::string_view text, std::string_view file_name) {
   OperatorScript script;
   int line_number = 0;
@@ -155,10 +150,9 @@ OperatorScript parse_operator_script(std::string_view text, std::string_view fil
     ++line_number;
     auto parsed = parse_operator_action(line);
     if (parsed.error) {
-      script.error = OperatorScriptError{std::string(file_name), line_number,
-                                         static_cast<int>(parsed.error->column),
-                                         parsed.error->message};
-      return script;
+      script.errors.push_back({std::string(file_name), static_cast<std::size_t>(line_number),
+                               parsed.error->column, parsed.error->message});
+      continue;
     }
     if (parsed.action) {
       const std::string_view body = trim(line.substr(0, line.find('#')), kLineBlanks);

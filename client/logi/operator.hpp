@@ -94,22 +94,13 @@ struct OperatorStep {
   OperatorAction action;
 };
 
-struct OperatorScriptError {
-  std::string file;
-  int line = 0;
-  int column = 0;
-  std::string message;
-  /// "file:line:col: message".
-  std::string to_string() const;
-};
-
 struct OperatorScript {
   std::vector<OperatorStep> steps;
-  std::optional<OperatorScriptError> error;  ///< the first line that did not parse
-  bool ok() const { return !error.has_value(); }
+  std::vector<client::ScriptError> errors;  ///< every line that did not parse, in order
+  bool ok() const { return errors.empty(); }
 };
 
-/// Parses a whole script, one action per line; stops at the first error.
+/// Parses a whole script, one action per line; every bad line is an error.
 OperatorScript parse_operator_script(std::string_view text, std::string_view file_name);
 
 /// What became of one action.

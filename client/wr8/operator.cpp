@@ -192,10 +192,6 @@ std::string word_not_in_profile(std::string_view word, std::string_view profile,
   return "unknown action '" + std::string(word) + "'; expected " + std::string(vocabulary);
 }
 
-std::string ScriptError::to_string() const {
-  return format_location(file, static_cast<std::size_t>(line), column, message);
-}
-
 Script parse_operator_script(std::string_view text, std::string file,
                              const proto::Profile& profile) {
   return parse_script_lines<Script>(

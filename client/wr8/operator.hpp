@@ -75,18 +75,9 @@ struct ScriptStep {
   OperatorAction action;
 };
 
-struct ScriptError {
-  std::string file;
-  int line = 0;
-  std::size_t column = 1;
-  std::string message;
-  /// "file:line:col: message"
-  std::string to_string() const;
-};
-
 struct Script {
   std::vector<ScriptStep> steps;
-  std::vector<ScriptError> errors;  ///< every bad line, in order
+  std::vector<client::ScriptError> errors;  ///< every bad line, in order
 };
 
 /// A script's lines read by `parse_line` (the ParseResult of one line) into
@@ -100,7 +91,8 @@ ScriptOf parse_script_lines(std::string_view text, const std::string& file, Pars
     ++number;
     auto parsed = parse_line(line);
     if (parsed.error) {
-      script.errors.push_back({file, number, parsed.error->column, parsed.error->message});
+      script.errors.push_back(
+          {file, static_cast<std::size_t>(number), parsed.error->column, parsed.error->message});
     } else if (parsed.action) {
       script.steps.push_back({number, std::move(*parsed.action)});
     }

@@ -90,7 +90,7 @@ struct SvguiScriptStep {
 
 struct SvguiScript {
   std::vector<SvguiScriptStep> steps;
-  std::vector<ScriptError> errors;  ///< every bad line, in order
+  std::vector<client::ScriptError> errors;  ///< every bad line, in order
 };
 
 SvguiScript parse_svgui_script(std::string_view text, std::string file, svgui::Version version);

@@ -33,18 +33,29 @@ Time at_ms(int ms) {
 
 OperatorLine parse_ok(const std::string& text) {
   auto parsed = parse_operator_line(text);
-  if (auto* e = std::get_if<OperatorError>(&parsed)) {
-    ADD_FAILURE() << text << " -> col " << e->column << ": " << e->message;
+  if (parsed.error) {
+    ADD_FAILURE() << text << " -> col " << parsed.error->column << ": " << parsed.error->message;
     return {};
   }
-  return std::get<OperatorLine>(parsed);
+  if (!parsed.action) {
+    ADD_FAILURE() << text << " -> no action";
+    return {};
+  }
+  return *parsed.action;
 }
 
 OperatorError parse_error(const std::string& text) {
   auto parsed = parse_operator_line(text);
-  if (auto* e = std::get_if<OperatorError>(&parsed)) return *e;
+  if (parsed.error) return *parsed.error;
   ADD_FAILURE() << text << " parsed, an error was expected";
   return {};
+}
+
+// A blank line or a comment: neither an action nor an error.
+void expect_nothing(const std::string& text) {
+  const auto parsed = parse_operator_line(text);
+  EXPECT_TRUE(parsed.ok()) << text << ": " << parsed.error->message;
+  EXPECT_FALSE(parsed.action.has_value()) << text;
 }
 
 // Every command of the line, across its parts (infos included).
@@ -122,9 +133,9 @@ TEST(LekaOperatorLine, WaitsCommentsAndBlankLines) {
   EXPECT_EQ(parse_ok("wait 1s").wait, link::seconds(1));
   EXPECT_EQ(parse_ok("  wait 1.5s  # half a second more").wait, milliseconds(1500));
   EXPECT_EQ(parse_ok("wait 1s").kind, OperatorLine::Kind::wait);
-  EXPECT_EQ(parse_ok("").kind, OperatorLine::Kind::empty);
-  EXPECT_EQ(parse_ok("   \t ").kind, OperatorLine::Kind::empty);
-  EXPECT_EQ(parse_ok("# lights only").kind, OperatorLine::Kind::empty);
+  expect_nothing("");
+  expect_nothing("   \t ");
+  expect_nothing("# lights only");
   const auto line = parse_ok("ear all 1 2 3 # red-ish");
   EXPECT_EQ(line.commands, 1u);
 }
@@ -196,10 +207,12 @@ TEST(LekaOperatorLine, TheBeltLimitFollowsTheValueLimits) {
   proto::ValueLimits wide;
   wide.max_belt_led_id = 0x19;
   auto parsed = parse_operator_line("belt single 25 1 1 1", wide);
-  ASSERT_TRUE(std::holds_alternative<OperatorLine>(parsed));
+  ASSERT_TRUE(parsed.ok());
+  ASSERT_TRUE(parsed.action.has_value());
   parsed = parse_operator_line("belt single 26 1 1 1", wide);
-  ASSERT_TRUE(std::holds_alternative<OperatorError>(parsed));
-  EXPECT_EQ(std::get<OperatorError>(parsed).message, "belt single: led must be 0..25, got 26");
+  ASSERT_TRUE(parsed.error.has_value());
+  EXPECT_FALSE(parsed.action.has_value());
+  EXPECT_EQ(parsed.error->message, "belt single: led must be 0..25, got 26");
 }
 
 TEST(LekaOperatorScript, ErrorsAreFileLineColumnAndBlankLinesCount) {
@@ -210,16 +223,30 @@ TEST(LekaOperatorScript, ErrorsAreFileLineColumnAndBlankLinesCount) {
       "wait 500ms\n"
       "motor all 0 100; belt single 20 0 0 255\n"
       "info\n";
-  auto parsed = parse_script(text, "demo.leka");
-  ASSERT_TRUE(std::holds_alternative<ScriptError>(parsed));
-  EXPECT_EQ(std::get<ScriptError>(parsed).to_string(),
-            "demo.leka:5:30: belt single: led must be 0..19, got 20");
+  const auto parsed = parse_script(text, "demo.leka");
+  ASSERT_EQ(parsed.errors.size(), 1u);
+  EXPECT_EQ(parsed.errors[0].to_string(), "demo.leka:5:30: belt single: led must be 0..19, got 20");
+}
+
+TEST(LekaOperatorScript, EveryWrongLineIsAnErrorInOrder) {
+  const auto parsed = parse_script("ear all 256 0 0\ninfo\nblink\n\nwait 1\n", "show.leka");
+  EXPECT_FALSE(parsed.ok());
+  ASSERT_EQ(parsed.errors.size(), 3u);
+  EXPECT_EQ(parsed.errors[0].to_string(), "show.leka:1:9: ear all: red must be 0..255, got 256");
+  EXPECT_EQ(parsed.errors[1].line, 3u);
+  EXPECT_EQ(parsed.errors[1].column, 1u);
+  EXPECT_EQ(parsed.errors[1].to_string().rfind("show.leka:3:1: unknown command 'blink'", 0), 0u)
+      << parsed.errors[1].to_string();
+  EXPECT_EQ(parsed.errors[2].to_string().rfind("show.leka:5:6: wait: expected a duration", 0), 0u)
+      << parsed.errors[2].to_string();
+  ASSERT_EQ(parsed.lines.size(), 1u) << "the lines that parse are still read";
+  EXPECT_EQ(parsed.lines[0].number, 2u);
 }
 
 TEST(LekaOperatorScript, KeepsTheLinesThatDoSomethingWithTheirNumbers) {
-  auto parsed = parse_script("# demo\r\near all 255 0 0\r\n\nwait 1s\ninfo   # ask", "demo.leka");
-  ASSERT_TRUE(std::holds_alternative<Script>(parsed));
-  const auto& script = std::get<Script>(parsed);
+  const auto script =
+      parse_script("# demo\r\near all 255 0 0\r\n\nwait 1s\ninfo   # ask", "demo.leka");
+  ASSERT_TRUE(script.ok()) << script.errors.front().to_string();
   EXPECT_EQ(script.source, "demo.leka");
   ASSERT_EQ(script.lines.size(), 3u);
   EXPECT_EQ(script.lines[0].number, 2u);
@@ -227,9 +254,9 @@ TEST(LekaOperatorScript, KeepsTheLinesThatDoSomethingWithTheirNumbers) {
   EXPECT_EQ(script.lines[1].number, 4u);
   EXPECT_EQ(script.lines[2].number, 5u);
   EXPECT_EQ(script.lines[2].text, "info") << "shown without its comment";
-  auto args = parse_lines({"info", "motor all 2 0"}, "arg");
-  ASSERT_TRUE(std::holds_alternative<ScriptError>(args));
-  EXPECT_EQ(std::get<ScriptError>(args).to_string(),
+  const auto args = parse_lines({"info", "motor all 2 0"}, "arg");
+  ASSERT_EQ(args.errors.size(), 1u);
+  EXPECT_EQ(args.errors[0].to_string(),
             "arg:2:11: motor all: direction must be 0 (forward) or 1 (backward), got 2");
 }
 
@@ -287,8 +314,9 @@ struct LekaOperatorRunner : ::testing::Test, test::VirtualCar<mocks::LekaFirmwar
 
   Script script(const std::string& text) {
     auto parsed = parse_script(text, "test.leka");
-    if (auto* e = std::get_if<ScriptError>(&parsed)) ADD_FAILURE() << e->to_string();
-    return std::get<Script>(parsed);
+    for (const auto& e : parsed.errors)
+      ADD_FAILURE() << e.to_string();
+    return parsed;
   }
 
   void run(const std::string& text) {

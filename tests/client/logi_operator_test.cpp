@@ -152,10 +152,10 @@ TEST(OperatorParser, DurationsAreExactAndPrintTheirShortestForm) {
   }
 }
 
-TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsTheFirstErrorAsFileLineColumn) {
+TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsEveryErrorAsFileLineColumn) {
   const auto script = parse_operator_script(
       "# manual drive\n\nconnect\n  speed 50   # half\nmode MAN\r\n", "drive.txt");
-  ASSERT_TRUE(script.ok()) << script.error->to_string();
+  ASSERT_TRUE(script.ok()) << script.errors.front().to_string();
   ASSERT_EQ(script.steps.size(), 3u);
   EXPECT_EQ(script.steps[0].line, 3);
   EXPECT_EQ(script.steps[0].text, "connect");
@@ -166,10 +166,13 @@ TEST(OperatorParser, ScriptKeepsLineNumbersAndReportsTheFirstErrorAsFileLineColu
 
   const auto bad = parse_operator_script("connect\nspeed 50\npress  UP\nmode HALF\n", "drive.txt");
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.error->line, 3);
-  EXPECT_EQ(bad.error->column, 8u);
-  EXPECT_EQ(bad.error->to_string().rfind("drive.txt:3:8: expected a direction", 0), 0u)
-      << bad.error->to_string();
+  ASSERT_EQ(bad.errors.size(), 2u) << "both bad lines, in order";
+  EXPECT_EQ(bad.errors[0].line, 3u);
+  EXPECT_EQ(bad.errors[0].column, 8u);
+  EXPECT_EQ(bad.errors[0].to_string().rfind("drive.txt:3:8: expected a direction", 0), 0u)
+      << bad.errors[0].to_string();
+  EXPECT_EQ(bad.errors[1].to_string().rfind("drive.txt:4:6: expected MAN or AUTO", 0), 0u)
+      << bad.errors[1].to_string();
   EXPECT_TRUE(parse_operator_script("", "empty.txt").steps.empty());
 }
 
@@ -189,7 +192,7 @@ class RunnerBench : public test::SessionOnMem<LogiSession, mocks::LogiFirmware, 
   /// Starts `script`; run() then runs it to its end.
   void start(const std::string& script, OperatorRunnerOptions options = {}) {
     const auto parsed = parse_operator_script(script, "test");
-    ASSERT_TRUE(parsed.ok()) << parsed.error->to_string();
+    ASSERT_TRUE(parsed.ok()) << parsed.errors.front().to_string();
     runner_ = std::make_unique<OperatorRunner>(
         session(), executor(), parsed.steps, options,
         [this](const ActionResult& r) { results_.push_back(r); },

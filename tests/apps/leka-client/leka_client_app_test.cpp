@@ -5,7 +5,6 @@
 
 #include <sstream>
 #include <string>
-#include <variant>
 
 #include "apps/leka-client/app.hpp"
 #include "tests/apps/client_program_support.hpp"
@@ -17,8 +16,8 @@ namespace leka = client::leka;
 
 leka::Script script_of(const std::string& text) {
   auto parsed = leka::parse_script(text, "demo.leka");
-  EXPECT_TRUE(std::holds_alternative<leka::Script>(parsed));
-  return std::get<leka::Script>(parsed);
+  EXPECT_TRUE(parsed.ok()) << parsed.errors.front().to_string();
+  return parsed;
 }
 
 TEST(LekaClientApp, APathIsASerialDeviceAndAUriKeepsItsOwnBaud) {
@@ -77,17 +76,16 @@ TEST(LekaClientApp, ArgumentsOrAScriptFromStdin) {
   AppOptions options;
   options.groups = {"info", "stop robot"};
   std::istringstream none;
-  auto from_args = load_script(options, none);
-  ASSERT_TRUE(std::holds_alternative<leka::Script>(from_args));
-  EXPECT_EQ(std::get<leka::Script>(from_args).source, "arg");
-  EXPECT_EQ(std::get<leka::Script>(from_args).lines.size(), 2u);
+  const auto from_args = load_script(options, none);
+  ASSERT_TRUE(from_args.ok());
+  EXPECT_EQ(from_args.source, "arg");
+  EXPECT_EQ(from_args.lines.size(), 2u);
   options.groups.clear();
   options.script = "-";
   std::istringstream in("info\near single 2 0 0 0\n");
-  auto from_stdin = load_script(options, in);
-  ASSERT_TRUE(std::holds_alternative<leka::ScriptError>(from_stdin));
-  EXPECT_EQ(std::get<leka::ScriptError>(from_stdin).to_string(),
-            "stdin:2:12: ear single: led must be 0..1, got 2");
+  const auto from_stdin = load_script(options, in);
+  ASSERT_EQ(from_stdin.errors.size(), 1u);
+  EXPECT_EQ(from_stdin.errors[0].to_string(), "stdin:2:12: ear single: led must be 0..1, got 2");
 }
 
 TEST(LekaClientApp, FrameBytesSetsTheFrameSizeAndThePace) {

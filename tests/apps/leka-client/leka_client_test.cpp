@@ -98,8 +98,8 @@ TEST(LekaClientBatch, GroupsSetLedsAndMotorsAndTheInfoIsPrinted) {
   // What the robot received: the group whole, then the info.
   const auto received = delivered_to_car_of(mock.wire_log);
   EXPECT_TRUE(contains(delivered_bytes_of(mock.wire_log),
-                           "2A 2B 2C 2D 0F 11 FF 00 00 14 00 09 00 00 FF 22 01 C8 00 "
-                           "C8 40"))
+                       "2A 2B 2C 2D 0F 11 FF 00 00 14 00 09 00 00 FF 22 01 C8 00 "
+                       "C8 40"))
       << read_file(mock.wire_log);
   EXPECT_TRUE(any_contains(received, "motor.duo left=backward/200 right=forward/200"));
   EXPECT_TRUE(contains(delivered_bytes_of(mock.wire_log), "2A 2B 2C 2D 01 70 70"));
@@ -236,6 +236,18 @@ TEST(LekaClientBatch, ARangeErrorInAScriptIsExit2WithFileLineColumn) {
   EXPECT_NE(client.output().find(script + ":3:13: belt single: led must be 0..19, got 20"),
             std::string::npos)
       << client.output();
+}
+
+TEST(LekaClientBatch, EveryBadLineOfAScriptIsReportedInOrder) {
+  TempDir dir("hil-leka-client");
+  const std::string script = dir.file("bad.leka");
+  std::ofstream(script) << "ear all 255 0 0\nbelt single 20 0 0 255\ninfo\nmotor all 2 100\n";
+  HilProcess client(LEKA_CLIENT_BINARY, {"--port", dir.file("nothing-here"), "--script", script});
+  ASSERT_EQ(client.wait_exit(), 2) << client.output();
+  const std::string expected =
+      script + ":2:13: belt single: led must be 0..19, got 20\n" + script +
+      ":4:11: motor all: direction must be 0 (forward) or 1 (backward), got 2\n";
+  EXPECT_EQ(client.output(), expected);
 }
 
 TEST(LekaClientBatch, AMissingDeviceIsAClearErrorAndExit1) {

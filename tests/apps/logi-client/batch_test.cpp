@@ -85,6 +85,17 @@ TEST_F(LogiClientBatch, AScriptWithATypoExits2NamingFileLineAndColumn) {
   }
 }
 
+TEST_F(LogiClientBatch, EveryBadLineOfAScriptIsReportedInOrder) {
+  const auto out = expect_script_refused(
+      "typos.txt", "connect\nspead 50\nmode MAN\npress  FORWARD\n", ":2:1: unknown action 'spead'");
+  const std::string script = (dir / "typos.txt").string();
+  const auto first = out.find(script + ":2:1: unknown action 'spead'");
+  const auto second = out.find(script + ":4:8: expected a direction");
+  ASSERT_NE(second, std::string::npos) << out;
+  EXPECT_LT(first, second) << out;
+  EXPECT_EQ(out.find("ok   connect"), std::string::npos) << "nothing ran: " << out;
+}
+
 TEST_F(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
   HilProcess client(LOGI_CLIENT_BINARY,
                     {"--port", free_tcp_port(), "--connect-timeout", "2s", "connect", "speed 50"});
@@ -161,12 +172,15 @@ TEST(LogiClientBatchPieces, TelemetryIsPrintedOnlyWhenAFieldTheOperatorActsOnCha
 
 TEST(LogiClientBatchPieces, ArgumentsAreOneActionEachAndErrorsNameTheArgument) {
   const auto ok = apps::logi_client::load_script_arguments({"connect", "speed 50 # half", ""});
-  ASSERT_TRUE(ok.ok()) << ok.error;
+  ASSERT_TRUE(ok.ok()) << ok.errors.front().to_string();
   ASSERT_EQ(ok.steps.size(), 2u);
   EXPECT_EQ(ok.steps[1].line, 2);
   EXPECT_EQ(ok.steps[1].text, "speed 50");
-  const auto bad = apps::logi_client::load_script_arguments({"connect", "mode", "run"});
-  EXPECT_EQ(bad.error, "<command line>:2:5: expected MAN or AUTO after 'mode'");
+  const auto bad = apps::logi_client::load_script_arguments({"connect", "mode", "run", "spead"});
+  ASSERT_EQ(bad.errors.size(), 2u);
+  EXPECT_EQ(bad.errors[0].to_string(), "<command line>:2:5: expected MAN or AUTO after 'mode'");
+  EXPECT_EQ(bad.errors[1].to_string().rfind("<command line>:4:1: unknown action 'spead'", 0), 0u)
+      << bad.errors[1].to_string();
 }
 
 }  // namespace
