@@ -97,8 +97,9 @@ TEST_F(LogiClientBatch, EveryBadLineOfAScriptIsReportedInOrder) {
 }
 
 TEST_F(LogiClientBatch, WithNoCarListeningConnectFailsAfterItsBoundAndExits1) {
+  const ClosedPort closed;
   HilProcess client(LOGI_CLIENT_BINARY,
-                    {"--port", free_tcp_port(), "--connect-timeout", "2s", "connect", "speed 50"});
+                    {"--port", closed.port(), "--connect-timeout", "2s", "connect", "speed 50"});
   ASSERT_NO_FATAL_FAILURE(expect_exit_status(client, 1, 20s));
   const std::string& out = client.output();
   expect_contains(out, {"WARN not connected (lost or refused); reconnecting",

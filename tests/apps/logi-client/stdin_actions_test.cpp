@@ -218,7 +218,8 @@ TEST_F(LogiClientStdinActions, TheStaleWarningAndItsEndAreEventLines) {
 }
 
 TEST_F(LogiClientStdinActions, NoCarMeansAFailedConnectWithReconnectingEventsAndAStill0Exit) {
-  auto client = stdin_client(free_tcp_port(), {"--connect-timeout", "1500ms"});
+  const ClosedPort closed;
+  auto client = stdin_client(closed.port(), {"--connect-timeout", "1500ms"});
   ASSERT_TRUE(client.write_stdin("connect\n"));
   expect_lines(client,
                {"event connection reconnecting", "] FAIL connect: not connected after 1.5s"});

@@ -148,7 +148,8 @@ TEST_F(Wr8ClientCli, BadUsageExits2) {
 }
 
 TEST_F(Wr8ClientCli, NothingListeningFailsConnectAndExits1) {
-  port = free_tcp_port();
+  const ClosedPort closed;
+  port = closed.port();
   const auto r = client({"--connect-timeout", "5", "connect", "drive 10"});
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(std::regex_search(r.output, std::regex("connect +FAIL +connect failed"))) << r.output;
