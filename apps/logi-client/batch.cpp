@@ -124,7 +124,7 @@ std::optional<std::string> BatchReporter::event_line(logi::Time now, const logi:
     return at + " car  " + status_text(s->status);
   }
   if (const auto* s = std::get_if<logi::StaleEvent>(&event)) {
-    return at + (s->stale ? " WARN telemetry stale: no STAT for 2 s or more"
+    return at + (s->stale ? " WARN telemetry stale: no STAT for more than 2 s"
                           : " car  telemetry fresh again");
   }
   if (const auto* n = std::get_if<logi::NoticeEvent>(&event)) {

@@ -466,9 +466,10 @@ void TuiModel::on_event(Time now, const logi::Event& event) {
                                   message_.style == Style::alert;
             if (!estop_mv) say(payload(e.command) + " rejected by the car", Style::warning);
           }
-          if (e.command == proto::Message{proto::SetMode{Mode::manual}} &&
-              e.state == CommandState::sent)
-            mode_shown_ = Mode::manual;
+          // The MD just sent is the mode shown until the next STAT, whether
+          // the operator asked for it or the client did (FB:MV:0).
+          const auto* md = std::get_if<proto::SetMode>(&e.command);
+          if (md != nullptr && e.state == CommandState::sent) mode_shown_ = md->mode;
         } else if constexpr (std::is_same_v<E, logi::StaleEvent>) {
           stale_ = e.stale;
         } else if constexpr (std::is_same_v<E, logi::NoticeEvent>) {

@@ -77,6 +77,10 @@ void draw_panel(WINDOW* w, const Panel& panel, bool colors) {
 
 }  // namespace
 
+namespace {
+constexpr int kControlsWidth = 41;
+}  // namespace
+
 TuiLayout layout_screen(int rows, int columns, const Render& render) {
   TuiLayout l;
   int row = 0;
@@ -94,7 +98,11 @@ TuiLayout layout_screen(int rows, int columns, const Render& render) {
   // The log keeps at least 3 lines of its own when the screen allows.
   const int room = rows - row - bottom - 5;
   const int top_height = std::max(3, std::min(wanted, room));
-  const int status_width = std::clamp(columns * 19 / 40, 26, 40);
+  // The controls keep the 41 columns their longest line needs with its
+  // frame ("Speed   [##########] 100 % Enter sends"); the status takes the
+  // rest, 26 to 40: at 80 columns its 36 characters hold the longest
+  // STAT line ("RPM  LR -113 LF -113 RF -113 RR -113").
+  const int status_width = std::clamp(columns - kControlsWidth, 26, 40);
   l.status = {row, 0, top_height, status_width};
   l.controls = {row, status_width, top_height, columns - status_width};
   row += top_height;

@@ -62,6 +62,15 @@ Duration ArduinoClientCore::timeout_of(int attempt) const {
   return config_.base_timeout * (std::int64_t{1} << attempt);
 }
 
+bool ArduinoClientCore::answers(std::uint8_t request_seq, const proto::Message& reply) const {
+  return reply.seq == request_seq;
+}
+
+bool ArduinoClientCore::resend_on(const proto::Nack& nack) const {
+  const auto* code = std::get_if<proto::NackCode>(&nack.error);
+  return code != nullptr && *code == proto::NackCode::bad_cs;
+}
+
 Bytes ArduinoClientCore::frame_of(const Pending& pending, std::uint8_t seq) const {
   if (const auto* raw = std::get_if<proto::Envelope>(&pending.what)) {
     proto::Envelope e = *raw;
@@ -205,7 +214,7 @@ void ArduinoClientCore::on_bytes(Time now, ByteView bytes) {
 }
 
 void ArduinoClientCore::handle_message(Time now, const proto::Message& m) {
-  if (!inflight_ || m.seq != inflight_->seq || proto::is_request(m.body)) {
+  if (!inflight_ || proto::is_request(m.body) || !answers(inflight_->seq, m)) {
     ++stale_frames_;
     return;
   }
@@ -219,9 +228,7 @@ void ArduinoClientCore::handle_message(Time now, const proto::Message& m) {
     return;
   }
   const auto& nack = std::get<proto::Nack>(m.body);
-  const auto* code = std::get_if<proto::NackCode>(&nack.error);
-  if (code != nullptr && *code == proto::NackCode::bad_cs &&
-      inflight_->bad_cs_resends < config_.max_bad_cs_resends) {
+  if (resend_on(nack) && inflight_->bad_cs_resends < config_.max_bad_cs_resends) {
     ++inflight_->bad_cs_resends;
     send_current(now);
     return;

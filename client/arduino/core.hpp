@@ -112,6 +112,11 @@ using Event = std::variant<RequestDone, LinkChanged, FrameReceived>;
 class ArduinoClientCore {
  public:
   explicit ArduinoClientCore(ClientConfig config = {});
+  virtual ~ArduinoClientCore() = default;
+  ArduinoClientCore(const ArduinoClientCore&) = default;
+  ArduinoClientCore& operator=(const ArduinoClientCore&) = default;
+  ArduinoClientCore(ArduinoClientCore&&) = default;
+  ArduinoClientCore& operator=(ArduinoClientCore&&) = default;
 
   // ---- from the user ----
   /// Asks for the port to be opened (OpenPort); OPEN once on_connected().
@@ -159,6 +164,17 @@ class ArduinoClientCore {
   std::uint64_t parse_errors() const { return parse_errors_; }
   const ClientConfig& config() const { return config_; }
 
+ protected:
+  // The protocol's rules, each decided here alone (docs/clients/arduino.md).
+  // A test overrides one to plant a known bug (tests/property/arduino_planted_bug.hpp).
+
+  /// The timeout rule: attempt `attempt` (0: the first) waits base_timeout x 2^attempt.
+  virtual Duration timeout_of(int attempt) const;
+  /// The matching rule: only a reply carrying `request_seq` answers the request sent with it.
+  virtual bool answers(std::uint8_t request_seq, const protocol::arduino::Message& reply) const;
+  /// The resend rule: a NACK saying the line damaged the request (BAD_CS) resends it at once.
+  virtual bool resend_on(const protocol::arduino::Nack& nack) const;
+
  private:
   enum class Purpose : std::uint8_t { user, health_check, reconnect_check };
   /// A typed request, or a raw token hil does not type, framed as given.
@@ -179,7 +195,6 @@ class ArduinoClientCore {
   };
 
   static Result lost_result(const Inflight& lost, ResultCode code, const std::string& detail);
-  Duration timeout_of(int attempt) const;
   Bytes frame_of(const Pending& pending, std::uint8_t seq) const;
   /// Queues the operator's request `id`, or completes it link_down at once
   /// while the link is closed or down.

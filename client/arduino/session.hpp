@@ -27,6 +27,11 @@ class ArduinoSession {
   /// `context` must outlive the session. Nothing happens until open().
   ArduinoSession(link::TransportContext& context, link::Endpoint endpoint,
                  ClientConfig config = {});
+  /// The same on `core`, which may be of a class derived from
+  /// ArduinoClientCore (a test's, with a rule broken on purpose); null throws
+  /// std::invalid_argument.
+  ArduinoSession(link::TransportContext& context, link::Endpoint endpoint,
+                 std::unique_ptr<ArduinoClientCore> core);
   ArduinoSession(const ArduinoSession&) = delete;
   ArduinoSession& operator=(const ArduinoSession&) = delete;
 
@@ -61,8 +66,8 @@ class ArduinoSession {
   RequestId ir(Callback done = {}) { return request(protocol::arduino::IrRead{}, std::move(done)); }
   RequestId help(Callback done = {}) { return request(protocol::arduino::Help{}, std::move(done)); }
 
-  ConnectionState state() const { return core_.state(); }
-  const ArduinoClientCore& core() const { return core_; }
+  ConnectionState state() const { return core_->state(); }
+  const ArduinoClientCore& core() const { return *core_; }
   CommLog& log() { return *log_; }
   std::shared_ptr<CommLog> shared_log() const { return log_; }
 
@@ -72,7 +77,7 @@ class ArduinoSession {
   void perform(Action& action);
   void dispatch(Event& event);
 
-  ArduinoClientCore core_;
+  std::unique_ptr<ArduinoClientCore> core_;
   std::shared_ptr<CommLog> log_ = std::make_shared<CommLog>();
   RequestCallbacks<RequestId, Result> callbacks_;
   EventHandler on_event_;

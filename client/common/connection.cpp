@@ -80,9 +80,9 @@ bool ConnectionLifecycle::unwant() {
   return active();
 }
 
-std::optional<ConnectionEvent> ConnectionLifecycle::retry_later(link::Time now) {
+std::optional<ConnectionEvent> ConnectionLifecycle::retry_at(link::Time at) {
   if (!wanted_) return set(ConnectionState::disconnected);
-  reconnect_.schedule(now);
+  reconnect_.schedule_at(at);
   return set(ConnectionState::reconnecting, reconnect_.attempt());
 }
 

@@ -119,9 +119,10 @@ class ConnectionLifecycle {
   /// count is back to 0; true when a connection was active (close it).
   bool unwant();
   /// A connection failed or ended: when wanted, the next attempt is
-  /// scheduled its backoff delay after `now` and the state is reconnecting;
-  /// else disconnected.
-  std::optional<ConnectionEvent> retry_later(link::Time now);
+  /// scheduled at `at` (its backoff delay after the failure:
+  /// reconnect().next_delay()) and the state is reconnecting; else
+  /// disconnected.
+  std::optional<ConnectionEvent> retry_at(link::Time at);
   /// The number of the attempt due at `now`, if one is (it is then no
   /// longer scheduled): the caller opens the connection.
   std::optional<int> take_due_attempt(link::Time now);

@@ -39,6 +39,12 @@ class ConnectionCore {
   std::vector<Action> take_actions() { return std::exchange(actions_, {}); }
   std::vector<Event> take_events() { return std::exchange(events_, {}); }
 
+  virtual ~ConnectionCore() = default;
+  ConnectionCore(const ConnectionCore&) = default;
+  ConnectionCore(ConnectionCore&&) = default;
+  ConnectionCore& operator=(const ConnectionCore&) = default;
+  ConnectionCore& operator=(ConnectionCore&&) = default;
+
   ConnectionState state() const { return connection_.state(); }
   const std::shared_ptr<CommLog>& log() const { return log_; }
 
@@ -79,10 +85,18 @@ class ConnectionCore {
   void close_unwanted() {
     if (connection_.unwant()) actions_.push_back(CloseConnection{});
   }
-  /// A failed or lost connection: retried after its backoff delay while
-  /// wanted (reconnecting), else disconnected.
+  /// The backoff rule: the reconnect attempt due `delay` after a failure
+  /// or loss at `now` goes out `delay` later. The one place every family's
+  /// client applies it; the property tests override it to plant a client
+  /// that does not wait (tests/property/*planted_bug.hpp).
+  virtual link::Time reconnect_time(link::Time now, link::Duration delay) const {
+    return now + delay;
+  }
+  /// A failed or lost connection: retried at reconnect_time() while wanted
+  /// (reconnecting), else disconnected.
   void retry_later(link::Time now) {
-    if (const auto changed = connection_.retry_later(now)) emit(*changed);
+    const link::Time at = reconnect_time(now, connection_.reconnect().next_delay());
+    if (const auto changed = connection_.retry_at(at)) emit(*changed);
   }
   /// Opens the connection again when a scheduled attempt is due: true then.
   bool reconnect_if_due(link::Time now) {

@@ -130,8 +130,12 @@ std::vector<Bytes> split_frames(const proto::CommandGroup& group, std::size_t ma
 std::optional<InfoReply> parse_info_line(std::string_view line) {
   while (!line.empty() && (line.back() == '\r' || line.back() == '\n'))
     line.remove_suffix(1);
-  if (!line.starts_with("LEKA")) return std::nullopt;
-  line.remove_prefix(4);
+  // Noise on the serial line before the reply (a glitch, a boot message
+  // cut short) ends up at the start of the same line: the reply begins at
+  // the last "LEKA ", as the frame receivers resynchronise on their header.
+  const auto start = line.rfind("LEKA ");
+  if (start == std::string_view::npos) return std::nullopt;
+  line.remove_prefix(start + 4);
   InfoReply reply;
   while (!line.empty()) {
     if (line.front() == ' ') {

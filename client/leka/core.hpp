@@ -110,7 +110,8 @@ struct InfoReply {
   std::string state;
   friend bool operator==(const InfoReply&, const InfoReply&) = default;
 };
-/// nullopt unless the line starts with "LEKA" and holds key=value fields.
+/// nullopt unless the line holds "LEKA " and key=value fields after it;
+/// whatever comes before the last "LEKA " is noise and is skipped.
 std::optional<InfoReply> parse_info_line(std::string_view line);
 
 using RequestId = std::uint64_t;

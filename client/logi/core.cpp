@@ -203,6 +203,15 @@ SubmitResult LogiClientCore::emergency_stop(Time now) {
     }
   }
   queue_ = std::move(kept);
+  // A newer emergency stop takes over the resending of an older one's ST:STOP.
+  for (auto it = flight_.begin(); it != flight_.end();) {
+    if (!it->until_answered) {
+      ++it;
+      continue;
+    }
+    emit(CommandEvent{it->id, it->command, CommandState::cancelled, it->attempt, false});
+    it = flight_.erase(it);
+  }
   note(now, "emergency stop");
   // Written at once, beside whatever is in flight: a stop must not wait up
   // to a feedback timeout (and its retries) behind an unanswered command.
@@ -213,6 +222,7 @@ SubmitResult LogiClientCore::emergency_stop(Time now) {
       p.switch_mode_on_reject = false;
       if (id == 0) id = p.id;
     }
+    p.until_answered = resend_until_answered(p.command);
     send(now, std::move(p));
   }
   return {id, Refusal::none};
@@ -222,6 +232,16 @@ std::vector<proto::Message> LogiClientCore::emergency_stop_commands() const {
   std::vector<proto::Message> commands{proto::Move{proto::Direction::stop}};
   if (mode_ != proto::Mode::manual) commands.emplace_back(proto::SetRun{false});
   return commands;
+}
+
+bool LogiClientCore::resend_until_answered(const proto::Message& m) const {
+  const auto* st = std::get_if<proto::SetRun>(&m);
+  return st != nullptr && !st->run;
+}
+
+bool LogiClientCore::stop_after_timeout(const proto::Message& m) const {
+  const auto* mv = std::get_if<proto::Move>(&m);
+  return mv != nullptr && mv->direction != proto::Direction::stop;
 }
 
 SubmitResult LogiClientCore::confirm_resend(Time now, RequestId request) {
@@ -303,6 +323,12 @@ void LogiClientCore::on_feedback(Time now, const proto::Feedback& fb) {
 }
 
 void LogiClientCore::on_timeout(Time now, Pending p) {
+  if (p.until_answered) {
+    // ST:STOP is idempotent: repeating it until the car answers is safe.
+    note(now, "no feedback for emergency stop request " + std::to_string(p.id) + ", resending");
+    send(now, std::move(p));
+    return;
+  }
   if (retryable(p.command) && p.attempt <= config_.max_retries) {
     note(now, "no feedback for request " + std::to_string(p.id) + ", resending");
     send(now, std::move(p));
@@ -312,6 +338,13 @@ void LogiClientCore::on_timeout(Time now, Pending p) {
   note(now, "no feedback for request " + std::to_string(p.id) + ": uncertain" +
                 (confirm ? ", resent only when the operator confirms" : ""));
   emit(CommandEvent{p.id, p.command, CommandState::uncertain, p.attempt, confirm});
+  if (stop_after_timeout(p.command)) {
+    // The car may have taken the move and be driving: stop it, ahead of
+    // anything queued. A refusal of this stop asks for no switch to MAN.
+    note(now, "fail-safe after the uncertain move: MV:STOP");
+    enqueue(now, proto::Move{proto::Direction::stop}, /*front=*/true,
+            /*switch_mode_on_reject=*/false);
+  }
   if (confirm) {
     p.attempt = 0;
     awaiting_confirm_.push_back(std::move(p));
@@ -340,15 +373,17 @@ void LogiClientCore::on_frame(Time now, const protocol::Frame<proto::Message>& f
   connection_.reconnect().succeeded();
   log_->add(LogEntry{now, LogKind::rx, std::string(frame.raw.begin(), frame.raw.end()),
                      proto::describe(frame.message)});
-  if (const auto* status = std::get_if<proto::Status>(&frame.message)) {
-    status_ = *status;
-    mode_ = status->mode;
+  if (refreshes_status(frame.message)) {
     last_stat_ = now;
     if (stale_) {
       stale_ = false;
       note(now, "status fresh again");
       emit(StaleEvent{false});
     }
+  }
+  if (const auto* status = std::get_if<proto::Status>(&frame.message)) {
+    status_ = *status;
+    mode_ = status->mode;
     emit(StatusEvent{*status});
   } else if (const auto* fb = std::get_if<proto::Feedback>(&frame.message)) {
     on_feedback(now, *fb);
@@ -371,7 +406,7 @@ void LogiClientCore::on_timer(Time now) {
     on_timeout(now, std::move(p));
   }
   if (state() == ConnectionState::connected && !stale_ && last_stat_ &&
-      now >= *last_stat_ + stale_after()) {
+      now >= stale_at(*last_stat_)) {
     stale_ = true;
     note(now, "stale: no STAT for " + link::format_ms(now - *last_stat_));
     emit(StaleEvent{true});
@@ -393,7 +428,7 @@ std::optional<Time> LogiClientCore::next_wakeup() const {
   for (const auto& p : flight_)
     next.consider(p.deadline);
   if (state() == ConnectionState::connected && !stale_ && last_stat_) {
-    next.consider(*last_stat_ + stale_after());
+    next.consider(stale_at(*last_stat_));
   }
   if (held_) next.consider(keepalive_at_);
   return next.time();

@@ -124,6 +124,9 @@ struct SubmitResult {
 
 class LogiClientCore : public ConnectionCore<Action, Event> {
  public:
+  /// The client's time resolution: the smallest step between two instants.
+  static constexpr Duration kTick{1};
+
   explicit LogiClientCore(ClientConfig config = {},
                           std::shared_ptr<CommLog> log = std::make_shared<CommLog>());
   virtual ~LogiClientCore() = default;
@@ -145,7 +148,8 @@ class LogiClientCore : public ConnectionCore<Action, Event> {
   /// The held direction's button came up: MV:STOP.
   SubmitResult release(Time now);
   /// MV:STOP, then ST:STOP unless the car is known to be in MAN, written at
-  /// once ahead of the queue; queued movement is cancelled.
+  /// once ahead of the queue; queued movement is cancelled. The ST:STOP is
+  /// resent every feedback timeout until the car answers it.
   SubmitResult emergency_stop(Time now);
   /// Resends an uncertain ST:RUN or GS (same request id).
   SubmitResult confirm_resend(Time now, RequestId request);
@@ -179,15 +183,33 @@ class LogiClientCore : public ConnectionCore<Action, Event> {
   /// Whether a command without feedback is sent again by itself: SP, MD
   /// and MV:STOP (max_retries times), never ST:RUN.
   virtual bool retryable(const proto::Message& m) const;
-  /// When the reconnect attempt due `delay` after a loss at `now` goes out.
-  virtual Time reconnect_time(Time now, Duration delay) const { return now + delay; }
+  // When a reconnect attempt goes out: reconnect_time(), ConnectionCore's.
   /// How long without a STAT raises the stale warning: stale_after.
   virtual Duration stale_after() const { return config_.stale_after; }
+  /// When the stale warning rises after the STAT (or connect) at
+  /// `last_stat`: the documentation asks for "more than" stale_after, so
+  /// the first instant after it, one tick (1 ns, the client's time
+  /// resolution) on. Exactly stale_after later it is not raised yet.
+  virtual Time stale_at(Time last_stat) const { return last_stat + stale_after() + kTick; }
+  /// Whether a frame from the car counts as fresh telemetry (it restarts the
+  /// stale clock and clears the warning): a STAT only, never an FB.
+  virtual bool refreshes_status(const proto::Message& m) const {
+    return std::holds_alternative<proto::Status>(m);
+  }
   /// Whether release() writes MV:STOP: always.
   virtual bool stop_on_release() const { return true; }
   /// What an emergency stop writes, in this order: MV:STOP, then ST:STOP
   /// unless the car is known to be in MAN.
   virtual std::vector<proto::Message> emergency_stop_commands() const;
+  /// Whether an emergency stop's `m` is written again every feedback
+  /// timeout until the car answers it, the link goes or a newer emergency
+  /// stop replaces it: ST:STOP. Stopping a stopped car changes nothing, so a
+  /// repeat is safe, and in AUTO it is the only stop the car obeys.
+  virtual bool resend_until_answered(const proto::Message& m) const;
+  /// Whether a command that got no feedback is followed by MV:STOP, written
+  /// ahead of the queue: every MV other than STOP (the documentation's
+  /// fail-safe for movement commands; the move itself is not resent).
+  virtual bool stop_after_timeout(const proto::Message& m) const;
   /// Decodes one read's bytes into `items`, after what the earlier reads of
   /// the connection left (a frame may span reads).
   virtual void decode(protocol::ByteView bytes, std::vector<proto::Item>& items);
@@ -200,6 +222,7 @@ class LogiClientCore : public ConnectionCore<Action, Event> {
     int attempt = 0;                // sends so far
     bool mode_switch_done = false;  // FB:MV:0 has already led to MD:MAN once
     bool switch_mode_on_reject = true;
+    bool until_answered = false;  // an emergency stop's ST:STOP: resent without limit
     Time deadline{0};
   };
 

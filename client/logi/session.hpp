@@ -18,6 +18,11 @@ class LogiSession
               EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>())
       : ConnectingSession(context, std::move(endpoint), std::move(sink),
                           LogiClientCore(std::move(config), std::move(log))) {}
+  /// The same on `core`, which may be of a class derived from LogiClientCore
+  /// (a test's, with a rule broken on purpose); must not be null.
+  LogiSession(link::TransportContext& context, std::unique_ptr<LogiClientCore> core,
+              link::Endpoint endpoint, EventSink sink = {})
+      : ConnectingSession(context, std::move(endpoint), std::move(sink), std::move(core)) {}
 
   SubmitResult submit(const proto::Message& command) {
     return feed([&](Time t) { return mutable_core().submit(t, command); });

@@ -96,6 +96,7 @@ void Wr8ClientCore::on_connected(Time now) {
   decoder_ = proto::Decoder(decoder_options(config_.profile));
   await_login(now, config_.auth_timeout);
   send(now, proto::Auth{config_.profile.auth_text});
+  if (!login_awaits_reply()) logged_in(proto::AuthReply{});
 }
 
 void Wr8ClientCore::on_closed(Time now) {
@@ -128,12 +129,7 @@ void Wr8ClientCore::on_bytes(Time now, protocol::ByteView bytes) {
 
 void Wr8ClientCore::handle(Time now, const proto::Message& message) {
   if (const auto* reply = std::get_if<proto::AuthReply>(&message)) {
-    if (state() == ConnectionState::authenticating) {
-      login_done();
-      last_data_.reset();
-      change_state(ConnectionState::connected);
-      emit(LoginEvent{*reply});
-    }
+    if (state() == ConnectionState::authenticating) logged_in(*reply);
     return;
   }
   if (state() != ConnectionState::connected) {
@@ -175,8 +171,16 @@ void Wr8ClientCore::handle(Time now, const proto::Message& message) {
   }
 }
 
+void Wr8ClientCore::logged_in(const proto::AuthReply& reply) {
+  login_done();
+  last_data_.reset();
+  change_state(ConnectionState::connected);
+  emit(LoginEvent{reply});
+}
+
 void Wr8ClientCore::on_response(Time now, const proto::Response& r) {
-  auto& p = pending_[r.coi];
+  const std::uint8_t coi = answered_coi(r);
+  auto& p = pending_[coi];
   if (!p) {
     ignored(now, r);
     return;
@@ -191,13 +195,13 @@ void Wr8ClientCore::on_response(Time now, const proto::Response& r) {
       p->deadline = now + (p->kind == RequestKind::task
                                ? config_.completion_timeout[static_cast<std::size_t>(p->task)]
                                : config_.answer_timeout);
-      emit(RequestEvent{r.coi, p->kind, p->task, RequestState::started});
+      emit(RequestEvent{coi, p->kind, p->task, RequestState::started});
       break;
     case proto::ResponseCode::completed:
-      finish(r.coi, RequestState::completed);
+      finish(coi, RequestState::completed);
       break;
     case proto::ResponseCode::error:
-      finish(r.coi, RequestState::error);
+      finish(coi, RequestState::error);
       break;
   }
 }
@@ -262,7 +266,7 @@ SubmitResult Wr8ClientCore::send_request(Time now, RequestKind kind, proto::Task
   log_->add(tx_entry(now, m, bytes, config_.profile));
   actions_.push_back(SendBytes{std::move(bytes)});
   next_coi_ = static_cast<std::uint8_t>(*coi + 1);
-  pending_[*coi] = Pending{kind, task, false, now + config_.answer_timeout};
+  pending_[*coi] = Pending{kind, task, false, now + config_.answer_timeout, requests_sent_++};
   emit(RequestEvent{*coi, kind, task, RequestState::sent});
   return {*coi, Refusal::none};
 }
@@ -291,6 +295,15 @@ SubmitResult Wr8ClientCore::set_settings(Time now, std::vector<proto::Setting> s
 std::size_t Wr8ClientCore::open_requests() const {
   return static_cast<std::size_t>(
       std::count_if(pending_.begin(), pending_.end(), [](const auto& p) { return p.has_value(); }));
+}
+
+std::optional<std::uint8_t> Wr8ClientCore::newest_open_coi() const {
+  std::optional<std::uint8_t> newest;
+  for (std::size_t coi = 0; coi < pending_.size(); ++coi) {
+    if (pending_[coi] && (!newest || pending_[coi]->order > pending_[*newest]->order))
+      newest = static_cast<std::uint8_t>(coi);
+  }
+  return newest;
 }
 
 void Wr8ClientCore::on_timer(Time now) {

@@ -270,18 +270,36 @@ class Wr8ClientCore : public LoginCore<Event> {
   std::size_t open_requests() const;
   const ClientConfig& config() const { return config_; }
 
+ protected:
+  // ---- the document dialect's rules, one function each (docs/clients/wr8.md) ----
+  // The property tests (tests/property/) override them to show that a
+  // client that breaks one is caught; the client itself never does. The
+  // reconnect rule, reconnect_time(), is ConnectionCore's.
+
+  /// Whether the login waits for the vehicle's AUTH-REPLY before the client
+  /// counts itself logged in and sends requests: always ("Login").
+  virtual bool login_awaits_reply() const { return true; }
+  /// Which open request the RESPONSE `r` answers: the one whose COI it
+  /// carries ("Requests and COI").
+  virtual std::uint8_t answered_coi(const proto::Response& r) const { return r.coi; }
+
+  /// The COI of the request sent last of those still open, if any.
+  std::optional<std::uint8_t> newest_open_coi() const;
+
  private:
   struct Pending {
     RequestKind kind = RequestKind::task;
     proto::TaskCode task = proto::TaskCode::check;
     bool started = false;
     Time deadline{0};
+    std::uint64_t order = 0;  // requests sent before it on this core
   };
 
   SubmitResult send_request(Time now, RequestKind kind, proto::TaskCode task,
                             const proto::Message& message);
   void send(Time now, const proto::Message& message);
   void handle(Time now, const proto::Message& message);
+  void logged_in(const proto::AuthReply& reply);
   void on_response(Time now, const proto::Response& r);
   void finish(std::uint8_t coi, RequestState state);
   void ignored(Time now, const proto::Message& message);
@@ -295,6 +313,7 @@ class Wr8ClientCore : public LoginCore<Event> {
   std::vector<proto::Item> items_;
 
   std::uint8_t next_coi_ = 0;
+  std::uint64_t requests_sent_ = 0;
   std::array<std::optional<Pending>, 256> pending_{};
 
   std::optional<LiveState> live_;

@@ -20,6 +20,11 @@ class Wr8Session
              EventSink sink = {}, std::shared_ptr<CommLog> log = std::make_shared<CommLog>())
       : ConnectingSession(context, std::move(endpoint), std::move(sink),
                           Wr8ClientCore(std::move(config), std::move(log))) {}
+  /// The same on `core`, which may be of a class derived from Wr8ClientCore
+  /// (a test's, with a rule broken on purpose); must not be null.
+  Wr8Session(link::TransportContext& context, std::unique_ptr<Wr8ClientCore> core,
+             link::Endpoint endpoint, EventSink sink = {})
+      : ConnectingSession(context, std::move(endpoint), std::move(sink), std::move(core)) {}
 
   SubmitResult task(proto::TaskCode code, std::vector<proto::Word> params = {}) {
     return feed([&](Time t) { return mutable_core().task(t, code, std::move(params)); });

@@ -209,6 +209,16 @@ TEST(LekaInfo, TheLineIsParsedIntoFields) {
   EXPECT_FALSE(parse_info_line("LEKA name").has_value());
 }
 
+TEST(LekaInfo, NoiseBeforeTheReplyOnItsLineIsSkipped) {
+  // Garbage bytes that reached the line before the robot's reply.
+  auto reply = parse_info_line("\x9d\x01zLEKA~LEKA name=leka firmware=1.0.0 buffer=128 state=ok");
+  ASSERT_TRUE(reply.has_value());
+  EXPECT_EQ(reply->name, "leka");
+  EXPECT_EQ(reply->buffer_bytes, 128);
+  EXPECT_EQ(reply->fields.size(), 4u);
+  EXPECT_FALSE(parse_info_line("\x9d\x01LEKAname=x").has_value());
+}
+
 TEST(LekaInfo, AReplyInTimeEndsTheRequest) {
   LekaClientCore core;
   core.on_connected(at_ms(0));

@@ -350,14 +350,61 @@ TEST(LogiClientCore, TimedOutRunAndGsAreResentOnlyWhenTheOperatorConfirms) {
   EXPECT_EQ(h.sent.size(), 3u);
 }
 
-TEST(LogiClientCore, AMoveOtherThanStopIsNotRetried) {
+TEST(LogiClientCore, AMoveOtherThanStopIsNotRetriedButFollowedByMvStopAtItsTimeout) {
   Harness h;
   h.ready();
-  h.press(Direction::fwd);
-  h.run_until(seconds(5));
+  const auto mv = h.press(Direction::fwd);
+  h.submit(proto::SetSpeed{30});  // queued behind the move
+  h.run_until(ms(799));
   EXPECT_EQ(h.frames(), (std::vector<std::string>{"LOGI:MV:FWD:23#"}));
-  ASSERT_EQ(h.commands(CommandState::uncertain).size(), 1u);
-  EXPECT_FALSE(h.commands(CommandState::uncertain)[0].resend_on_confirm);
+  h.run_until(ms(800));
+  // The move is uncertain and not resent; MV:STOP goes out at once, ahead
+  // of the queued SP, since the car may have taken the move.
+  ASSERT_EQ(h.sent.size(), 2u);
+  EXPECT_EQ(h.sent[1], (std::pair<Time, std::string>{ms(800), "LOGI:MV:STOP:88#"}));
+  const auto unc = h.commands(CommandState::uncertain);
+  ASSERT_EQ(unc.size(), 1u);
+  EXPECT_EQ(unc[0].request, mv.request);
+  EXPECT_FALSE(unc[0].resend_on_confirm);
+  const auto sent = h.commands(CommandState::sent);
+  ASSERT_EQ(sent.size(), 2u);
+  EXPECT_NE(sent[1].request, mv.request) << "the stop is a request of its own";
+  EXPECT_EQ(h.core.held(), Direction::fwd) << "the operator still holds the button";
+  h.now = ms(850);
+  h.reply("FB:MV:1");
+  EXPECT_EQ(h.sent.back(), (std::pair<Time, std::string>{ms(850), "LOGI:SP:030:D5#"}));
+  h.reply("FB:SP:1");
+  h.run_until(seconds(5));
+  EXPECT_EQ(h.sent.size(), 3u) << "nothing more: the move is never written again";
+}
+
+TEST(LogiClientCore, TheFailSafeStopIsRetriedLikeAnyMvStopAndARefusalSwitchesNoMode) {
+  Harness h;
+  h.ready();
+  h.press(Direction::cw);
+  h.run_until(ms(2400));
+  EXPECT_EQ(h.frames(), (std::vector<std::string>{"LOGI:MV:CW:DC#", "LOGI:MV:STOP:88#",
+                                                  "LOGI:MV:STOP:88#", "LOGI:MV:STOP:88#"}));
+  EXPECT_EQ(h.sent[3].first, ms(2400));
+  h.reply("FB:MV:0");
+  EXPECT_TRUE(h.of<NoticeEvent>().empty()) << "no switch to MAN for a stop";
+  ASSERT_EQ(h.commands(CommandState::rejected).size(), 1u);
+  EXPECT_EQ(h.commands(CommandState::rejected)[0].attempt, 3);
+  EXPECT_EQ(h.sent.size(), 4u);
+}
+
+TEST(LogiClientCore, TimedOutStopsRunsAndSettingsAreNotFollowedByMvStop) {
+  Harness h;
+  h.ready(Mode::automatic);
+  h.submit(proto::SetStation{1});
+  h.run_until(ms(800));
+  h.submit(proto::SetRun{true});
+  h.run_until(ms(1600));
+  h.submit(proto::SetRun{false});
+  h.run_until(ms(2400));
+  EXPECT_EQ(h.frames(),
+            (std::vector<std::string>{"LOGI:GS:001:CA#", "LOGI:ST:RUN:3B#", "LOGI:ST:STOP:8C#"}));
+  EXPECT_EQ(h.commands(CommandState::uncertain).size(), 3u);
 }
 
 // ---- safety guard ----
@@ -376,20 +423,57 @@ TEST(LogiClientCore, ReleasingAHeldDirectionSendsStop) {
   EXPECT_EQ(h.core.release(h.now).refusal, Refusal::not_held);
 }
 
-TEST(LogiClientCore, NoStatFor2sRaisesStaleAndAFreshStatClearsIt) {
+TEST(LogiClientCore, StaleRisesOnlyMoreThan2sAfterTheLastStatAndAFreshStatClearsIt) {
   Harness h;
   h.connected();
   h.now = ms(1000);
   h.feed(stat_frame());
-  h.run_until(ms(2999));
-  EXPECT_FALSE(h.core.stale());
+  EXPECT_EQ(h.core.next_wakeup(), ms(3000) + LogiClientCore::kTick);
   h.run_until(ms(3000));
+  EXPECT_FALSE(h.core.stale()) << "exactly 2 s without a STAT is not more than 2 s";
+  h.core.on_timer(ms(3000));  // a timer firing exactly at 2 s raises nothing either
+  h.drain();
+  EXPECT_FALSE(h.core.stale());
+  h.run_until(ms(3000) + LogiClientCore::kTick);
   EXPECT_TRUE(h.core.stale());
   h.run_until(ms(3500));
   h.feed(stat_frame());
   EXPECT_FALSE(h.core.stale());
   EXPECT_EQ(test::stale_flags(h.of<StaleEvent>()),
-            (std::vector<std::pair<Time, bool>>{{ms(3000), true}, {ms(3500), false}}));
+            (std::vector<std::pair<Time, bool>>{{ms(3000) + LogiClientCore::kTick, true},
+                                                {ms(3500), false}}));
+}
+
+TEST(LogiClientCore, StaleCountsFromTheConnectWhenNoStatCame) {
+  Harness h;
+  h.now = ms(250);
+  h.connected();
+  h.run_until(ms(2250));
+  EXPECT_FALSE(h.core.stale());
+  h.run_until(ms(2250) + LogiClientCore::kTick);
+  EXPECT_TRUE(h.core.stale());
+}
+
+TEST(LogiClientCore, OnlyAStatClearsTheStaleWarningNotFeedback) {
+  Harness h;
+  h.ready();
+  h.run_until(ms(2000) + LogiClientCore::kTick);
+  ASSERT_TRUE(h.core.stale());
+  h.now = ms(2100);
+  h.submit(proto::SetSpeed{40});
+  h.reply("FB:SP:1");  // a valid frame, but not telemetry
+  EXPECT_TRUE(h.core.stale());
+  h.run_until(ms(4200));
+  EXPECT_TRUE(h.core.stale()) << "an FB neither clears the warning nor restarts its clock";
+  EXPECT_EQ(h.of<StaleEvent>().size(), 1u);
+  h.now = ms(4300);
+  h.feed(stat_frame());
+  EXPECT_FALSE(h.core.stale());
+  // The clock restarts at that STAT: stale again only after 6300 ms.
+  h.run_until(ms(6300));
+  EXPECT_FALSE(h.core.stale());
+  h.run_until(ms(6300) + LogiClientCore::kTick);
+  EXPECT_TRUE(h.core.stale());
 }
 
 TEST(LogiClientCore, EmergencyStopInAutoWritesStopsAheadOfTheQueue) {
@@ -416,6 +500,63 @@ TEST(LogiClientCore, EmergencyStopInAutoWritesStopsAheadOfTheQueue) {
   h.reply("FB:ST:1");
   ASSERT_EQ(h.sent.size(), 4u);
   EXPECT_EQ(h.sent[3].second, "LOGI:SP:080:DA#");
+}
+
+TEST(LogiClientCore, EmergencyStStopIsResentEvery800msUntilTheCarAnswers) {
+  Harness h;
+  h.ready(Mode::automatic);
+  h.now = ms(100);
+  const auto stop = h.emergency_stop();
+  h.now = ms(105);
+  h.reply("FB:MV:0");  // AUTO refuses MV:STOP; the ST:STOP stays unanswered
+  h.run_until(ms(4100));
+  std::vector<std::pair<Time, std::string>> st;
+  for (const auto& [t, frame] : h.sent) {
+    if (frame == "LOGI:ST:STOP:8C#") st.emplace_back(t, frame);
+  }
+  ASSERT_EQ(st.size(), 6u) << "sent at 100 ms and every 800 ms after, no limit";
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    EXPECT_EQ(st[i].first, ms(100) + ms(800) * static_cast<int>(i));
+  }
+  EXPECT_TRUE(h.commands(CommandState::uncertain).empty()) << "an emergency stop is never given up";
+  h.now = ms(4200);
+  h.reply("FB:ST:1");
+  const auto accepted = h.commands(CommandState::accepted);
+  ASSERT_EQ(accepted.size(), 1u);
+  EXPECT_EQ(accepted[0].request, stop.request + 1) << "the ST:STOP's own request";
+  EXPECT_EQ(accepted[0].attempt, 6);
+  h.run_until(seconds(10));
+  EXPECT_EQ(h.sent.size(), 7u) << "answered: no more resends";
+}
+
+TEST(LogiClientCore, EmergencyStStopResendsEndWithARefusalTheLinkOrANewerEmergencyStop) {
+  Harness h;
+  h.ready(Mode::automatic);
+  h.emergency_stop();
+  h.run_until(ms(800));
+  ASSERT_EQ(h.sent.size(), 4u) << "MV:STOP and ST:STOP, then both again at 800 ms";
+  // A second emergency stop takes over: the first one's ST:STOP is cancelled.
+  h.now = ms(1000);
+  h.emergency_stop();
+  auto cancelled = h.commands(CommandState::cancelled);
+  ASSERT_EQ(cancelled.size(), 1u);
+  EXPECT_EQ(cancelled[0].command, proto::Message{proto::SetRun{false}});
+  h.reply("FB:MV:0");
+  h.reply("FB:MV:0");
+  h.reply("FB:ST:0");  // the car refuses the stop: answered, so no more resends
+  ASSERT_EQ(h.commands(CommandState::rejected).size(), 3u);
+  EXPECT_EQ(h.commands(CommandState::rejected)[2].command, proto::Message{proto::SetRun{false}});
+  const std::size_t sent = h.sent.size();
+  h.run_until(seconds(10));
+  EXPECT_EQ(h.sent.size(), sent);
+
+  Harness lost;
+  lost.ready(Mode::automatic);
+  lost.emergency_stop();
+  lost.run_until(ms(1600));
+  lost.closed();
+  EXPECT_EQ(lost.commands(CommandState::cancelled).size(), 2u) << "MV:STOP and ST:STOP";
+  EXPECT_EQ(lost.core.in_flight(), 0u);
 }
 
 TEST(LogiClientCore, EmergencyStopInManSendsOnlyMvStopAndReleasesTheHeldDirection) {

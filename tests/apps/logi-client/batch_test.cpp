@@ -168,7 +168,7 @@ TEST(LogiClientBatchPieces, TelemetryIsPrintedOnlyWhenAFieldTheOperatorActsOnCha
   ASSERT_TRUE(running);
   EXPECT_NE(running->find("RUN 1  STA 002"), std::string::npos) << *running;
   EXPECT_EQ(*reporter.event_line(std::chrono::seconds(3), client::logi::StaleEvent{true}),
-            "[  3.000 s] WARN telemetry stale: no STAT for 2 s or more");
+            "[  3.000 s] WARN telemetry stale: no STAT for more than 2 s");
 }
 
 TEST(LogiClientBatchPieces, ArgumentsAreOneActionEachAndErrorsNameTheArgument) {

@@ -339,6 +339,20 @@ TEST_F(TuiModelTest, TheModeKeyTogglesManAndAuto) {
   model.on_key(ms(30), 'm');
 }
 
+TEST_F(TuiModelTest, TheModeShownIsTheLastMdSentWhoeverSentIt) {
+  connected();
+  const auto sent = [&](Time at, std::uint64_t request, Mode mode) {
+    model.on_event(at,
+                   logi::CommandEvent{request, proto::SetMode{mode}, CommandState::sent, 1, false});
+  };
+  // The client's own MD:MAN (after a refused move), then the operator's
+  // MD:AUTO queued behind it: AUTO is what the car will be in.
+  sent(ms(0), 1, Mode::manual);
+  EXPECT_NE(screen().find("Mode    MAN"), std::string::npos) << screen();
+  sent(ms(10), 2, Mode::automatic);
+  EXPECT_NE(screen().find("Mode    AUTO"), std::string::npos) << screen();
+}
+
 TEST_F(TuiModelTest, StationRunAndStopKeysSendTheirCommands) {
   connected();
   {
