@@ -135,6 +135,7 @@ logi::Status LogiFirmware::status() const {
 void LogiFirmware::on_connect(Time now) {
   decoder_ = logi::Decoder(
       logi::DecoderOptions{logi::kDefaultMaxFrameBytes, config_.accept_lowercase_checksum});
+  if (config_.grid_from_first_connection && !grid_start_) grid_start_ = now;
   next_stat_ = grid_after(now, config_.stat_period);
 }
 
@@ -373,10 +374,11 @@ bool LogiFirmware::active() const {
 
 Time LogiFirmware::grid_after(Time now, Duration period) const {
   // Floor division: before the offset, the first grid point is the offset.
-  const Duration since = now - config_.boot_offset;
+  const Time start = grid_start_.value_or(Time(0)) + config_.boot_offset;
+  const Duration since = now - start;
   auto ticks = since / period;
   if (since < Duration::zero() && since % period != Duration::zero()) --ticks;
-  return config_.boot_offset + (ticks + 1) * period;
+  return start + (ticks + 1) * period;
 }
 
 void LogiFirmware::on_tick(Time now) {

@@ -39,6 +39,12 @@ struct LogiConfig {
   /// of a fleet switched on at different moments spread their telemetry and
   /// control work instead of all waking at once. 0..stat_period.
   Duration boot_offset = Duration::zero();
+  /// The grids count from the first client's connection (plus boot_offset)
+  /// instead of from time 0: a car switched on as its client connects. The
+  /// harness sets it for an external client, whose first connection is its
+  /// run's origin, so the STATs keep the same times from the origin as
+  /// they have from time 0 with the reference client.
+  bool grid_from_first_connection = false;
   /// The obstacle lock holds the car while the sonar reads below this.
   int obstacle_stop_cm = 20;
   /// ...and lets go when it reads at least obstacle_stop_cm + this again.
@@ -147,6 +153,9 @@ class LogiFirmware final : public FirmwareWith<LogiConfig, LogiState> {
   protocol::logi::Decoder decoder_;
   std::vector<protocol::logi::Item> items_;
   Time next_stat_{0};
+  /// Where the grids count from: 0, or the first connection
+  /// (LogiConfig::grid_from_first_connection).
+  std::optional<Time> grid_start_;
   Time next_control_{0};
   bool control_scheduled_ = false;      // next_control_ was handed out by next_tick()
   std::optional<std::string> run_tag_;  // the tag the station check saw last

@@ -78,6 +78,30 @@ TEST(LogiFirmware, ABootOffsetShiftsTheStatAndControlGridsByItself) {
   EXPECT_EQ(b.decode_errors(), 0u);
 }
 
+TEST(LogiFirmware, GridsFromTheFirstConnectionCountFromItAndKeepCountingAfterIt) {
+  // A car whose client first connects 729 ms in (an external client's
+  // origin): STAT at 1229, 1729 ms, as at 500, 1000 ms from a connection at 0.
+  LogiConfig config;
+  config.grid_from_first_connection = true;
+  VirtualCar<LogiFirmware> car(sim::logi_car(), [config](sim::World& w, sim::Vehicle& v) {
+    return std::make_unique<LogiFirmware>(w, v, config);
+  });
+  car.run_until(at_ms(729));
+  auto client = car.connect();  // up at 729 ms
+  car.run_until(at_ms(1229) - link::Duration(1));
+  EXPECT_EQ(client->text(), "") << "nothing on the 500 ms grid from 0";
+  car.run_until(at_ms(1229));
+  EXPECT_TRUE(client->text().starts_with("LOGI:STAT:")) << client->text();
+  // A second connection keeps the first one's grid.
+  client->pipe->close();
+  car.run_until(at_ms(1400));
+  auto again = car.connect();
+  car.run_until(at_ms(1729) - link::Duration(1));
+  EXPECT_EQ(again->text(), "");
+  car.run_until(at_ms(1729));
+  EXPECT_TRUE(again->text().starts_with("LOGI:STAT:")) << again->text();
+}
+
 TEST(LogiFirmware, ABootOffsetOutsideOneStatPeriodIsRefused) {
   LogiConfig config;
   config.boot_offset = link::milliseconds(501);
