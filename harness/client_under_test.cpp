@@ -25,11 +25,14 @@ const std::string* program_command(const ClientSetup& setup) {
 }
 
 std::unique_ptr<ScenarioClient> make_reference(const ClientSetup& setup) {
+  if (setup.options.reference_client) {
+    if (auto replaced = setup.options.reference_client(setup)) return replaced;
+  }
   const Scenario& scenario = setup.scenario;
   const auto* reference = std::get_if<ReferenceClient>(&scenario.client);
   return make_reference_client(scenario.car, setup.context, setup.car, setup.timeline,
-                                reference ? reference->settings : nlohmann::json::object(),
-                                scenario.profile);
+                               reference ? reference->settings : nlohmann::json::object(),
+                               scenario.profile);
 }
 
 // Every operator action of the scenario, one a line, for {actions}.
@@ -68,8 +71,7 @@ Placeholders placeholders(const ClientSetup& setup) {
   return values;
 }
 
-std::unique_ptr<ScenarioClient> make_program(const ClientSetup& setup,
-                                               const std::string& command) {
+std::unique_ptr<ScenarioClient> make_program(const ClientSetup& setup, const std::string& command) {
   ExecOptions o;
   o.environment = placeholders(setup);
   try {

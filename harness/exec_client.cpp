@@ -154,12 +154,6 @@ class ExecSession final : public ScenarioClient {
     if (pid_ <= 0) return;
     read(stdout_, out_buffer_, out_line_, "stdout");
     read(stderr_, err_buffer_, err_line_, "stderr");
-    startup_timer_ = executor_.call_after(options_.startup_timeout, [this] {
-      startup_timer_ = 0;
-      if (answered_ || pending_.empty()) return;
-      fail_pending("no result from the client within " + link::format_ms(options_.startup_timeout) +
-                   " of its start");
-    });
   }
 
   void execute(const std::string& text, Done done) override {
@@ -173,6 +167,10 @@ class ExecSession final : public ScenarioClient {
     }
     pending_.push_back(std::move(done));
     queue_write(text + "\n");
+    if (!first_action_handed_) {
+      first_action_handed_ = true;
+      arm_startup_timer();
+    }
   }
 
   // Lines go out as the scenario reaches them; results come back in order.
@@ -192,6 +190,8 @@ class ExecSession final : public ScenarioClient {
   void poll() override { reap(); }
 
   bool finished() const override { return pid_ <= 0 || exit_.has_value(); }
+
+  void on_first_result(std::function<void()> f) override { on_first_result_ = std::move(f); }
 
   void terminate(bool hard) override {
     if (pid_ <= 0 || reaped_) return;
@@ -354,6 +354,7 @@ class ExecSession final : public ScenarioClient {
   }
 
   void on_result(const ClientLine& result, const std::string& line) {
+    if (!answered_ && on_first_result_) on_first_result_();
     answered_ = true;
     if (ignore_results_ > 0) {
       --ignore_results_;
@@ -367,6 +368,18 @@ class ExecSession final : public ScenarioClient {
     Done done = std::move(pending_.front());
     pending_.pop_front();
     done(result.ok, result.reason);
+  }
+
+  // A program answers its first action within its startup timeout of
+  // being handed it: time to start, counted from when there was something
+  // to answer (a serial car's steps wait for the program to open the port).
+  void arm_startup_timer() {
+    startup_timer_ = executor_.call_after(options_.startup_timeout, [this] {
+      startup_timer_ = 0;
+      if (answered_ || pending_.empty()) return;
+      fail_pending("no result from the client within " + link::format_ms(options_.startup_timeout) +
+                   " of its first action");
+    });
   }
 
   void fail_pending(const std::string& reason) {
@@ -426,6 +439,8 @@ class ExecSession final : public ScenarioClient {
   nlohmann::json status_;
   std::optional<nlohmann::json> exit_;
   link::Executor::TimerId startup_timer_ = 0;
+  std::function<void()> on_first_result_;
+  bool first_action_handed_ = false;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
@@ -516,7 +531,7 @@ ClientLine parse_client_line(std::string_view raw) {
 }
 
 std::unique_ptr<ScenarioClient> make_exec_client(link::TransportContext& context,
-                                                    ExecOptions options, RunTimeline& timeline) {
+                                                 ExecOptions options, RunTimeline& timeline) {
   if (context.io == nullptr)
     throw std::logic_error("an external client needs the real-time driver");
   return std::make_unique<ExecSession>(context, std::move(options), timeline);

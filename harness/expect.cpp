@@ -226,6 +226,11 @@ ExpectationOutcome missing_anchor_outcome(const Expectation& e, const Timeline& 
 struct ExpectWindow {
   Time from{0};
   Time to{0};
+  /// Where `times` count from: the window's anchor (`from` but for a
+  /// window from the start, which opens at the run's start so that what
+  /// came before the origin is not missed, and whose times count from the
+  /// origin).
+  Time times_from{0};
   Time wide_from{0};
   Time wide_to{0};
   Time narrow_from{0};
@@ -237,9 +242,12 @@ struct ExpectWindow {
   bool in_narrow(Time at) const { return at >= narrow_from && at <= narrow_to; }
 };
 
-ExpectWindow expect_window(const Expectation& e, Time from, Time run_end, Duration slack) {
+ExpectWindow expect_window(const Expectation& e, Time from, Time run_end, Duration slack,
+                           const Origin& origin) {
   ExpectWindow w;
-  w.from = from;
+  const bool from_the_start = !e.window.from.event && e.window.from.offset == Duration(0);
+  w.from = from_the_start ? Time(0) : from;
+  w.times_from = from;
   w.to = e.window.within ? from + *e.window.within : run_end;
   // With slack (real time) the edges are known only to within it: what
   // must happen may fall in the wider window, what must not is looked for
@@ -247,12 +255,17 @@ ExpectWindow expect_window(const Expectation& e, Time from, Time run_end, Durati
   // is where it is; a run time or an edge `within` after one moves.
   const bool movable_start = !e.window.from.event && slack > Duration(0);
   const bool movable_end = e.window.within.has_value() && slack > Duration(0);
-  w.wide_from = movable_start ? std::max(Time(0), from - slack) : from;
+  w.wide_from = movable_start ? std::max(Time(0), w.from - slack) : w.from;
   w.wide_to = movable_end ? w.to + slack : w.to;
-  w.narrow_from = movable_start ? from + slack : from;
+  w.narrow_from = movable_start ? w.from + slack : w.from;
   w.narrow_to = movable_end ? std::max(w.narrow_from, w.to - slack) : w.to;
   w.where = "between " + hil::seconds_text(w.from, 3) + " and " + hil::seconds_text(w.to, 3);
   if (e.window.from.event) w.where += " (" + window_text(e.window) + ")";
+  if (!e.window.from.event && origin.cause != Origin::Cause::run_start) {
+    const std::string written = window_text(e.window);
+    w.where += " (" + (written.empty() ? std::string("the run") : written) + " from the origin, " +
+               origin_text(origin) + ")";
+  }
   if (slack > Duration(0)) w.where += " (± " + hil::seconds_text(slack, 3) + " for real time)";
   return w;
 }
@@ -374,11 +387,11 @@ void check_at_times(const Expectation& e, const Timeline& timeline, const Expect
                     const ExpectMatches& m, Duration slack, ExpectationOutcome& outcome) {
   const auto& records = timeline.records();
   const Duration tolerance = e.tolerance + slack;
-  const ClaimedTimes c = claim_times(e, timeline, m, w.from, tolerance);
+  const ClaimedTimes c = claim_times(e, timeline, m, w.times_from, tolerance);
 
   std::vector<Time> targets;
   for (const auto& t : e.times)
-    targets.push_back(w.from + t);
+    targets.push_back(w.times_from + t);
   std::string message =
       "expected " + quoted(matcher_text(e.what)) + (e.only ? " only at " : " at ");
   for (std::size_t i = 0; i < targets.size(); ++i)
@@ -482,11 +495,12 @@ bool matches(const Matcher& matcher, const Record& record) {
                      [&](const FieldTest& test) { return expect_parts::test_holds(test, record); });
 }
 
-std::optional<Time> resolve(const Anchor& anchor, const Timeline& timeline) {
-  if (!anchor.event) return Time(0) + anchor.offset;
+std::optional<Time> resolve(const Anchor& anchor, const Timeline& timeline, Time origin,
+                            Time until) {
+  if (!anchor.event) return origin + anchor.offset;
   std::vector<Time> seen;
   for (const auto& record : timeline.records())
-    if (matches(*anchor.event, record)) seen.push_back(record.at);
+    if (record.at <= until && matches(*anchor.event, record)) seen.push_back(record.at);
   // occurrence n counts from the first (1) or, negative, from the last (-1).
   const long long n = anchor.occurrence;
   const long long size = static_cast<long long>(seen.size());
@@ -498,12 +512,12 @@ std::optional<Time> resolve(const Anchor& anchor, const Timeline& timeline) {
 }
 
 ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time run_end,
-                         Duration slack) {
+                         Duration slack, const Origin& origin) {
   using namespace expect_parts;
   ExpectationOutcome outcome = start_outcome(e);
-  const auto start = resolve(e.window.from, timeline);
+  const auto start = resolve(e.window.from, timeline, origin.at, run_end);
   if (!start) return missing_anchor_outcome(e, timeline, std::move(outcome));
-  const ExpectWindow w = expect_window(e, *start, run_end, slack);
+  const ExpectWindow w = expect_window(e, *start, run_end, slack, origin);
   outcome.window_from = w.from;
   outcome.window_to = w.to;
   const ExpectMatches m = find_expect_matches(e, timeline, w);
@@ -517,11 +531,12 @@ ExpectationOutcome check(const Expectation& e, const Timeline& timeline, Time ru
 }
 
 std::vector<ExpectationOutcome> check_all(const std::vector<Expectation>& expectations,
-                                          const Timeline& timeline, Time run_end, Duration slack) {
+                                          const Timeline& timeline, Time run_end, Duration slack,
+                                          const Origin& origin) {
   std::vector<ExpectationOutcome> outcomes;
   outcomes.reserve(expectations.size());
   for (const auto& e : expectations)
-    outcomes.push_back(check(e, timeline, run_end, slack));
+    outcomes.push_back(check(e, timeline, run_end, slack, origin));
   return outcomes;
 }
 

@@ -2,7 +2,12 @@
 
 namespace hil::harness {
 
+std::string ExpectationOutcome::where() const {
+  return line > 0 ? "expect line " + std::to_string(line) : std::string("at the end");
+}
+
 bool ScenarioOutcome::passed() const {
+  if (was_skipped()) return true;
   if (!error.empty()) return false;
   for (const auto& s : steps)
     if (!s.ok) return false;
@@ -16,7 +21,7 @@ std::string ScenarioOutcome::first_failure() const {
   for (const auto& s : steps)
     if (!s.ok) return "step line " + std::to_string(s.line) + " (" + s.text + "): " + s.reason;
   for (const auto& e : expectations)
-    if (!e.passed) return "expect line " + std::to_string(e.line) + ": " + e.message;
+    if (!e.passed) return e.where() + ": " + e.message;
   return {};
 }
 

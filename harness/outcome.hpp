@@ -41,6 +41,10 @@ struct ExpectationOutcome {
   /// Records around the verdict (the matches, or what came closest and
   /// the frames near the window), in time order.
   std::vector<Record> evidence;
+
+  /// "expect line 31", or "at the end" for what every run expects without
+  /// a line of its own (an external program's clean exit, the car at rest).
+  std::string where() const;
 };
 
 struct ScenarioOutcome {
@@ -56,7 +60,11 @@ struct ScenarioOutcome {
   Timeline timeline;
   sim::Arena arena;  ///< for the trajectory picture
   std::vector<sim::Trajectory> trajectories;
-  Duration run_time{0};     ///< simulated (or real) time the run covered
+  Duration run_time{0};  ///< simulated (or real) time the run covered
+  /// Where the session ended and the run stopped the client; what came
+  /// after (its stop, the car judged at the end) is not judged by the
+  /// scenario's expectations.
+  Time session_end{0};
   double wall_seconds = 0;  ///< what it cost
   bool real_time = false;
   /// The command line that repeats this run exactly (seed included).
@@ -65,8 +73,14 @@ struct ScenarioOutcome {
   /// after the faults), when RunOptions::work_dir asked for one.
   std::string wire_log;
 
-  /// Passed: no error, every step ok, every expectation met.
+  /// Why the scenario was not run (see skip_reason() in harness/runner.hpp);
+  /// empty: it ran.
+  std::string skipped;
+
+  /// Nothing failed: skipped, or run with no error, every step ok and
+  /// every expectation met.
   bool passed() const;
+  bool was_skipped() const { return !skipped.empty(); }
   /// The first thing that failed, for the table: "step 4 (press FWD): ..."
   /// or "expect line 31: ...", or the error; empty when passed.
   std::string first_failure() const;

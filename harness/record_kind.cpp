@@ -17,7 +17,8 @@ constexpr auto kClientKindNames = base::enum_names<ClientKind>(
     {ClientKind::stale, "stale"}, {ClientKind::fresh, "fresh"}, {ClientKind::notice, "notice"},
     {ClientKind::action, "action"}, {ClientKind::login, "login"},
     {ClientKind::parse_error, "parse_error"}, {ClientKind::movement, "movement"},
-    {ClientKind::output, "output"}, {ClientKind::exit, "exit"}, {ClientKind::start, "start"});
+    {ClientKind::output, "output"}, {ClientKind::exit, "exit"}, {ClientKind::start, "start"},
+    {ClientKind::origin, "origin"});
 constexpr auto kSimKindNames = base::enum_names<SimKind>(
     {SimKind::sample, "sample"}, {SimKind::station, "station"}, {SimKind::collision, "collision"},
     {SimKind::at_rest, "at_rest"}, {SimKind::moving, "moving"});

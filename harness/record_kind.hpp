@@ -43,6 +43,7 @@ enum class ClientKind : std::uint8_t {
   output,       ///< an external program's line of output
   exit,         ///< an external program ended
   start,        ///< an external program started
+  origin,       ///< where an external program's run time counts from (harness/origin.hpp)
 };
 enum class SimKind : std::uint8_t { sample, station, collision, at_rest, moving };
 enum class StepKind : std::uint8_t { start, end };

@@ -89,9 +89,9 @@ class RecordingSession : public ScenarioClient {
 class LogiReference final : public RecordingSession {
  public:
   LogiReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
-                client::logi::ClientConfig config)
+                std::unique_ptr<client::logi::LogiClientCore> core)
       : RecordingSession(context.executor, timeline),
-        session_(context, std::move(endpoint), std::move(config),
+        session_(context, std::move(core), std::move(endpoint),
                  [this](Time now, const client::logi::Event& e) { on_event(now, e); }) {}
 
   void execute(const std::string& text, Done done) override {
@@ -117,8 +117,13 @@ class LogiReference final : public RecordingSession {
 
   void cancel() override { actions_.cancel(); }
 
+  // What an operator quitting does (apps/logi-client): a car that may be
+  // moving gets the emergency stop (MV:STOP, and ST:STOP outside MAN)
+  // before the hang-up, as the firmware runs on when its client leaves.
   void stop() override {
+    const bool may_be_moving = actions_.may_be_moving();
     cancel();
+    if (may_be_moving) session_.emergency_stop();
     session_.disconnect();
   }
 
@@ -210,6 +215,14 @@ class Wr8Reference final : public RecordingSession {
         session_(context, std::move(endpoint), std::move(config),
                  [this](Time now, const typename Dialect::Event& e) { on_event(now, e); }),
         runner_(std::make_unique<Runner>(executor_, session_)) {}
+  /// The document's dialect on `core` (make_wr8_reference_client()); only
+  /// DocumentWr8's session is made on a core, so only it compiles this.
+  Wr8Reference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+               std::unique_ptr<client::wr8::Wr8ClientCore> core)
+      : RecordingSession(context.executor, timeline),
+        session_(context, std::move(core), std::move(endpoint),
+                 [this](Time now, const typename Dialect::Event& e) { on_event(now, e); }),
+        runner_(std::make_unique<Runner>(executor_, session_)) {}
 
   void execute(const std::string& text, Done done) override {
     auto parsed = dialect_.parse(text);
@@ -287,9 +300,9 @@ class Wr8Reference final : public RecordingSession {
 class ArduinoReference final : public RecordingSession {
  public:
   ArduinoReference(link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
-                   client::arduino::ClientConfig config)
+                   std::unique_ptr<client::arduino::ArduinoClientCore> core)
       : RecordingSession(context.executor, timeline),
-        session_(context, std::move(endpoint), std::move(config)) {
+        session_(context, std::move(endpoint), std::move(core)) {
     log_in_run_time(session_);
     make_runner();
   }
@@ -317,8 +330,11 @@ class ArduinoReference final : public RecordingSession {
     if (!runner_->idle()) make_runner();
   }
 
+  // What an operator quitting does: a last S (stop) to a robot that may
+  // still be moving, then the port closes.
   void stop() override {
     cancel();
+    if (session_.state() == client::ConnectionState::connected) session_.stop();
     session_.close();
   }
 
@@ -416,8 +432,11 @@ class LekaReference final : public RecordingSession {
     runner_.cancel();
   }
 
+  // What leka-client does when it is stopped: "stop robot" (motors and
+  // behaviour) before the port closes, as the robot runs on without it.
   void stop() override {
     cancel();
+    if (session_.is_open()) session_.send(client::leka::GroupBuilder{}.stop_robot());
     session_.close();
     poll();
   }
@@ -440,14 +459,35 @@ class LekaReference final : public RecordingSession {
 
 }  // namespace
 
+std::unique_ptr<ScenarioClient> make_logi_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::logi::LogiClientCore> core) {
+  return std::make_unique<LogiReference>(context, std::move(endpoint), timeline, std::move(core));
+}
+
+std::unique_ptr<ScenarioClient> make_arduino_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::arduino::ArduinoClientCore> core) {
+  return std::make_unique<ArduinoReference>(context, std::move(endpoint), timeline,
+                                            std::move(core));
+}
+
+std::unique_ptr<ScenarioClient> make_wr8_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::wr8::Wr8ClientCore> core) {
+  return std::make_unique<Wr8Reference<DocumentWr8>>(context, std::move(endpoint), timeline,
+                                                     std::move(core));
+}
+
 std::unique_ptr<ScenarioClient> make_reference_client(
     mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
     RunTimeline& timeline, const nlohmann::json& settings, std::string_view profile) {
   const protocol::CarProfile& named = protocol::find_car_profile(mocks::to_string(car), profile);
   switch (car) {
     case mocks::CarKind::logi:
-      return std::make_unique<LogiReference>(context, std::move(endpoint), timeline,
-                                             logi_client_config(settings));
+      return make_logi_reference_client(
+          context, std::move(endpoint), timeline,
+          std::make_unique<client::logi::LogiClientCore>(logi_client_config(settings)));
     case mocks::CarKind::wr8: {
       if (const auto version = svgui_version(car, named.name)) {
         auto config = svgui_client_config(settings);
@@ -455,13 +495,14 @@ std::unique_ptr<ScenarioClient> make_reference_client(
         return std::make_unique<Wr8Reference<ProgramWr8>>(context, std::move(endpoint), timeline,
                                                           config, ProgramWr8{*version});
       }
-      return std::make_unique<Wr8Reference<DocumentWr8>>(context, std::move(endpoint), timeline,
-                                                         wr8_client_config(settings));
+      return make_wr8_reference_client(
+          context, std::move(endpoint), timeline,
+          std::make_unique<client::wr8::Wr8ClientCore>(wr8_client_config(settings)));
     }
     case mocks::CarKind::arduino: {
-      auto config = arduino_client_config(settings);
-      config.dialect = protocol::arduino::dialect_named(named.name);
-      return std::make_unique<ArduinoReference>(context, std::move(endpoint), timeline, config);
+      return make_arduino_reference_client(context, std::move(endpoint), timeline,
+                                           std::make_unique<client::arduino::ArduinoClientCore>(
+                                               arduino_client_config(settings, named.name)));
     }
     case mocks::CarKind::leka: {
       auto config = leka_client_config(settings);

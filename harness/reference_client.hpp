@@ -14,6 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "client/arduino/core.hpp"
+#include "client/logi/core.hpp"
+#include "client/wr8/core.hpp"
 #include "harness/reference_settings.hpp"
 #include "harness/scenario_client.hpp"
 #include "harness/timeline_recorder.hpp"
@@ -33,5 +36,28 @@ std::unique_ptr<ScenarioClient> make_reference_client(
     mocks::CarKind car, link::TransportContext& context, link::Endpoint endpoint,
     RunTimeline& timeline, const nlohmann::json& settings = nlohmann::json::object(),
     std::string_view profile = {});
+
+/// hil's LOGI reference client as make_reference_client() makes it, on
+/// `core`, which may be of a class derived from client::logi::LogiClientCore
+/// (a test's, with a rule broken on purpose).
+std::unique_ptr<ScenarioClient> make_logi_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::logi::LogiClientCore> core);
+
+/// hil's WR8 reference client as make_reference_client() makes it for the
+/// default (`document`) profile, on `core`, which may be of a class derived
+/// from client::wr8::Wr8ClientCore (a test's, with a rule broken on
+/// purpose); `core`'s config carries the settings.
+std::unique_ptr<ScenarioClient> make_wr8_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::wr8::Wr8ClientCore> core);
+
+/// hil's Arduino reference client as make_reference_client() makes it, on
+/// `core`, which may be of a class derived from
+/// client::arduino::ArduinoClientCore (a test's, with a rule broken on
+/// purpose); `core`'s config carries the settings and the dialect.
+std::unique_ptr<ScenarioClient> make_arduino_reference_client(
+    link::TransportContext& context, link::Endpoint endpoint, RunTimeline& timeline,
+    std::unique_ptr<client::arduino::ArduinoClientCore> core);
 
 }  // namespace hil::harness

@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "link/faults/profile_yaml.hpp"
+#include "protocol/arduino/codec.hpp"
+#include "protocol/common/car_profile.hpp"
 
 namespace hil::harness {
 namespace {
@@ -298,8 +300,12 @@ client::wr8::ClientConfig wr8_client_config(const Json& settings) {
 client::wr8::SvguiConfig svgui_client_config(const Json& settings) {
   return configured(svgui_options(), settings);
 }
-client::arduino::ClientConfig arduino_client_config(const Json& settings) {
-  return configured(arduino_options(), settings);
+client::arduino::ClientConfig arduino_client_config(const Json& settings,
+                                                    std::string_view profile) {
+  auto config = configured(arduino_options(), settings);
+  config.dialect =
+      protocol::arduino::dialect_named(protocol::find_car_profile("arduino", profile).name);
+  return config;
 }
 client::leka::ClientConfig leka_client_config(const Json& settings) {
   return configured(leka_options(), settings);

@@ -51,7 +51,10 @@ std::optional<protocol::wr8::svgui::Version> svgui_version(mocks::CarKind car,
 client::logi::ClientConfig logi_client_config(const nlohmann::json& settings);
 client::wr8::ClientConfig wr8_client_config(const nlohmann::json& settings);
 client::wr8::SvguiConfig svgui_client_config(const nlohmann::json& settings);
-client::arduino::ClientConfig arduino_client_config(const nlohmann::json& settings);
+/// The Arduino client also speaks the dialect of the car's `profile`
+/// (protocol/common/car_profile.hpp; empty: the default).
+client::arduino::ClientConfig arduino_client_config(const nlohmann::json& settings,
+                                                    std::string_view profile = {});
 client::leka::ClientConfig leka_client_config(const nlohmann::json& settings);
 
 }  // namespace hil::harness

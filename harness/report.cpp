@@ -121,6 +121,7 @@ std::string describe_client(const Record& r) {
   }
   if (r.kind == ClientKind::output) return "output: " + printable(field(d, "line"));
   if (r.kind == ClientKind::exit) return "exit code " + field(d, "code");
+  if (r.kind == ClientKind::origin) return field(d, "text");
   return {};
 }
 
@@ -232,6 +233,7 @@ std::string display_name(const ReportEntry& e) {
 constexpr const char* kRed = "\033[31m";
 constexpr const char* kGreen = "\033[32m";
 constexpr const char* kYellow = "\033[33m";
+constexpr const char* kCyan = "\033[36m";
 constexpr const char* kBold = "\033[1m";
 constexpr const char* kReset = "\033[0m";
 
@@ -247,6 +249,8 @@ const char* colour_of(Verdict v) {
       return kRed;
     case Verdict::flaky:
       return kYellow;
+    case Verdict::skip:
+      return kCyan;
   }
   return kReset;
 }
@@ -285,8 +289,9 @@ void append_evidence(std::string& out, const std::vector<Record>& records) {
 
 }  // namespace
 
-constexpr auto kVerdictNames = base::enum_names<Verdict>(
-    {Verdict::pass, "PASS"}, {Verdict::fail, "FAIL"}, {Verdict::flaky, "FLAKY"});
+constexpr auto kVerdictNames =
+    base::enum_names<Verdict>({Verdict::pass, "PASS"}, {Verdict::fail, "FAIL"},
+                              {Verdict::flaky, "FLAKY"}, {Verdict::skip, "SKIP"});
 
 const char* to_string(Verdict verdict) {
   return kVerdictNames.name(verdict).data();  // every name is a literal, so it ends in a NUL
@@ -301,6 +306,12 @@ std::vector<ScenarioSummary> summarize(const std::vector<ReportEntry>& entries) 
     auto& s = out.back();
     ++s.runs;
     if (!e.outcome.passed()) ++s.failed_runs;
+    // A scenario is skipped for what it asks of the client, so each of its
+    // runs is.
+    if (e.outcome.was_skipped()) {
+      s.verdict = Verdict::skip;
+      continue;
+    }
     s.verdict = s.failed_runs == 0        ? Verdict::pass
                 : s.failed_runs == s.runs ? Verdict::fail
                                           : Verdict::flaky;
@@ -311,9 +322,12 @@ std::vector<ScenarioSummary> summarize(const std::vector<ReportEntry>& entries) 
 std::string summary_line(const std::vector<ReportEntry>& entries) {
   std::size_t passed = 0;
   std::size_t failed = 0;
+  std::size_t skipped = 0;
   for (const auto& s : summarize(entries))
-    (s.verdict == Verdict::pass ? passed : failed) += 1;
-  return std::to_string(passed) + " passed, " + std::to_string(failed) + " failed";
+    (s.verdict == Verdict::pass ? passed : s.verdict == Verdict::skip ? skipped : failed) += 1;
+  std::string line = std::to_string(passed) + " passed, " + std::to_string(failed) + " failed";
+  if (skipped > 0) line += ", " + std::to_string(skipped) + " skipped";
+  return line;
 }
 
 bool want_color(int fd) {
@@ -374,7 +388,7 @@ std::string failure_text(const ScenarioOutcome& o) {
   if (not_run > 0) out += "  (" + std::to_string(not_run) + " later step(s) did not run)\n";
   for (const auto& e : o.expectations) {
     if (e.passed) continue;
-    out += "  expect line " + std::to_string(e.line);
+    out += "  " + e.where();
     if (!e.label.empty()) out += " (" + e.label + ")";
     out += ": " + e.message + "\n";
     if (e.window_from || e.window_to) {
@@ -424,15 +438,17 @@ void write_console(std::ostream& out, const std::vector<ReportEntry>& entries,
     const auto& e = entries[i];
     const auto& o = e.outcome;
     const bool ok = o.passed();
-    const Verdict v = ok ? Verdict::pass
-                         : (scenario_verdict[i] == Verdict::flaky ? Verdict::flaky : Verdict::fail);
+    const Verdict v =
+        o.was_skipped() ? Verdict::skip
+        : ok            ? Verdict::pass
+                        : (scenario_verdict[i] == Verdict::flaky ? Verdict::flaky : Verdict::fail);
     Row row{shorten(display_name(e), name_width),
             to_string(v),
             "-",
             fixed(o.wall_seconds, 3) + " s",
-            shorten(first_line(o.first_failure()), 400),
+            shorten(first_line(o.was_skipped() ? o.skipped : o.first_failure()), 400),
             colour_of(v)};
-    if (o.error.empty() || o.run_time.count() > 0)
+    if (!o.was_skipped() && (o.error.empty() || o.run_time.count() > 0))
       row.time = format_seconds(o.run_time) + (o.real_time ? " real" : " sim");
     rows.push_back(std::move(row));
   }
@@ -478,6 +494,15 @@ void write_console(std::ostream& out, const std::vector<ReportEntry>& entries,
     any_flaky = true;
     out << paint("FLAKY", colour_of(Verdict::flaky), c) << ' ' << s.name << " (" << s.file
         << "): " << s.failed_runs << " of " << s.runs << " runs failed\n";
+  }
+  // Why each skipped scenario was not run, once (its repeats are alike).
+  bool any_skipped = false;
+  for (const auto& e : entries) {
+    if (!e.outcome.was_skipped() || e.repeat > 0) continue;
+    if (!any_skipped) out << '\n';
+    any_skipped = true;
+    out << paint("SKIP", colour_of(Verdict::skip), c) << ' ' << e.outcome.name << " ("
+        << e.outcome.file << "): " << e.outcome.skipped << '\n';
   }
   out << '\n' << summary_line(entries) << '\n';
 }

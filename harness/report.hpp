@@ -24,9 +24,10 @@ struct ReportEntry {
 };
 
 /// A scenario's verdict over all its runs: a scenario that both passed and
-/// failed is flaky, and counts as failed.
-enum class Verdict { pass, fail, flaky };
-const char* to_string(Verdict verdict);  ///< "PASS", "FAIL", "FLAKY"
+/// failed is flaky, and counts as failed; one not run (its runs are all
+/// skipped) is skipped, and fails nothing.
+enum class Verdict { pass, fail, flaky, skip };
+const char* to_string(Verdict verdict);  ///< "PASS", "FAIL", "FLAKY", "SKIP"
 
 /// One verdict per scenario (a group of entries starts at each repeat 0),
 /// in entry order.
@@ -39,7 +40,8 @@ struct ScenarioSummary {
 };
 std::vector<ScenarioSummary> summarize(const std::vector<ReportEntry>& entries);
 
-/// "N passed, M failed", counting scenarios (a flaky one as failed).
+/// "N passed, M failed", counting scenarios (a flaky one as failed), with
+/// ", K skipped" when some were not run.
 std::string summary_line(const std::vector<ReportEntry>& entries);
 
 struct ConsoleOptions {

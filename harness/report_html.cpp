@@ -67,7 +67,7 @@ void write_file(const fs::path& path, const std::string& content) {
 
 constexpr const char* kStyle = R"(<style>
 body{font-family:system-ui,sans-serif;margin:1.5em;color:#222}
-h1 .pass,td.pass{color:#1a7f37} h1 .fail,td.fail{color:#c62828}
+h1 .pass,td.pass{color:#1a7f37} h1 .fail,td.fail{color:#c62828} h1 .skip,td.skip{color:#00838f}
 table{border-collapse:collapse;margin:.5em 0} td,th{border:1px solid #ddd;padding:.2em .5em;
 text-align:left;vertical-align:top} th{background:#f4f4f4}
 pre,code,.mono{font-family:ui-monospace,monospace;font-size:.9em}
@@ -128,8 +128,8 @@ std::string expectations_html(const ScenarioOutcome& o) {
   if (o.expectations.empty()) return "<p>No expectations.</p>\n";
   std::string out;
   for (const auto& e : o.expectations) {
-    out += std::string("<div class=\"expectation\"><h3>") + verdict_span(e.passed) + " line " +
-           std::to_string(e.line) + ": " + esc(e.label) + "</h3>\n";
+    out += std::string("<div class=\"expectation\"><h3>") + verdict_span(e.passed) + " " +
+           esc(e.where()) + ": " + esc(e.label) + "</h3>\n";
     if (!e.message.empty()) out += "<p>" + esc(e.message) + "</p>\n";
     if (e.window_from || e.window_to) {
       out += "<p>window: " + (e.window_from ? seconds3(*e.window_from) + " s" : "start") + " .. " +
@@ -448,9 +448,12 @@ std::string run_page_html(const ReportEntry& entry) {
   std::string title = (o.name.empty() ? o.file : o.name);
   if (entry.repeats > 1)
     title += " #" + std::to_string(entry.repeat + 1) + " of " + std::to_string(entry.repeats);
-  std::string out = page_head(title + (passed ? " PASS" : " FAIL"));
+  const bool skipped = o.was_skipped();
+  std::string out = page_head(title + (skipped ? " SKIP" : passed ? " PASS" : " FAIL"));
   out += "<body>\n<p><a href=\"../index.html\">all runs</a></p>\n";
-  out += "<h1>" + verdict_span(passed) + " " + esc(title) + "</h1>\n";
+  out += "<h1>" +
+         (skipped ? std::string("<span class=\"skip\">SKIP</span>") : verdict_span(passed)) + " " +
+         esc(title) + "</h1>\n";
   out += "<table class=\"meta\">";
   out += "<tr><td>file</td><td class=\"mono\">" + esc(o.file) + "</td></tr>";
   out += "<tr><td>seed</td><td>" + std::to_string(o.seed) + "</td></tr>";
@@ -468,6 +471,7 @@ std::string run_page_html(const ReportEntry& entry) {
   if (!o.repro_command.empty())
     out += "<tr><td>repeat</td><td><code>" + esc(o.repro_command) + "</code></td></tr>";
   out += "</table>\n";
+  if (skipped) out += "<h2>Not run</h2>\n<p>" + esc(o.skipped) + "</p>\n";
   if (!o.error.empty()) out += "<h2>Error</h2>\n<pre>" + esc(o.error) + "</pre>\n";
   if (!passed) out += "<h2>Failure</h2>\n<pre>" + esc(failure_text(o)) + "</pre>\n";
   out += "<h2>Playback</h2>\n" + playback_html(o);
@@ -517,11 +521,12 @@ void write_report_dir(const std::string& dir, std::vector<ReportEntry> entries) 
     if (e.repeats > 1) name += " #" + std::to_string(e.repeat + 1);
     char wall[32];
     std::snprintf(wall, sizeof wall, "%.3f s", o.wall_seconds);
-    index += std::string("<tr") + (passed ? "" : " class=\"fail\"") + "><td class=\"" +
-             (passed ? "pass\">PASS" : "fail\">FAIL") + "</td><td><a href=\"" + esc(e.folder) +
-             "/index.html\">" + esc(name) + "</a></td><td class=\"mono\">" + esc(o.file) +
-             "</td><td>" + std::to_string(o.seed) + "</td><td>" + format_seconds(o.run_time) +
-             "</td><td>" + wall + "</td><td>" + esc(o.first_failure()) + "</td></tr>\n";
+    const char* result = o.was_skipped() ? "skip\">SKIP" : passed ? "pass\">PASS" : "fail\">FAIL";
+    index += std::string("<tr") + (passed ? "" : " class=\"fail\"") + "><td class=\"" + result +
+             "</td><td><a href=\"" + esc(e.folder) + "/index.html\">" + esc(name) +
+             "</a></td><td class=\"mono\">" + esc(o.file) + "</td><td>" + std::to_string(o.seed) +
+             "</td><td>" + format_seconds(o.run_time) + "</td><td>" + wall + "</td><td>" +
+             esc(o.was_skipped() ? o.skipped : o.first_failure()) + "</td></tr>\n";
   }
   index += "</tbody></table>\n</body></html>\n";
   write_file(root / "index.html", index);

@@ -39,8 +39,7 @@ std::string step_list(const ScenarioOutcome& o) {
     out += "\n";
   }
   for (const auto& e : o.expectations) {
-    out += std::string(e.passed ? "met   " : "NOT MET") + "  expect line " +
-           std::to_string(e.line) + ": " + e.label;
+    out += std::string(e.passed ? "met   " : "NOT MET") + "  " + e.where() + ": " + e.label;
     if (!e.passed) out += "  (" + e.message + ")";
     out += "\n";
   }
@@ -52,15 +51,17 @@ std::string step_list(const ScenarioOutcome& o) {
 
 std::string junit_xml(const std::vector<ReportEntry>& entries) {
   std::size_t failures = 0;
+  std::size_t skipped = 0;
   double total = 0;
   for (const auto& e : entries) {
     if (!e.outcome.passed()) ++failures;
+    if (e.outcome.was_skipped()) ++skipped;
     total += e.outcome.wall_seconds;
   }
   std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   out += "<testsuite name=\"hil\" tests=\"" + std::to_string(entries.size()) + "\" failures=\"" +
-         std::to_string(failures) + "\" errors=\"0\" skipped=\"0\" time=\"" + junit_seconds(total) +
-         "\">\n";
+         std::to_string(failures) + "\" errors=\"0\" skipped=\"" + std::to_string(skipped) +
+         "\" time=\"" + junit_seconds(total) + "\">\n";
   for (const auto& e : entries) {
     const auto& o = e.outcome;
     std::string name = o.name.empty() ? o.file : o.name;
@@ -70,6 +71,7 @@ std::string junit_xml(const std::vector<ReportEntry>& entries) {
            "\" time=\"" + junit_seconds(o.wall_seconds) + "\"";
     if (!o.file.empty()) out += " file=\"" + xml_escape(o.file) + "\"";
     out += ">\n";
+    if (o.was_skipped()) out += "    <skipped message=\"" + xml_escape(o.skipped) + "\"/>\n";
     if (!o.passed()) {
       out += "    <failure message=\"" + xml_escape(o.first_failure()) + "\" type=\"" +
              (o.error.empty() ? "failure" : "error") + "\">" + xml_escape(failure_text(o)) +

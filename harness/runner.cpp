@@ -7,6 +7,7 @@
 #include <memory>
 #include <random>
 #include <utility>
+#include <variant>
 
 #include <stdlib.h>
 
@@ -15,10 +16,12 @@
 
 #include "harness/client_under_test.hpp"
 #include "harness/judging.hpp"
+#include "harness/origin.hpp"
 #include "harness/run_driver.hpp"
 #include "harness/sim_observer.hpp"
 #include "harness/step_sequencer.hpp"
 #include "harness/timeline_recorder.hpp"
+#include "link/endpoint.hpp"
 #include "mocks/car.hpp"
 #include "mocks/server.hpp"
 #include "sim/arena_yaml.hpp"
@@ -28,6 +31,22 @@ namespace {
 
 // Teardown still runs after a timeout; it gets this long of its own.
 constexpr Duration kTeardownGrace = std::chrono::seconds(10);
+// The car is judged this long after the client stopped (docs/scenarios.md,
+// "The end of a run"): long enough for any car's ramp down to rest.
+constexpr Duration kEndLook = std::chrono::seconds(1);
+
+// How long an external program may take to its first result line, which
+// also bounds the wait for its origin (harness/origin.hpp).
+Duration startup_timeout(const Scenario& scenario) {
+  if (const auto* exec = std::get_if<ExecClient>(&scenario.client)) return exec->startup_timeout;
+  return ExecClient{}.startup_timeout;
+}
+
+// Whether the run's client is an external program (the scenario's `exec`,
+// or `hil run --client-exec`).
+bool external_client(const Scenario& scenario, const RunOptions& options) {
+  return options.client_exec || std::holds_alternative<ExecClient>(scenario.client);
+}
 
 // The world file as written, or next to the scenario file when relative.
 std::string world_path(const Scenario& scenario) {
@@ -90,6 +109,7 @@ class ScenarioRun {
   void play_steps();
   void drive(const std::function<bool()>& done, Time deadline);
   void end();
+  Time stop_client();
 
   const Scenario& scenario_;
   const RunOptions& options_;
@@ -107,6 +127,7 @@ class ScenarioRun {
   std::unique_ptr<ClientUnderTest> client_;
   std::unique_ptr<SimObserver> observer_;
   std::unique_ptr<StepSequencer> steps_;
+  std::unique_ptr<OriginWatch> origin_;  // an external program's
   bool stuck_ = false;
 };
 
@@ -126,6 +147,10 @@ bool ScenarioRun::build_car() {
   try {
     mocks::apply_profile(car.configs, scenario_.car, scenario_.profile);
     if (scenario_.reply_latency) car.configs.reply_latency = *scenario_.reply_latency;
+    // An external client's run times count from its first connection (its
+    // origin), and so do the LOGI car's STAT and control grids, as they
+    // count from time 0 with the reference client.
+    car.configs.logi.grid_from_first_connection = external_client(scenario_, options_);
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));
     car_ = std::make_unique<mocks::MockCar>(std::move(car));
   } catch (const std::exception& e) {
@@ -161,7 +186,12 @@ std::optional<link::Endpoint> ScenarioRun::listen_endpoint() {
 bool ScenarioRun::start_server(const link::Endpoint& listen) {
   mocks::ServerOptions server;
   server.listen = listen;
-  server.faults = scenario_.faults;
+  // An external program's fault times count from its origin, which its
+  // first contact fixes (StepSequencer::origin_fixed moves them then); until
+  // that, what is in force from time 0 stays in force.
+  server.faults = external_client(scenario_, options_) && has_timed_rules(scenario_.faults)
+                      ? awaiting_origin(scenario_.faults)
+                      : scenario_.faults;
   server.seed = out_.seed;
   server.name = "car0";
   if (!options_.work_dir.empty()) {
@@ -207,6 +237,12 @@ void ScenarioRun::run() {
       StepTargets{executor(), timeline_, *car_, *server_, client_->session()});
   // The world starts at rest: that is the state the first transition leaves.
   timeline_.add(SimKind::at_rest);
+  // An external program's run times count from its first contact with the
+  // car; the reference client's from the run's start.
+  if (client_->external()) {
+    origin_ = std::make_unique<OriginWatch>(executor(), timeline_, startup_timeout(scenario_));
+    client_->session().on_first_result([this] { origin_->first_result(); });
+  }
   client_->session().start();
   observer_ = std::make_unique<SimObserver>(executor(), *car_, timeline_, options_.sample_period,
                                             [this] { client_->session().poll(); });
@@ -220,7 +256,19 @@ void ScenarioRun::run() {
 void ScenarioRun::play_steps() {
   using Sequence = StepSequencer::Sequence;
   steps_->start_schedule();
-  steps_->start(Sequence::main);
+  if (origin_)
+    origin_->when_fixed([this](const Origin& origin) { steps_->origin_fixed(origin.at); });
+  else
+    steps_->origin_fixed(Time(0));
+  // A serial car has no `connect` step: an external program opens the port
+  // when it starts, as it would connect. Its steps begin at its origin (that
+  // opening, its first result line, or its startup timeout), so the windows
+  // after a step do not count the program's start-up.
+  if (origin_ &&
+      std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(scenario_.car, 0)))
+    origin_->when_fixed([this](const Origin&) { steps_->start(Sequence::main); });
+  else
+    steps_->start(Sequence::main);
   drive([this] { return steps_->done(Sequence::main); }, Time(0) + scenario_.timeout);
   if (!steps_->done(Sequence::main))
     steps_->time_out(Sequence::main, "timed out after " + run_seconds_text(scenario_.timeout));
@@ -234,20 +282,24 @@ void ScenarioRun::play_steps() {
   drive([] { return false; }, executor().now() + scenario_.settle);
 }
 
+// The client stops (an external program's input closes and it exits; the
+// reference client quits as an operator would); the car is judged
+// kEndLook later, then everything closes.
 void ScenarioRun::end() {
   steps_->stop_schedule();
   // Expectations judge the session up to here: an external program's
   // shutdown after its input closed (a last stop, the hang-up) is the
-  // contract's business, judged by its exit.
+  // contract's business, judged by its exit and the car's state after it.
   const Time session_end = executor().now();
-  if (client_->external())
-    client_->end_program(
-        [this](const std::function<bool()>& done, Time deadline) { drive(done, deadline); });
+  const std::size_t session_records = timeline_.timeline().size();
+  const Origin origin = origin_ ? origin_->settled() : Origin{};
+  const Time client_end = stop_client();
+  drive([] { return false; }, client_end + kEndLook);
+  const SimObserver::Motion motion = observer_->motion();
   observer_->stop();
   const Time run_end = executor().now();
   steps_->close();
   timeline_.close();
-  if (!client_->external()) client_->session().stop();
   server_->close();
   // What the closes cause, outside the timeline (a moment of real time for
   // sockets to finish closing).
@@ -258,8 +310,21 @@ void ScenarioRun::end() {
   out_.arena = car_->world().arena();
   out_.trajectories = observer_->trajectories();
   out_.run_time = run_end;
-  out_.expectations = judge(JudgedRun{scenario_, out_.timeline, client_->external(), session_end,
-                                      run_end, time_slack(options_, driver_->real_time())});
+  out_.session_end = session_end;
+  out_.expectations = judge(JudgedRun{
+      scenario_, out_.timeline, client_->external(), session_end, session_records, client_end,
+      time_slack(options_, driver_->real_time()), origin,
+      EndMotion{run_end - client_end, run_end, motion.moving, motion.speed_mps, motion.driven}});
+}
+
+// Stops the client; returns when it had stopped.
+Time ScenarioRun::stop_client() {
+  if (client_->external())
+    client_->end_program(
+        [this](const std::function<bool()>& done, Time deadline) { drive(done, deadline); });
+  else
+    client_->session().stop();
+  return executor().now();
 }
 
 std::uint64_t chosen_seed(const Scenario& scenario, const RunOptions& options) {
@@ -269,6 +334,19 @@ std::uint64_t chosen_seed(const Scenario& scenario, const RunOptions& options) {
 }
 
 }  // namespace
+
+std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options) {
+  const auto* reference = std::get_if<ReferenceClient>(&scenario.client);
+  if (!options.client_exec || reference == nullptr || reference->settings.empty())
+    return std::nullopt;
+  std::string names;
+  for (const auto& [name, value] : reference->settings.items())
+    names += (names.empty() ? "" : ", ") + name;
+  return "it sets hil's reference client's " + names +
+         " (client: reference: settings:), which the program given by --client-exec does not "
+         "take; give the program those options on its own command line and run a copy of the "
+         "scenario without the settings (docs/scenarios.md, \"Skipped scenarios\")";
+}
 
 ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
@@ -280,7 +358,11 @@ ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options
   out.repro_command = "hil run " + (scenario.file.empty() ? scenario.name : scenario.file) +
                       " --seed " + std::to_string(out.seed);
 
-  const bool exec = options.client_exec || std::holds_alternative<ExecClient>(scenario.client);
+  if (auto why = skip_reason(scenario, options)) {
+    out.skipped = std::move(*why);
+    return out;
+  }
+  const bool exec = external_client(scenario, options);
   out.real_time = exec || std::get<ReferenceClient>(scenario.client).real_time;
   // A program that closes its stdin early must not end hil with SIGPIPE;
   // the write fails with EPIPE instead.

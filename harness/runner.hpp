@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -13,6 +14,9 @@
 #include "harness/scenario.hpp"
 
 namespace hil::harness {
+
+class ScenarioClient;
+struct ClientSetup;
 
 /// The default slack of a run in real time: a loaded 2-core machine
 /// delays a frame or a client's answer by tens of milliseconds.
@@ -36,9 +40,23 @@ struct RunOptions {
   std::function<void(const std::string&)> on_client_command;
   /// Period of the simulation samples in the timeline.
   Duration sample_period{std::chrono::milliseconds(100)};
+  /// Makes the client of a scenario that runs the car's reference client
+  /// (harness/client_under_test.hpp), in its place: a test runs a library
+  /// against a reference client with a bug planted in it. Returning null,
+  /// or leaving this empty, keeps the car's own reference client; an
+  /// external program is never replaced.
+  std::function<std::unique_ptr<ScenarioClient>(const ClientSetup&)> reference_client;
 };
 
-/// Never throws for a scenario's own failures; they are in the outcome.
+/// Why `scenario` is not run with `options`, or nullopt: it is. A scenario
+/// that sets options of hil's reference client (`client: reference:
+/// settings:`) is skipped when RunOptions::client_exec puts an external
+/// program in that client's place: hil cannot give the program those
+/// options, and its verdict would judge a client set up otherwise.
+std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options);
+
+/// Never throws for a scenario's own failures; they are in the outcome. A
+/// scenario skip_reason() skips is not run: its outcome says why.
 ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options = {});
 
 }  // namespace hil::harness

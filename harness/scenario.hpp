@@ -185,6 +185,14 @@ using ClientSpec = std::variant<ReferenceClient, ExecClient>;
 
 // ---------------------------------------------------------------- scenario
 
+/// How the car must be when the run judges it, a while after the client
+/// stopped (docs/scenarios.md, "The end of a run").
+enum class AtEnd : std::uint8_t {
+  at_rest,  ///< at rest, its motors not driven (the default)
+  moving,   ///< still moving or driven: the scenario ends moving on purpose
+  any,      ///< not judged
+};
+
 struct Scenario {
   std::string file;  ///< where it was loaded from ("" for one built in code)
   std::string name;
@@ -212,6 +220,8 @@ struct Scenario {
   Duration timeout{std::chrono::seconds(120)};
   /// Time the run goes on after the last step, so late frames are seen.
   Duration settle{std::chrono::milliseconds(500)};
+  /// How the car must be at the end, once the client has stopped.
+  AtEnd at_end = AtEnd::at_rest;
 };
 
 }  // namespace hil::harness

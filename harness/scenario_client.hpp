@@ -5,7 +5,9 @@
 // one at a time and hears how each ended; the run stops it at the end.
 
 #include <functional>
+#include <memory>
 #include <string>
+#include <utility>
 
 namespace hil::harness {
 
@@ -39,6 +41,36 @@ class ScenarioClient {
   /// After stop(), when finished() did not come in time: end it by force
   /// (`hard`: no more chances).
   virtual void terminate(bool hard) { (void)hard; }
+  /// `f` runs when an external program prints its first result line (one
+  /// of the marks of the run's origin, harness/origin.hpp); a reference
+  /// client has no result lines.
+  virtual void on_first_result(std::function<void()> f) { (void)f; }
+};
+
+/// A client that is another one in every way but what a subclass changes:
+/// the base of a test's decorator (one that walks away at the end, one that
+/// is stopped when it spins).
+class ForwardingClient : public ScenarioClient {
+ public:
+  explicit ForwardingClient(std::unique_ptr<ScenarioClient> inner) : inner_(std::move(inner)) {}
+
+  void start() override { inner_->start(); }
+  void execute(const std::string& text, Done done) override {
+    inner_->execute(text, std::move(done));
+  }
+  bool concurrent() const override { return inner_->concurrent(); }
+  void cancel() override { inner_->cancel(); }
+  void stop() override { inner_->stop(); }
+  void poll() override { inner_->poll(); }
+  bool finished() const override { return inner_->finished(); }
+  void terminate(bool hard) override { inner_->terminate(hard); }
+  void on_first_result(std::function<void()> f) override { inner_->on_first_result(std::move(f)); }
+
+ protected:
+  ScenarioClient& inner() { return *inner_; }
+
+ private:
+  std::unique_ptr<ScenarioClient> inner_;
 };
 
 }  // namespace hil::harness

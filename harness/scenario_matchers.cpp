@@ -15,7 +15,7 @@ constexpr auto kFieldTestSymbols = base::enum_names<FieldTest::Op>(
     {FieldTest::Op::less, " < "}, {FieldTest::Op::greater, " > "},
     {FieldTest::Op::greater_equal, " >= "}, {FieldTest::Op::less_equal, " <= "});
 
-/// The names the cars' decoded messages give their fields (docs/scenarios.md,
+/// The names the cars' decoded messages give their fields (docs/timeline.md,
 /// "The timeline"), to catch a misspelt one; a name far from all of them is
 /// let through, for a firmware's extra keys and a WR8 profile's own DATA.
 Keys known_frame_fields(mocks::CarKind car) {

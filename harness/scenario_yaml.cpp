@@ -36,9 +36,13 @@ namespace {
 
 using namespace scenario_parts;
 
-const Keys kTopKeys = {"name",   "description", "tags",    "car",      "profile",   "reply_latency",
-                       "world",  "seed",        "timeout", "settle",   "variables", "faults",
-                       "client", "setup",       "steps",   "teardown", "schedule",  "expect"};
+const Keys kTopKeys = {"name",          "description", "tags",     "car",     "profile",
+                       "reply_latency", "world",       "seed",     "timeout", "settle",
+                       "at_end",        "variables",   "faults",   "client",  "setup",
+                       "steps",         "teardown",    "schedule", "expect"};
+
+constexpr auto kAtEndNames = base::enum_names<AtEnd>(
+    {AtEnd::at_rest, "at_rest"}, {AtEnd::moving, "moving"}, {AtEnd::any, "any"});
 
 /// Reads a scenario file top-down; each part goes to the reader of its
 /// concept (harness/scenario_parts.hpp).
@@ -111,6 +115,15 @@ class ScenarioReader : public config::Reader {
     }
     if (auto n = root["settle"]) scenario.settle = duration(n, "'settle'");
     if (auto n = root["reply_latency"]) scenario.reply_latency = duration(n, "'reply_latency'");
+    if (auto n = root["at_end"]) scenario.at_end = at_end(n);
+  }
+
+  /// `at_end: moving`: how the car must be once the client has stopped.
+  AtEnd at_end(const YAML::Node& n) const {
+    const std::string word = scalar(n, "'at_end'");
+    if (const auto parsed = kAtEndNames.parse(word)) return *parsed;
+    fail(n, "'at_end' must be " + kAtEndNames.list(" or ") + ", got '" + word + "'" +
+                config::did_you_mean(word, kAtEndNames.names()));
   }
 
   /// Step texts first: step matchers anywhere refer to them.

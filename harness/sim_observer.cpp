@@ -68,6 +68,15 @@ void SimObserver::tick() {
   });
 }
 
+SimObserver::Motion SimObserver::motion() {
+  car_.world().advance_to(executor_.now());
+  const sim::Twist v = car_.vehicle().velocity();
+  const sim::Twist wheels = car_.vehicle().chassis().wheel_twist();
+  const bool driven = std::hypot(wheels.vx_mps, wheels.vy_mps) >= kMovingMps / 2 ||
+                      std::abs(wheels.wz_radps) >= kMovingRadps / 2;
+  return Motion{moving_, std::hypot(v.vx_mps, v.vy_mps), driven};
+}
+
 void SimObserver::note_collisions() {
   const std::size_t vehicle = car_.vehicle().index();
   for (const auto& c : recorder_.observe(car_.world())) {

@@ -34,6 +34,16 @@ class SimObserver {
 
   const std::vector<sim::Trajectory>& trajectories() const { return recorder_.trajectories(); }
 
+  /// The car now: `moving` is the observer's own notion (between a `sim
+  /// moving` record and the next `sim at_rest`), `driven` that the wheels
+  /// are still driven above the at-rest threshold (a car pushing a wall).
+  struct Motion {
+    bool moving = false;
+    double speed_mps = 0;
+    bool driven = false;
+  };
+  Motion motion();
+
  private:
   void tick();
   void note_collisions();

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "harness/expect.hpp"
+#include "harness/origin.hpp"
 #include "harness/run_driver.hpp"
 #include "protocol/common/overloaded.hpp"
 #include "sim/geometry.hpp"
@@ -11,7 +12,7 @@ namespace hil::harness {
 
 StepSequencer::StepSequencer(const Scenario& scenario, std::vector<StepOutcome>& steps,
                              StepTargets targets)
-    : scenario_(scenario), steps_(steps), targets_(targets) {
+    : scenario_(scenario), steps_(steps), targets_(targets), faults_in_force_(scenario.faults) {
   for (const auto& s : scenario_.setup)
     main_.steps.push_back(add(s, "setup"));
   for (const auto& s : scenario_.steps)
@@ -50,17 +51,31 @@ void StepSequencer::post(std::function<void()> f) {
   targets_.executor.post(guarded(std::move(f)));
 }
 
+std::function<void()> StepSequencer::scheduled_start(std::size_t index) {
+  return guarded([this, index] {
+    if (!closed_ && !schedule_stopped_) begin_step(index, [](bool) {});
+  });
+}
+
+void StepSequencer::origin_fixed(Time origin) {
+  origin_shift_ = origin - Time(0);
+  for (std::size_t j = 0; j < scenario_.schedule.size(); ++j) {
+    const Anchor& when = scenario_.schedule[j].when;
+    if (!when.event)
+      targets_.executor.call_at(origin + when.offset, scheduled_start(schedule_base_ + j));
+  }
+  if (origin_shift_ != Duration(0) && has_timed_rules(faults_in_force_)) {
+    // Told from a timeline listener perhaps, while the link is opening: on
+    // the next turn.
+    post([this] { targets_.server.set_faults(moved(faults_in_force_, origin_shift_)); });
+  }
+}
+
 void StepSequencer::start_schedule() {
   for (std::size_t j = 0; j < scenario_.schedule.size(); ++j) {
-    const std::size_t index = schedule_base_ + j;
     const Anchor& when = scenario_.schedule[j].when;
-    auto fire = guarded([this, index] {
-      if (!closed_ && !schedule_stopped_) begin_step(index, [](bool) {});
-    });
-    if (!when.event) {
-      targets_.executor.call_at(Time(0) + when.offset, std::move(fire));
-      continue;
-    }
+    if (!when.event) continue;  // origin_fixed() arms it
+    auto fire = scheduled_start(schedule_base_ + j);
     // The n-th matching record arms the step; a "last" occurrence cannot be
     // known while the run goes on, so it means the first.
     const int wanted = when.occurrence > 0 ? when.occurrence : 1;
@@ -133,11 +148,14 @@ void StepSequencer::begin_step(std::size_t index, std::function<void(bool ok)> t
                        CarEventKind::behaviour,
                        {{"name", c.behaviour.name},
                         {"action", std::string(mocks::action_name(c.behaviour.action))}});
-                   targets_.car.firmware().arm(c.behaviour);
+                   mocks::Behaviour behaviour = c.behaviour;
+                   if (behaviour.when.at) *behaviour.when.at += origin_shift_;
+                   targets_.car.firmware().arm(std::move(behaviour));
                    finish_later(index, true, "");
                  },
                  [&](const FaultsStep& f) {
-                   targets_.server.set_faults(f.profile);
+                   faults_in_force_ = f.profile;
+                   targets_.server.set_faults(moved(f.profile, origin_shift_));
                    finish_later(index, true, "");
                  },
                  [&](const ObstacleStep& s) { begin_obstacle(index, s); },

@@ -43,8 +43,14 @@ class StepSequencer {
   StepSequencer(const StepSequencer&) = delete;
   StepSequencer& operator=(const StepSequencer&) = delete;
 
-  /// Arms each scheduled step for its moment.
+  /// Arms each scheduled step whose moment is an event.
   void start_schedule();
+  /// The run's origin is known (harness/origin.hpp): arms each scheduled
+  /// step whose moment is a run time (`at: 5s`) from it, and from now on
+  /// the run times inside faults and car steps (a rule's or a behaviour's
+  /// `at`) count from it too. A fault profile in force with such times (the
+  /// scenario's own, from the start) is put in force again, moved by it.
+  void origin_fixed(Time origin);
   /// Starts the sequence's first step on the next executor turn.
   void start(Sequence which);
   bool done(Sequence which) const;
@@ -84,6 +90,8 @@ class StepSequencer {
   void begin_obstacle(std::size_t index, const ObstacleStep& step);
   void pump_actions();
   void post(std::function<void()> f);
+  /// Starts the scheduled step `index` when called, unless the schedule is over.
+  std::function<void()> scheduled_start(std::size_t index);
   std::function<void()> guarded(std::function<void()> f) const;
 
   const Scenario& scenario_;
@@ -98,6 +106,10 @@ class StepSequencer {
   std::deque<std::size_t> actions_;
   std::size_t actions_under_way_ = 0;
   std::multimap<std::string, std::size_t> obstacles_;  // name -> arena obstacle index
+  /// How far run times in faults and car steps move: the origin, once known.
+  Duration origin_shift_{0};
+  /// The fault profile in force, as the scenario wrote it.
+  link::FaultProfile faults_in_force_;
   bool schedule_stopped_ = false;
   bool closed_ = false;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);

@@ -21,7 +21,7 @@ using link::Time;
 
 /// One thing that happened: its kind (harness/record_kind.hpp), which
 /// names its source, and its data. `kind` and `data` by source (the full list, with
-/// every field, is in docs/scenarios.md, "The timeline"):
+/// every field, is in docs/timeline.md, "The timeline"):
 /// - wire, kind "frame": data {"dir": "to_car"|"to_client", "stage": "sent"|"delivered",
 ///   "frame": the frame's kind ("MV:STOP", "AUTH", "NACK"), "text" or "hex": the bytes,
 ///   "valid": bool, "error": why it is not valid ("checksum", ...)}; kind "open", "close"

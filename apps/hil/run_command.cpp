@@ -336,7 +336,10 @@ class BatchRunner {
   void show_progress(std::size_t finished, const Planned& p, const ReportEntry& entry) {
     const std::lock_guard lock(progress_);
     std::cerr << '[' << finished << '/' << batch_.tasks.size() << "] "
-              << (entry.outcome.passed() ? "PASS " : "FAIL ") << entry.outcome.name;
+              << (entry.outcome.was_skipped() ? "SKIP "
+                  : entry.outcome.passed()    ? "PASS "
+                                              : "FAIL ")
+              << entry.outcome.name;
     if (entry.repeats > 1) std::cerr << " #" << entry.repeat + 1;
     if (p.scenario) std::cerr << " (seed " << entry.outcome.seed << ')';
     std::cerr << '\n';
@@ -352,8 +355,8 @@ class BatchRunner {
 };
 
 // The table on stdout, then JUnit XML and the report folder when asked
-// for. Returns the exit status: 1 when anything did not pass or a file
-// could not be written.
+// for. Returns the exit status: 1 when anything failed (a skipped scenario
+// did not) or a file could not be written.
 int report_results(const RunArgs& args, const std::vector<ReportEntry>& entries) {
   harness::ConsoleOptions console;
   console.color = harness::want_color(STDOUT_FILENO);
@@ -363,7 +366,7 @@ int report_results(const RunArgs& args, const std::vector<ReportEntry>& entries)
 
   int status = 0;
   for (const auto& s : harness::summarize(entries))
-    if (s.verdict != harness::Verdict::pass) status = 1;
+    if (s.verdict == harness::Verdict::fail || s.verdict == harness::Verdict::flaky) status = 1;
   if (!args.junit.empty()) {
     // Atomically: a CI job that reads the file never sees half of it, and a
     // run stopped while writing leaves the previous file whole.
@@ -471,7 +474,10 @@ void register_run(CLI::App& app, std::function<int()>& run) {
       "  hil run scenarios/logi/release.yaml --seed 42   # repeat one run exactly\n"
       "  hil run scenarios/ --repeat 20 -j 4             # hunt flaky scenarios\n"
       "Every failure prints the command that repeats it.\n"
-      "Exit status: 0 every scenario passed; 1 any failed (or was flaky, or did not load);\n"
+      "A scenario that sets hil's reference client's settings is skipped (SKIP) under\n"
+      "--client-exec: the program is not given those settings.\n"
+      "Exit status: 0 every scenario passed or was skipped; 1 any failed (or was flaky, or\n"
+      "did not load);\n"
       "2 a malformed command line, a path that does not exist, or no scenario to run.");
   cmd->callback([&run, args] { run = [args] { return run_scenarios(*args); }; });
 }

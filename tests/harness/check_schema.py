@@ -52,6 +52,7 @@ WRONG = {
     "another car's profile": "name: t\ncar: arduino\nprofile: comspecs-v3\nsteps: [connect]\n",
     "a WR8 profile misspelt": "name: t\ncar: wr8\nprofile: svgui-2020\nsteps: [connect]\n",
     "a reply latency without a unit": "name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n",
+    "an end state misspelt": "name: t\ncar: logi\nat_end: movin\nsteps: [connect]\n",
 }
 
 # And these are right in ways that are easy to get wrong in a schema.
@@ -65,6 +66,7 @@ RIGHT = {
         "expect:\n  - {received: SP, at_least: '${n}'}\n"
     ),
     "faults off in YAML 1.1": "name: t\ncar: logi\nfaults: off\nsteps:\n  - faults: off\n",
+    "a scenario that ends moving": "name: t\ncar: logi\nat_end: moving\nsteps: [connect]\n",
     "an exec client": (
         "name: t\ncar: wr8\nclient: {exec: 'c {host} {port}', startup_timeout: 5s}\n"
         "steps: [connect]\n"

@@ -123,6 +123,20 @@ TEST(HilRunCli, TheReproCommandCarriesTheSeedVariablesAndClient) {
   EXPECT_THAT(exec.output, HasSubstr("--seed 9 --client-exec 'my-client {host} {port}'\n"));
 }
 
+TEST(HilRunCli, AScenarioThatSetsTheReferenceClientIsSkippedForAnExternalProgram) {
+  // `false` would fail any run it took part in: the skipped scenario never
+  // starts it, and the other one (no settings) does.
+  const auto out = expect_table(
+      "scenarios/logi/logi-manual-keepalive.yaml " + kData + "/pass.yaml -v --client-exec false", 1,
+      {"logi-manual-keepalive SKIP", "run-pass FAIL"}, "0 passed, 1 failed, 1 skipped");
+  expect_contains(out, {"] SKIP logi-manual-keepalive",
+                        "\nSKIP logi-manual-keepalive "
+                        "(scenarios/logi/logi-manual-keepalive.yaml): it sets hil's reference "
+                        "client's keepalive, keepalive_period (client: reference: settings:)"});
+  expect_table("scenarios/logi/logi-manual-keepalive.yaml --client-exec false", 0,
+               {"logi-manual-keepalive SKIP"}, "0 passed, 0 failed, 1 skipped");
+}
+
 TEST(HilRunCli, AFolderRunsEveryScenarioInItSortedByFile) {
   // flaky.yaml has no seed of its own: seed 1 makes it fail.
   const auto out = expect_table(kData + " -v --seed 1", 1,

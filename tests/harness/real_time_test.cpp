@@ -6,12 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
 #include "tests/harness/runner_test_support.hpp"
+#include "tests/harness/scratch_dir.hpp"
 
 namespace hil::harness {
 namespace {
@@ -58,6 +60,13 @@ std::string summary(const ScenarioOutcome& o) {
   return s;
 }
 
+// The verdict on the clean exit every external program owes.
+const ExpectationOutcome* exit_verdict(const ScenarioOutcome& o) {
+  for (const auto& e : o.expectations)
+    if (e.label == "the client exited with code 0 after its input closed") return &e;
+  return nullptr;
+}
+
 // A client in four lines of shell: answers every action with `ok`, and
 // exits when its input closes.
 constexpr const char* kEchoClient = R"(while read -r line; do echo "ok $line"; done)";
@@ -84,9 +93,8 @@ TEST(ExternalClient, EachActionLineGetsItsResultAndAFailGivesItsReason) {
   const auto exits = of(o, ClientKind::exit);
   ASSERT_EQ(exits.size(), 1u) << summary(o);
   EXPECT_EQ(exits[0].data["code"], 0);
-  ASSERT_FALSE(o.expectations.empty());
-  EXPECT_EQ(o.expectations.back().label, "the client exited with code 0 after its input closed");
-  EXPECT_TRUE(o.expectations.back().passed);
+  ASSERT_NE(exit_verdict(o), nullptr);
+  EXPECT_TRUE(exit_verdict(o)->passed);
 }
 
 TEST(ExternalClient, EventLinesAndOtherOutputAreRecordedForExpectations) {
@@ -163,8 +171,39 @@ TEST(ExternalClient, ASerialCarGivesThePathOfItsPty) {
   else echo "fail $line: no pty at {pty}"; fi
   done)sh";
   Scenario s = exec_scenario(mocks::CarKind::arduino, client, {action("V")});
+  // It never opens the port: its first action comes after its startup
+  // timeout, and it has that long again to answer it.
+  s.client = ExecClient{client, seconds(1)};
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
+  ASSERT_EQ(o.steps.size(), 1u);
+  EXPECT_GE(o.steps[0].started, seconds(1)) << "handed over at the startup timeout";
+}
+
+TEST(ExternalClient, ASerialCarsStepsBeginWhenTheProgramOpensThePort) {
+  // Starts slowly (as an interpreter may), then holds the port open.
+  const std::string client = R"sh(sleep 0.5; exec 3<>{pty}
+  while read -r line; do echo "ok $line"; done)sh";
+  Scenario s = exec_scenario(mocks::CarKind::arduino, client, {action("PING")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_TRUE(o.passed()) << summary(o);
+  const auto opens = of(o, WireKind::open);
+  ASSERT_FALSE(opens.empty()) << summary(o);
+  ASSERT_EQ(o.steps.size(), 1u);
+  EXPECT_GE(opens[0].at, milliseconds(500)) << "the program slept first";
+  EXPECT_GE(o.steps[0].started, opens[0].at) << "the step waited for the port";
+  EXPECT_LT(o.steps[0].started, opens[0].at + milliseconds(500))
+      << "and began once it was open (a generous bound for a loaded machine)";
+}
+
+TEST(ExternalClient, AProgramThatExitsBeforeItsFirstContactFailsItsStepAtOnce) {
+  Scenario s = exec_scenario(mocks::CarKind::leka, "exit 4", {action("info")});
+  const ScenarioOutcome o = run_scenario(s);
+  EXPECT_FALSE(o.passed());
+  ASSERT_EQ(o.steps.size(), 1u);
+  EXPECT_FALSE(o.steps[0].ok);
+  EXPECT_LT(o.steps[0].started, seconds(5))
+      << "the exit is a sign: the steps do not wait out the 10 s startup timeout";
 }
 
 TEST(ExternalClient, AProgramThatExitsEarlyFailsTheActionsItOwes) {
@@ -179,7 +218,8 @@ TEST(ExternalClient, AProgramThatExitsEarlyFailsTheActionsItOwes) {
   const auto exits = of(o, ClientKind::exit);
   ASSERT_EQ(exits.size(), 1u);
   EXPECT_EQ(exits[0].data["code"], 3);
-  EXPECT_FALSE(o.expectations.back().passed) << "exit code 3 is not a clean exit";
+  ASSERT_NE(exit_verdict(o), nullptr);
+  EXPECT_FALSE(exit_verdict(o)->passed) << "exit code 3 is not a clean exit";
 }
 
 TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
@@ -200,7 +240,8 @@ TEST(ExternalClient, AProgramThatWillNotEndIsKilledAndFailsTheRun) {
   EXPECT_EQ(notices[0].data["text"],
             "the client did not exit within 5 s of its input closing: sent SIGTERM");
   EXPECT_EQ(notices[1].data["text"], "the client ignored SIGTERM for 2 s: sent SIGKILL");
-  EXPECT_FALSE(o.expectations.back().passed);
+  ASSERT_NE(exit_verdict(o), nullptr);
+  EXPECT_FALSE(exit_verdict(o)->passed);
 }
 
 TEST(ExternalClient, TheProgramInheritsNoSocketOrFileOfHils) {
@@ -243,7 +284,7 @@ TEST(ExternalClient, WhatTheProgramDoesAfterItsInputClosedIsNotJudgedByTheScenar
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
   EXPECT_EQ(of(o, ClientKind::command).size(), 1u) << "still in the timeline";
-  EXPECT_EQ(o.expectations.size(), 2u);
+  EXPECT_EQ(o.expectations.size(), 3u) << "the scenario's, the clean exit, the car at rest";
 }
 
 TEST(ExternalClient, ACommandThatDoesNotExistSaysSo) {
@@ -266,7 +307,8 @@ TEST(ExternalClient, AnExpectationOnTheExitCodeReplacesTheCleanExitRule) {
       expectation("exits with 4", client_record(ClientKind::exit, "code", 4, "exit 4")));
   const ScenarioOutcome o = run_scenario(s);
   EXPECT_TRUE(o.passed()) << summary(o);
-  EXPECT_EQ(o.expectations.size(), 1u);
+  EXPECT_EQ(exit_verdict(o), nullptr);
+  EXPECT_EQ(o.expectations.size(), 2u) << "the scenario's, the car at rest";
 }
 
 TEST(ExternalClient, AnUnknownPlaceholderIsAnErrorBeforeAnythingStarts) {
@@ -290,6 +332,112 @@ TEST(ExternalClient, TheActionsFileHoldsEveryActionInScenarioOrder) {
   ASSERT_TRUE(o.passed()) << summary(o);
   EXPECT_EQ(lines_of(o),
             (std::vector<std::string>{"connect", "speed 50", "mode MAN", "disconnect"}));
+}
+
+// ------------------------------------------------ the origin and the end
+
+// A LOGI client in Python's standard library: `connect` opens the car's
+// TCP port, the MAN actions become their frames, every action is answered
+// `ok`. With "stop" as its argument it sends MV:STOP when its input ends,
+// as the contract asks; without, it walks away from a moving car.
+constexpr const char* kPythonLogiClient = R"py(
+import os, socket, sys
+def frame(payload):
+    body = ("LOGI:" + payload).encode()
+    return body + b":%02X#" % (sum(body) & 0xFF)
+FRAMES = {"mode MAN": "MD:MAN", "speed 50": "SP:050", "press FWD": "MV:FWD"}
+car = None
+for line in sys.stdin:
+    action = line.strip()
+    if action == "connect":
+        car = socket.create_connection((os.environ["HIL_HOST"], int(os.environ["HIL_PORT"])))
+        print("event connection connected", flush=True)
+    elif action in FRAMES:
+        car.sendall(frame(FRAMES[action]))
+    print("ok", flush=True)
+if car is not None and sys.argv[1:] == ["stop"]:
+    car.sendall(frame("MV:STOP"))
+    car.recv(64)
+)py";
+
+/// The Python client above, in `dir`, started after `delay` of its own.
+std::string python_client(const hil::test::ScratchDir& dir, const std::string& delay,
+                          const std::string& args = "") {
+  const auto script = dir.path() / "client.py";
+  std::ofstream(script) << kPythonLogiClient;
+  return "sleep " + delay + "; exec python3 " + script.string() + " " + args;
+}
+
+TEST(ExternalClientOrigin, AClientThatTakes2sToStartStillMeetsAWindowFromTheStart) {
+  const hil::test::ScratchDir dir("hil-origin");
+  Scenario s = exec_scenario(mocks::CarKind::logi, python_client(dir, "2"),
+                             {action("connect"), wait(milliseconds(600))});
+  // "connected within 500 ms of the start": the start is the program's
+  // first connection, 2 s and more after hil started it.
+  Expectation connected = expectation(
+      "connected within 500 ms", client_record(ClientKind::connection, "state", "connected", "c"));
+  connected.window.within = milliseconds(500);
+  s.expectations.push_back(connected);
+  s.schedule.push_back(ScheduledStep{Anchor{std::nullopt, 1, milliseconds(300)},
+                                     step_of("wait 1ms", WaitStep{milliseconds(1)})});
+  // The car hangs up 400 ms into the run: 400 ms after the origin.
+  link::FaultRule hang_up;
+  hang_up.trigger.at = Time(milliseconds(400));
+  hang_up.action = link::Reset{};
+  s.faults.rules.push_back(hang_up);
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+
+  const auto origins = of(o, ClientKind::origin);
+  ASSERT_EQ(origins.size(), 1u) << summary(o);
+  EXPECT_EQ(origins[0].data["cause"], "connection");
+  const auto opens = of(o, WireKind::open);
+  ASSERT_FALSE(opens.empty());
+  EXPECT_EQ(origins[0].at, opens[0].at) << "the car accepting the connection";
+  EXPECT_GE(origins[0].at, seconds(2)) << "the program slept 2 s first";
+  const std::string text = origins[0].data["text"];
+  EXPECT_EQ(text.rfind("origin: the client's first connection at +2.", 0), 0u) << text;
+  // The step scheduled `at: 300ms` counts from there too.
+  const StepOutcome& scheduled = o.steps.back();
+  EXPECT_EQ(scheduled.phase, "schedule");
+  EXPECT_TRUE(scheduled.ran);
+  EXPECT_GE(scheduled.started, origins[0].at + milliseconds(300));
+  const auto resets = of(o, link::FaultKind::reset);
+  ASSERT_EQ(resets.size(), 1u) << summary(o);
+  EXPECT_GE(resets[0].at, origins[0].at + milliseconds(400));
+  const auto closes = of(o, WireKind::close);
+  ASSERT_FALSE(closes.empty());
+  EXPECT_LT(closes[0].at, o.session_end) << "the hang-up came during the session";
+}
+
+TEST(ExternalClientEnd, AProgramThatExitsLeavingTheCarMovingFailsTheRun) {
+  const hil::test::ScratchDir dir("hil-end");
+  const std::vector<Step> drive = {action("connect"), action("mode MAN"), action("speed 50"),
+                                   action("press FWD"), wait(milliseconds(500))};
+  Scenario s = exec_scenario(mocks::CarKind::logi, python_client(dir, "0"), drive);
+  const ScenarioOutcome walked_away = run_scenario(s);
+  EXPECT_FALSE(walked_away.passed());
+  const auto& end = walked_away.expectations.back();
+  EXPECT_FALSE(end.passed) << summary(walked_away);
+  EXPECT_EQ(end.message.rfind("the car was still moving 1.0 s after the client exited (", 0), 0u)
+      << end.message;
+  EXPECT_NE(end.message.find("): a client stops the car when its input ends "
+                             "(docs/client-contract.md, section 4)"),
+            std::string::npos)
+      << end.message;
+  ASSERT_NE(exit_verdict(walked_away), nullptr);
+  EXPECT_TRUE(exit_verdict(walked_away)->passed) << "its exit itself was clean";
+
+  s.at_end = AtEnd::moving;
+  const ScenarioOutcome on_purpose = run_scenario(s);
+  EXPECT_TRUE(on_purpose.passed()) << summary(on_purpose);
+
+  s.at_end = AtEnd::at_rest;
+  s.client = ExecClient{python_client(dir, "0", "stop"), seconds(10)};
+  const ScenarioOutcome stopped = run_scenario(s);
+  EXPECT_TRUE(stopped.passed()) << summary(stopped);
+  EXPECT_EQ(stopped.expectations.back().message,
+            "the car was at rest 1.0 s after the client exited");
 }
 
 // One scenario, both drivers: the reference client makes the car do the

@@ -225,6 +225,34 @@ TEST(ReportConsole, AScenarioThatBothPassedAndFailedIsFlakyAndCountsAsFailed) {
   EXPECT_EQ(s[1].verdict, Verdict::pass);
 }
 
+ScenarioOutcome skipped() {
+  ScenarioOutcome o = logi_run("keepalive", "manual-keepalive", 1, 0, 0.0);
+  o.skipped = "it sets hil's reference client's keepalive";
+  return o;
+}
+
+TEST(ReportConsole, ASkippedScenarioReadsSkipWithItsReasonAndFailsNothing) {
+  std::vector<ReportEntry> entries{entry(skipped(), 0, 2), entry(skipped(), 1, 2),
+                                   entry(passing())};
+  const std::string text = console(entries);
+  const auto lines = lines_of(text);
+  EXPECT_THAT(lines[1], HasSubstr("manual-keepalive #1"));
+  EXPECT_THAT(lines[1], HasSubstr("SKIP"));
+  EXPECT_THAT(lines[1], HasSubstr("it sets hil's reference client's keepalive"));
+  EXPECT_THAT(lines[2], HasSubstr("SKIP"));
+  EXPECT_THAT(text, HasSubstr("\nSKIP manual-keepalive (scenarios/logi/keepalive.yaml): it sets "
+                              "hil's reference client's keepalive\n\n"))
+      << "the reason once, not once per repeat";
+  EXPECT_THAT(text, Not(HasSubstr("\nFAIL")));
+  EXPECT_EQ(lines.back(), "1 passed, 0 failed, 1 skipped");
+
+  const auto s = summarize(entries);
+  ASSERT_EQ(s.size(), 2U);
+  EXPECT_EQ(s[0].verdict, Verdict::skip);
+  EXPECT_EQ(s[0].failed_runs, 0);
+  EXPECT_EQ(summary_line({entry(passing())}), "1 passed, 0 failed") << "no skip, no mention";
+}
+
 TEST(ReportConsole, RecordsReadAsOneLineEach) {
   EXPECT_EQ(format_record(frame(5000, "to_car", "delivered", "LOGI:MV:STOP:A1#\r\n")),
             "    5.000 s  wire    car received  LOGI:MV:STOP:A1#\\r\\n");
@@ -285,6 +313,15 @@ TEST(ReportJunit, OneTestcasePerRunWithTheFailureAndItsEvidence) {
   EXPECT_THAT(xml, HasSubstr("<system-out>seed 7\n"));
   EXPECT_THAT(xml, HasSubstr("ok      steps line 5: speed 50"));
   expect_well_escaped(xml);
+}
+
+TEST(ReportJunit, ASkippedRunIsASkippedTestcaseAndNoFailure) {
+  const std::string xml = junit_xml({entry(skipped()), entry(failed_step())});
+  EXPECT_THAT(xml, HasSubstr("tests=\"2\" failures=\"1\" errors=\"0\" skipped=\"1\""));
+  EXPECT_THAT(xml,
+              HasSubstr("name=\"manual-keepalive\" time=\"0.000\" "
+                        "file=\"scenarios/logi/keepalive.yaml\">\n    <skipped message=\"it "
+                        "sets hil&#39;s reference client&#39;s keepalive\"/>\n    <system-out>"));
 }
 
 TEST(ReportJunit, HostileTextStaysInsideItsElement) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "client/logi/core.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -186,7 +187,9 @@ TEST(RunnerLogi, AfterTheCarHangsUpAt5sTheClientReconnectsAt6s) {
       {seconds(5) + kLogiLatency, "reconnecting"},
       {seconds(6) + kLogiLatency, "connecting"},
       {seconds(6) + kLogiLatency, "connected"},
+      {o.session_end, "disconnected"},  // the run stopped the client
   };
+  EXPECT_EQ(o.session_end, seconds(8) + milliseconds(500)) << "the steps, then the settle";
   EXPECT_EQ(states, expected);
   const auto behaviours = of(o, CarEventKind::behaviour);
   ASSERT_EQ(behaviours.size(), 1u);
@@ -226,7 +229,7 @@ TEST(RunnerLogi, RefusedConnectionsAreFaultRecordsAndTheClientGetsBackInWhenThey
   const auto opens = of(o, WireKind::open);
   ASSERT_EQ(opens.size(), 2u) << "a refused connection gets no link";
   EXPECT_EQ(opens[1].at, seconds(11) + kLogiLatency);
-  EXPECT_EQ(of(o, ClientKind::connection).back().data["state"], "connected");
+  EXPECT_EQ(in_session(o, ClientKind::connection).back().data["state"], "connected");
 }
 
 TEST(RunnerLogi, AnAutoRunReachesStation2AndTheCarStopsThere) {
@@ -335,7 +338,8 @@ TEST(RunnerLogi, ARunThatOutlivesItsTimeoutFailsTheRestAndStillTearsDown) {
   EXPECT_EQ(o.steps[2].reason, "timed out after 3 s");
   EXPECT_TRUE(o.steps[3].ok);
   EXPECT_EQ(o.steps[3].started, seconds(3));
-  EXPECT_EQ(o.run_time, seconds(3) + milliseconds(500)) << "teardown at once, then the settle";
+  EXPECT_EQ(o.session_end, seconds(3) + milliseconds(500)) << "teardown at once, then the settle";
+  EXPECT_EQ(o.run_time, o.session_end + seconds(1)) << "then 1 s to judge the car at rest";
 }
 
 TEST(RunnerLogi, AWaitUntilThatNeverMatchesFailsAfterItsTimeout) {
@@ -366,7 +370,8 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
     if (r.data["frame"] == "SP" && !received) received = r.at;
   ASSERT_TRUE(received);
   EXPECT_EQ(o.steps.back().started, *received + milliseconds(1200));
-  // Muted: no STAT after the step, and the client says so 2 s after the last.
+  // Muted: no STAT after the step, and the client says so as soon as more
+  // than 2 s have passed since the last (one tick of its clock later).
   std::optional<Time> last_stat;
   for (const auto& r : wire(o, "to_client", "sent"))
     if (r.data["frame"] == "STAT") last_stat = r.at;
@@ -375,7 +380,7 @@ TEST(RunnerLogi, AStepScheduledOnAnEventStartsAtTheEventPlusItsOffset) {
       << "STAT every 500 ms, each after the car's latency, until the mute at 1.2 s";
   const auto stale = of(o, ClientKind::stale);
   ASSERT_EQ(stale.size(), 1u);
-  EXPECT_EQ(stale[0].at, *last_stat + seconds(2));
+  EXPECT_EQ(stale[0].at, *last_stat + seconds(2) + client::logi::LogiClientCore::kTick);
 }
 
 TEST(RunnerOtherCars, AnObstaclePutAheadOfTheWr8IsHitAndCanBeTakenAway) {
@@ -428,7 +433,9 @@ TEST(RunnerOtherCars, ArduinoAnswersPingSpeedAndStatus) {
   ASSERT_TRUE(o.passed()) << o.first_failure() << "\n" << steps_summary(o);
   expect_frames_both_ways(o);
   EXPECT_EQ(of(o, ClientKind::connection).front().data["state"], "connecting");
-  EXPECT_EQ(of(o, ClientKind::command).size(), 3u);
+  EXPECT_EQ(in_session(o, ClientKind::command).size(), 3u);
+  EXPECT_EQ(of(o, ClientKind::command).size(), 4u)
+      << "and the S (stop) the client sends when the run stops it";
 }
 
 TEST(RunnerOtherCars, LekaRunsAGroupAndAnswersInfo) {
@@ -458,13 +465,40 @@ TEST(Runner, AWorldThatCannotBeBuiltIsTheRunsError) {
   EXPECT_FALSE(o.passed());
 }
 
+TEST(Runner, ASettingOfTheReferenceClientSkipsTheScenarioForAnExternalProgram) {
+  Scenario s = scenario(mocks::CarKind::logi, {action("connect")});
+  s.client = ReferenceClient{false, {{"keepalive", true}, {"keepalive_period", "300ms"}}};
+  RunOptions exec;
+  // A program that would fail the run at once: the skip starts nothing.
+  exec.client_exec = "false";
+  const auto why = skip_reason(s, exec);
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("keepalive, keepalive_period"), std::string::npos) << *why;
+  EXPECT_NE(why->find("--client-exec"), std::string::npos) << *why;
+
+  const auto o = run_scenario(s, exec);
+  EXPECT_TRUE(o.was_skipped());
+  EXPECT_EQ(o.skipped, *why);
+  EXPECT_TRUE(o.passed()) << "a skipped scenario fails nothing";
+  EXPECT_TRUE(o.steps.empty());
+  EXPECT_EQ(o.timeline.size(), 0u) << "nothing ran";
+  EXPECT_TRUE(o.error.empty()) << o.error;
+
+  // hil's own client takes the settings, and no settings skips nothing.
+  EXPECT_FALSE(skip_reason(s, RunOptions{}).has_value());
+  EXPECT_FALSE(run_scenario(s).was_skipped());
+  s.client = ReferenceClient{};
+  EXPECT_FALSE(skip_reason(s, exec).has_value());
+}
+
 TEST(Runner, WithoutASeedOneIsChosenAndPrintedInTheReproCommand) {
   Scenario s = scenario(mocks::CarKind::logi, {});
   s.seed.reset();
   s.file = "scenarios/x.yaml";
   const auto o = run_scenario(s);
   EXPECT_EQ(o.repro_command, "hil run scenarios/x.yaml --seed " + std::to_string(o.seed));
-  EXPECT_EQ(o.run_time, milliseconds(500)) << "no steps: the settle alone";
+  EXPECT_EQ(o.session_end, milliseconds(500)) << "no steps: the settle alone";
+  EXPECT_EQ(o.run_time, milliseconds(1500)) << "then 1 s to judge the car at rest";
 }
 
 TEST(Runner, TheExampleScenariosPassWithTheReferenceClient) {

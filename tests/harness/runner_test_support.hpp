@@ -59,4 +59,12 @@ inline std::vector<Record> of(const ScenarioOutcome& o, RecordKind kind) {
   return out;
 }
 
+/// The records of one kind before the run stopped the client.
+inline std::vector<Record> in_session(const ScenarioOutcome& o, RecordKind kind) {
+  std::vector<Record> out;
+  for (const auto& r : o.timeline.records())
+    if (r.kind == kind && r.at < o.session_end) out.push_back(r);
+  return out;
+}
+
 }  // namespace hil::harness::test

@@ -153,6 +153,7 @@ TEST(ScenarioYaml, AMinimalScenarioTakesTheDefaults) {
   EXPECT_FALSE(s.seed.has_value());
   EXPECT_EQ(s.timeout, seconds(120));
   EXPECT_EQ(s.settle, milliseconds(500));
+  EXPECT_EQ(s.at_end, AtEnd::at_rest);
   EXPECT_EQ(s.client, ClientSpec{ReferenceClient{}});
   EXPECT_TRUE(s.faults.rules.empty());
   ASSERT_EQ(s.steps.size(), 1u);
@@ -169,6 +170,7 @@ TEST(ScenarioYaml, ReadsEveryTopLevelKey) {
       "seed: 42\n"
       "timeout: 60s\n"
       "settle: 250ms\n"
+      "at_end: moving\n"
       "client: {reference: {real_time: true}}\n"
       "faults:\n"
       "  rules:\n"
@@ -182,6 +184,7 @@ TEST(ScenarioYaml, ReadsEveryTopLevelKey) {
   EXPECT_EQ(s.seed, 42u);
   EXPECT_EQ(s.timeout, seconds(60));
   EXPECT_EQ(s.settle, milliseconds(250));
+  EXPECT_EQ(s.at_end, AtEnd::moving);
   EXPECT_EQ(s.client, ClientSpec{ReferenceClient{true}});
   ASSERT_EQ(s.faults.rules.size(), 1u);
   EXPECT_EQ(s.setup.at(0).text, "connect");
@@ -596,8 +599,13 @@ TEST(ScenarioYamlErrors, EveryMistakeNamesItsLineAndColumn) {
       // Unknown key, with the allowed ones and the likely one.
       {"name: t\ncar: logi\nstpes: [connect]\n",
        "t.yaml:3:1: the scenario: unknown key 'stpes' (allowed: name, description, tags, "
-       "car, profile, reply_latency, world, seed, timeout, settle, variables, faults, client, "
-       "setup, steps, teardown, schedule, expect); did you mean 'steps'?"},
+       "car, profile, reply_latency, world, seed, timeout, settle, at_end, variables, faults, "
+       "client, setup, steps, teardown, schedule, expect); did you mean 'steps'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nat_end: movin\n",
+       "t.yaml:4:9: 'at_end' must be at_rest, moving or any, got 'movin'; did you mean "
+       "'moving'?"},
+      {"name: t\ncar: logi\nsteps: [connect]\nat_end: [moving]\n",
+       "t.yaml:4:9: 'at_end' must be a text or a number, not a list"},
       {"name: t\ncar: logi\n", "t.yaml:1:1: the scenario: 'steps' is missing"},
       {"name: t\ncar: tesla\nsteps: [connect]\n",
        "t.yaml:2:6: unknown car 'tesla' (expected logi, wr8, arduino or leka)"},
