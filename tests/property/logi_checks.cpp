@@ -1,6 +1,7 @@
-// The named LOGI properties as checks over one recorded session. Each
-// returns an empty string when its rule held and otherwise says where and
-// how it broke, with virtual times exact to the nanosecond.
+// The named LOGI properties as checks over one recorded session (those of
+// the safety guard are in logi_safety_checks.cpp). Each returns an empty
+// string when its rule held and otherwise says where and how it broke, with
+// virtual times exact to the nanosecond.
 
 #include <algorithm>
 #include <cstdio>
@@ -69,20 +70,6 @@ std::string show(const Received& r) {
   return "error " + std::string(protocol::to_string(e.first)) + " '" + e.second + "'";
 }
 
-/// Requests written by an emergency stop (exempt from the single queue).
-std::set<RequestId> estop_requests(const Rig& rig) {
-  std::set<RequestId> ids;
-  for (const auto& op : rig.ops) {
-    if (op.kind != OpRecord::Kind::estop) continue;
-    for (std::size_t i = op.events_before; i < op.events_after; ++i) {
-      if (const auto* c = std::get_if<CommandEvent>(&rig.events[i].second)) {
-        if (c->state == CommandState::sent) ids.insert(c->request);
-      }
-    }
-  }
-  return ids;
-}
-
 /// The client's events of each connection: [connected event, leaving event).
 std::vector<std::pair<std::size_t, std::size_t>> connections(const Rig& rig) {
   std::vector<std::pair<std::size_t, std::size_t>> out;
@@ -141,12 +128,8 @@ std::string compare_streams(const Rig& rig) {
   return {};
 }
 
-struct Step {
-  std::size_t index;
-  Time at;
-  const Event* e;
-};
-/// Every event of request `id`, in order (its CommandEvents and FeedbackEvents).
+}  // namespace
+
 std::map<RequestId, std::vector<Step>> by_request(const Rig& rig) {
   std::map<RequestId, std::vector<Step>> out;
   for (std::size_t i = 0; i < rig.events.size(); ++i) {
@@ -158,6 +141,8 @@ std::map<RequestId, std::vector<Step>> by_request(const Rig& rig) {
   }
   return out;
 }
+
+namespace {
 
 // ---------------------------------------------------------------- checks
 
@@ -286,6 +271,7 @@ std::string check_timeout(const Rig& rig) {
 }
 
 std::string check_retries(const Rig& rig) {
+  const auto estop = estop_requests(rig);
   for (const auto& [id, steps] : by_request(rig)) {
     const proto::Message* cmd = nullptr;
     int sends = 0;
@@ -313,7 +299,9 @@ std::string check_retries(const Rig& rig) {
         if (mv != nullptr && !stop && sends > 1 && !(sends == 2 && rejected_once)) {
           return what + ": a move was resent without the car refusing it (FB:MV:0)";
         }
-        if (!sp_md && mv == nullptr && sends > 1) {
+        // An emergency stop's ST:STOP is owed until answered (its own check).
+        const bool owed = estop.count(id) != 0 && std::holds_alternative<proto::SetRun>(c.command);
+        if (!sp_md && mv == nullptr && sends > 1 && !owed) {
           return what + ": resent at " + ms(st.at) + " without the operator confirming";
         }
       } else if (c.state == CommandState::uncertain) {
@@ -327,209 +315,6 @@ std::string check_retries(const Rig& rig) {
       }
     }
     (void)cmd;
-  }
-  return {};
-}
-
-std::string check_stop_on_release(const Rig& rig) {
-  const auto steps = by_request(rig);
-  for (const auto& op : rig.ops) {
-    if (op.kind != OpRecord::Kind::release || !op.result) continue;
-    const auto it = steps.find(op.result.request);
-    const std::string what = "release at " + ms(op.at);
-    if (it == steps.end() || it->second.empty()) {
-      if (op.line_idle) return what + " on an idle line: no MV:STOP was written";
-      // On a busy line it waits its turn: no later operator request may go first.
-      for (const auto& later : rig.ops) {
-        if (!later.result || later.kind == OpRecord::Kind::estop ||
-            later.result.request <= op.result.request) {
-          continue;
-        }
-        const auto l = steps.find(later.result.request);
-        if (l != steps.end() && !l->second.empty()) {
-          return what + ": no MV:STOP written, yet request " +
-                 std::to_string(later.result.request) + " queued after it was";
-        }
-      }
-      continue;
-    }
-    const auto* first = std::get_if<CommandEvent>(it->second.front().e);
-    if (first == nullptr) return what + ": odd first event";
-    if (first->state == CommandState::cancelled) continue;  // the link went first
-    if (first->state != CommandState::sent || first->command != proto::Message{proto::Move{}}) {
-      return what + ": its request is " + proto::describe(first->command) + ", not MV:STOP";
-    }
-    if (op.line_idle && it->second.front().at != op.at) {
-      return what + " on an idle line: MV:STOP written only at " + ms(it->second.front().at);
-    }
-  }
-  return {};
-}
-
-std::string check_stale(const Rig& rig) {
-  const Duration after = seconds(2);
-  bool connected = false;
-  bool stale = false;
-  Time last{0};
-  auto overdue = [&](Time upto) -> std::string {
-    if (connected && !stale && last + after < upto) {
-      return "no stale warning at " + ms(last + after) +
-             ", 2 s after the last STAT (or connect) at " + ms(last);
-    }
-    return {};
-  };
-  for (std::size_t i = 0; i < rig.events.size(); ++i) {
-    const auto& [t, e] = rig.events[i];
-    if (auto why = overdue(t); !why.empty()) return why;
-    if (const auto* c = std::get_if<ConnectionEvent>(&e)) {
-      connected = c->state == ConnectionState::connected;
-      if (connected) last = t;
-    } else if (std::holds_alternative<StatusEvent>(e)) {
-      last = t;
-      if (stale) return "a STAT at " + ms(t) + " did not clear the stale warning";
-    } else if (const auto* s = std::get_if<StaleEvent>(&e)) {
-      if (s->stale) {
-        if (!connected || stale)
-          return "a stale warning at " + ms(t) + " while not connected or already stale";
-        if (t != last + after) {
-          return "stale warning at " + ms(t) + ", expected exactly " + ms(last + after) +
-                 " (2 s after the last STAT or connect at " + ms(last) + ")";
-        }
-        stale = true;
-      } else {
-        const bool stat_follows = i + 1 < rig.events.size() && rig.events[i + 1].first == t &&
-                                  std::holds_alternative<StatusEvent>(rig.events[i + 1].second);
-        if (!stale || !stat_follows) return "stale cleared at " + ms(t) + " without a fresh STAT";
-        stale = false;
-        last = t;  // the STAT that cleared it comes next
-      }
-    }
-  }
-  return overdue(rig.now());
-}
-
-std::string check_estop_order(const Rig& rig) {
-  for (const auto& op : rig.ops) {
-    if (op.kind != OpRecord::Kind::estop || op.state_before != ConnectionState::connected) continue;
-    std::vector<proto::Message> sent;
-    for (std::size_t i = op.events_before; i < op.events_after; ++i) {
-      if (const auto* c = std::get_if<CommandEvent>(&rig.events[i].second)) {
-        if (c->state == CommandState::sent) sent.push_back(c->command);
-      }
-    }
-    const bool in_man = op.known_mode_before == Mode::manual;
-    std::vector<proto::Message> want{proto::Move{}};
-    if (!in_man) want.emplace_back(proto::SetRun{false});
-    if (sent != want) {
-      std::string got;
-      for (const auto& m : sent)
-        got += " " + proto::describe(m);
-      return "emergency stop at " + ms(op.at) +
-             (in_man ? " (car known in MAN)" : " (AUTO or unknown)") +
-             " wrote:" + (got.empty() ? " nothing" : got) +
-             (in_man ? "; expected MV:STOP only" : "; expected MV:STOP then ST:STOP");
-    }
-  }
-  return {};
-}
-
-std::string check_mode_conflict(const Rig& rig) {
-  const auto estop = estop_requests(rig);
-  std::map<RequestId, int> refusals;
-  for (std::size_t i = 0; i < rig.events.size(); ++i) {
-    const auto* f = std::get_if<FeedbackEvent>(&rig.events[i].second);
-    if (f == nullptr || f->request == 0 || f->feedback.command != proto::Command::mv ||
-        f->feedback.accepted) {
-      continue;
-    }
-    const Time t = rig.events[i].first;
-    const bool notice = i + 1 < rig.events.size() &&
-                        std::holds_alternative<NoticeEvent>(rig.events[i + 1].second) &&
-                        std::get<NoticeEvent>(rig.events[i + 1].second).text ==
-                            "Not in manual mode, switching to MAN";
-    const int n = ++refusals[f->request];
-    if (estop.count(f->request) != 0 || n > 1) {
-      if (notice)
-        return "FB:MV:0 at " + ms(t) + " for an emergency stop or a retried move led to MD:MAN";
-      continue;
-    }
-    if (!notice)
-      return "FB:MV:0 at " + ms(t) + " without the notice 'Not in manual mode, switching to MAN'";
-    // The next non-emergency sends: MD:MAN, then the move once more.
-    std::vector<std::pair<RequestId, proto::Message>> next;
-    for (std::size_t j = i + 1; j < rig.events.size() && next.size() < 2; ++j) {
-      const auto& e = rig.events[j].second;
-      if (const auto* k = std::get_if<ConnectionEvent>(&e)) {
-        if (k->state != ConnectionState::connected) break;
-      }
-      const auto* c = std::get_if<CommandEvent>(&e);
-      if (c != nullptr && c->request == f->request && c->state == CommandState::cancelled) {
-        break;  // an emergency stop dropped the queued move: no retry is owed
-      }
-      if (c == nullptr || c->state != CommandState::sent || estop.count(c->request) != 0) continue;
-      if (!next.empty() && next.back().first == c->request) continue;  // an MD retry
-      next.emplace_back(c->request, c->command);
-    }
-    if (!next.empty() && next[0].second != proto::Message{proto::SetMode{Mode::manual}}) {
-      return "after FB:MV:0 at " + ms(t) + " the client wrote " + proto::describe(next[0].second) +
-             ", not MD:MAN";
-    }
-    if (next.size() == 2 && next[1].first != f->request) {
-      return "after FB:MV:0 at " + ms(t) + " and MD:MAN the move was not retried next (" +
-             proto::describe(next[1].second) + " came)";
-    }
-  }
-  return {};
-}
-
-std::string check_safe_state(Rig& rig) {
-  if (!rig.failures(Prop::safe_state_and_reconfirm).empty()) {
-    return rig.failures(Prop::safe_state_and_reconfirm).front();
-  }
-  // Everything open is cancelled as the connection goes; nothing is written
-  // on a new connection before the operator acts.
-  std::set<RequestId> open;
-  std::size_t op = 0;
-  std::optional<Time> fresh_connection;
-  bool movement_enabled = false;
-  for (std::size_t i = 0; i < rig.events.size(); ++i) {
-    for (; op < rig.ops.size() && rig.ops[op].events_before <= i; ++op) {
-      fresh_connection.reset();
-      if (rig.ops[op].result && rig.ops[op].kind != OpRecord::Kind::connect &&
-          rig.ops[op].kind != OpRecord::Kind::disconnect) {
-        open.insert(rig.ops[op].result.request);
-      }
-    }
-    const auto& [t, e] = rig.events[i];
-    if (const auto* c = std::get_if<CommandEvent>(&e)) {
-      if (c->state == CommandState::sent) {
-        if (fresh_connection) {
-          return proto::describe(c->command) + " written at " + ms(t) +
-                 " on a new connection before the operator did anything";
-        }
-        open.insert(c->request);
-      } else if (c->state != CommandState::sent) {
-        open.erase(c->request);
-      }
-    } else if (const auto* m = std::get_if<MovementEvent>(&e)) {
-      movement_enabled = m->enabled;
-    } else if (const auto* k = std::get_if<ConnectionEvent>(&e)) {
-      if (k->state == ConnectionState::connected) {
-        fresh_connection = t;
-      } else {
-        fresh_connection.reset();
-        const bool disabled = i + 1 < rig.events.size() &&
-                              std::holds_alternative<MovementEvent>(rig.events[i + 1].second) &&
-                              !std::get<MovementEvent>(rig.events[i + 1].second).enabled;
-        if (movement_enabled && !disabled) {
-          return "movement controls still enabled as the link left at " + ms(t);
-        }
-        if (!open.empty()) {
-          return "request " + std::to_string(*open.begin()) +
-                 " neither ended nor cancelled when the link left at " + ms(t);
-        }
-      }
-    }
   }
   return {};
 }
@@ -799,34 +584,6 @@ std::string check_log(const Rig& rig) {
   return {};
 }
 
-std::string check_estop_accessible(const Rig& rig) {
-  for (const auto& op : rig.ops) {
-    if (op.kind != OpRecord::Kind::estop) continue;
-    const bool connected = op.state_before == ConnectionState::connected;
-    const Refusal want = connected ? Refusal::none : Refusal::not_connected;
-    if (op.result.refusal != want) {
-      return "emergency stop at " + ms(op.at) + " answered '" +
-             std::string(to_string(op.result.refusal)) + "' while " +
-             std::string(to_string(op.state_before));
-    }
-    if (!connected) continue;
-    bool stop_now = false;
-    for (std::size_t i = op.events_before; i < op.events_after; ++i) {
-      const auto& [t, e] = rig.events[i];
-      if (const auto* c = std::get_if<CommandEvent>(&e)) {
-        if (c->state == CommandState::sent && c->command == proto::Message{proto::Move{}} &&
-            t == op.at)
-          stop_now = true;
-      }
-    }
-    if (!stop_now) {
-      return "emergency stop at " + ms(op.at) + (op.line_idle ? "" : " (line busy)") +
-             " did not write MV:STOP at once";
-    }
-  }
-  return {};
-}
-
 std::string check_checksums(const Rig& rig) {
   for (std::size_t k = 0; k < rig.links.size(); ++k) {
     for (const auto& r : reference_decode(rig.links[k].to_car_sent)) {
@@ -863,9 +620,8 @@ bool exercised(Prop p, const Rig& rig) {
   switch (p) {
     case Prop::backoff_delays:
     case Prop::safe_state_and_reconfirm:
-      return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {
-        return c.state == ConnectionState::reconnecting;
-      });
+      return any_event<ConnectionEvent>(
+          rig, [](const ConnectionEvent& c) { return c.state == ConnectionState::reconnecting; });
     case Prop::reconnects_automatically:
       return any_event<ConnectionEvent>(rig, [](const ConnectionEvent& c) {
         return c.state == ConnectionState::connecting && c.attempt > 0;
@@ -887,6 +643,19 @@ bool exercised(Prop p, const Rig& rig) {
     case Prop::emergency_stop_order:
     case Prop::emergency_stop_accessible:
       return any_op(rig, connected_estop);
+    case Prop::estop_st_stop_resent:
+      return any_event<CommandEvent>(rig, [](const CommandEvent& c) {
+        return c.attempt > 1 && c.command == proto::Message{proto::SetRun{false}};
+      });
+    case Prop::car_rests_after_estop:
+      return any_op(rig, [&](const OpRecord& op) {
+        return op.car_running && estop_st_stop(rig, op).has_value();
+      });
+    case Prop::move_timeout_stops:
+      return any_event<CommandEvent>(rig, [](const CommandEvent& c) {
+        const auto* mv = std::get_if<proto::Move>(&c.command);
+        return c.state == CommandState::uncertain && mv && mv->direction != Direction::stop;
+      });
     case Prop::mode_conflict:
       return any_event<NoticeEvent>(rig, [](const NoticeEvent&) { return true; });
     case Prop::bad_checksum_dropped:
@@ -952,6 +721,12 @@ std::string check(Prop p, Rig& rig) {
       return check_stale(rig);
     case Prop::emergency_stop_order:
       return check_estop_order(rig);
+    case Prop::estop_st_stop_resent:
+      return check_estop_st_stop_resent(rig);
+    case Prop::car_rests_after_estop:
+      return check_car_rests_after_estop(rig);
+    case Prop::move_timeout_stops:
+      return check_move_timeout_stops(rig);
     case Prop::mode_conflict:
       return check_mode_conflict(rig);
     case Prop::safe_state_and_reconfirm:

@@ -22,8 +22,14 @@ HIL_LOGI_PROP(OneCommandAwaitsFeedbackAtATime, single_outbound_queue)
 HIL_LOGI_PROP(FeedbackTimeoutIsExactly800ms, feedback_timeout_800ms)
 HIL_LOGI_PROP(OnlySpMdMvStopAreRetriedAtMostTwice, retry_rules)
 HIL_LOGI_PROP(ReleaseSendsMvStop, stop_on_release)
-HIL_LOGI_PROP(StaleExactly2sAfterTheLastStatAndNotBefore, stale_after_2s)
+HIL_LOGI_PROP(StaleJustAfter2sWithoutStatAndClearedOnlyByStat, stale_after_2s)
 HIL_LOGI_PROP(EmergencyStopSendsMvStopFirstThenStStopInAuto, emergency_stop_order)
+HIL_LOGI_PROP(EmergencyStStopResentEvery800msUntilTheCarAnswers, estop_st_stop_resent)
+// End to end: at the first 800 ms slot of an emergency stop that the faults
+// let through, its ST:STOP reaches the car, which runs no more and rests
+// within kBrakeBound (520 ms).
+HIL_LOGI_PROP(CarStopsOnceTheLinkLetsAnEmergencyStStopThrough, car_rests_after_estop)
+HIL_LOGI_PROP(ATimedOutMoveIsFollowedByMvStopAtOnce, move_timeout_stops)
 HIL_LOGI_PROP(FbMv0GivesANoticeMdManAndOneRetry, mode_conflict)
 HIL_LOGI_PROP(SafeStateOnLossAndReconfirmAfterReconnect, safe_state_and_reconfirm)
 HIL_LOGI_PROP(BadChecksumFramesAreDroppedLoggedAndTheLinkKept, bad_checksum_dropped)

@@ -3,6 +3,7 @@
 // generator, and the body every named property runs.
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -240,15 +241,16 @@ PlantedBug bug_from_environment() {
   static const PlantedBug bug = [] {
     const char* name = std::getenv("HIL_LOGI_PLANTED_BUG");
     if (name == nullptr) return PlantedBug::none;
-    const std::string n = name;
-    if (n == "no_backoff") return PlantedBug::no_backoff;
-    if (n == "retry_run") return PlantedBug::retry_run;
-    if (n == "no_stop_on_release") return PlantedBug::no_stop_on_release;
-    if (n == "read_is_frame") return PlantedBug::read_is_frame;
-    if (n == "stale_at_5s") return PlantedBug::stale_at_5s;
-    if (n == "no_sp_retry") return PlantedBug::no_sp_retry;
-    if (n == "st_stop_first") return PlantedBug::st_stop_first;
-    return PlantedBug::none;
+    for (const auto& entry : kPlantedBugs) {
+      if (entry.name == name) return entry.bug;
+    }
+    // A misspelt name would otherwise test the shipped client unnoticed.
+    std::string known;
+    for (const auto& entry : kPlantedBugs)
+      known += " " + std::string(entry.name);
+    std::fprintf(stderr, "HIL_LOGI_PLANTED_BUG=%s: no such planted bug; expected one of:%s\n", name,
+                 known.c_str());
+    std::exit(2);
   }();
   return bug;
 }

@@ -32,9 +32,15 @@ const char* name_of(Prop p) {
     case Prop::stop_on_release:
       return "ReleaseSendsMvStop";
     case Prop::stale_after_2s:
-      return "StaleExactly2sAfterTheLastStatAndNotBefore";
+      return "StaleJustAfter2sWithoutStatAndClearedOnlyByStat";
     case Prop::emergency_stop_order:
       return "EmergencyStopSendsMvStopFirstThenStStopInAuto";
+    case Prop::estop_st_stop_resent:
+      return "EmergencyStStopResentEvery800msUntilTheCarAnswers";
+    case Prop::car_rests_after_estop:
+      return "CarStopsOnceTheLinkLetsAnEmergencyStStopThrough";
+    case Prop::move_timeout_stops:
+      return "ATimedOutMoveIsFollowedByMvStopAtOnce";
     case Prop::mode_conflict:
       return "FbMv0GivesANoticeMdManAndOneRetry";
     case Prop::safe_state_and_reconfirm:
@@ -93,6 +99,36 @@ Focus focus_for(Prop p) {
       return {.station = 4, .run = 4, .reject = 3, .ignore = 6, .faults = 4};
     case Prop::mode_conflict:
       return {.mode = 8, .reject = 4};
+    case Prop::estop_st_stop_resent:
+    case Prop::car_rests_after_estop:
+      // Auto runs (a press would switch the car to MAN) stopped through a lossy link.
+      return {.disconnect = 0,
+              .speed = 6,
+              .mode = 6,
+              .press = 1,
+              .release = 2,
+              .station = 6,
+              .run = 8,
+              .stop = 1,
+              .estop = 8,
+              .drop_link = 0,
+              .reject = 0,
+              .ignore = 0,
+              .mute = 0,
+              .faults = 6};
+    case Prop::move_timeout_stops:
+      return {.disconnect = 0,
+              .speed = 6,
+              .mode = 6,
+              .press = 12,
+              .release = 4,
+              .station = 0,
+              .run = 0,
+              .stop = 0,
+              .estop = 1,
+              .drop_link = 0,
+              .ignore = 8,
+              .faults = 6};
     case Prop::emergency_stop_order:
     case Prop::emergency_stop_accessible:
       return {.station = 5, .run = 5, .estop = 8};
@@ -107,13 +143,14 @@ Focus focus_for(Prop p) {
   }
 }
 
-namespace {
-
 bool is_movement(const proto::Message& m) {
   if (const auto* mv = std::get_if<proto::Move>(&m)) return mv->direction != Direction::stop;
   if (const auto* st = std::get_if<proto::SetRun>(&m)) return st->run;
   return false;
 }
+
+namespace {
+
 /// The signs of the forward, leftward and anticlockwise motion `d` asks for.
 std::array<int, 3> motion_signs(Direction d) {
   const auto one_of = [d](std::initializer_list<Direction> ds) {
@@ -246,9 +283,10 @@ void Rig::advance_to(Time until) {
   // and the clock must stop there even within one long wait.
   for (;;) {
     std::optional<Time> check_due;
-    if (!chassis_checks_.empty()) check_due = chassis_checks_.begin()->first;
-    if (!rest_checks_.empty() && (!check_due || rest_checks_.begin()->first < *check_due)) {
-      check_due = rest_checks_.begin()->first;
+    for (const auto* checks : {&chassis_checks_, &rest_checks_, &estop_samples_}) {
+      if (!checks->empty() && (!check_due || checks->begin()->first < *check_due)) {
+        check_due = checks->begin()->first;
+      }
     }
     const Time target = check_due && *check_due < until ? *check_due : until;
     const auto next = car_.executor.next_due();
@@ -262,10 +300,14 @@ void Rig::advance_to(Time until) {
       const std::size_t index = chassis_checks_.begin()->second;
       chassis_checks_.erase(chassis_checks_.begin());
       check_chassis(*check_due, index);
-    } else {
+    } else if (!rest_checks_.empty() && rest_checks_.begin()->first == *check_due) {
       const std::size_t op = rest_checks_.begin()->second;
       rest_checks_.erase(rest_checks_.begin());
       check_rest(*check_due, op);
+    } else {
+      const std::size_t op = estop_samples_.begin()->second;
+      estop_samples_.erase(estop_samples_.begin());
+      sample_estop(*check_due, op);
     }
   }
   car_.executor.run_until(until);
@@ -332,6 +374,32 @@ void Rig::check_rest(Time due, std::size_t op_index) {
              std::to_string(stops_sent) + " stop frames sent, " + std::to_string(stops_destroyed) +
              " destroyed by faults)");
   }
+}
+
+void Rig::sample_estop(Time due, std::size_t op_index) {
+  const bool running = firmware().state().running;
+  estop_samples.push_back({op_index, due, running, at_rest()});
+  // The next attempt's instant, while the ST:STOP is still owed: not
+  // answered or cancelled, no newer emergency stop, the same link up.
+  const OpRecord& op = ops[op_index];
+  const auto request = estop_st_stop(*this, op);
+  for (std::size_t i = op_index + 1; i < ops.size(); ++i) {
+    if (ops[i].kind == OpRecord::Kind::estop) return;
+  }
+  if (op.links_before == 0 || links.size() != op.links_before ||
+      links[op.links_before - 1].closed) {
+    return;
+  }
+  for (std::size_t i = op.events_before; i < events.size(); ++i) {
+    const auto& e = events[i].second;
+    if (const auto* f = std::get_if<FeedbackEvent>(&e); f && f->request == *request) return;
+    const auto* c = std::get_if<CommandEvent>(&e);
+    if (c && c->request == *request && c->state != CommandState::sent &&
+        c->state != CommandState::uncertain) {
+      return;
+    }
+  }
+  estop_samples_.emplace(due + core().config().feedback_timeout, op_index);
 }
 
 void Rig::on_car_accepted(Time at, const proto::Feedback& fb) {
@@ -494,6 +562,7 @@ void Rig::op_estop() {
   const auto& op = ops[index];
   if (op.state_before == ConnectionState::connected) {
     rest_checks_.emplace(op.at + kStopToRest, index);
+    if (estop_st_stop(*this, op)) estop_samples_.emplace(op.at + kBrakeBound, index);
   }
 }
 

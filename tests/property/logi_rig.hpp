@@ -5,7 +5,8 @@
 // (logi_rig.cpp); rapidcheck commands for operator actions, car-side events
 // and time (logi_commands.cpp); a recorder of everything the client, the
 // wire and the car did; and one named check per rule of the LOGI
-// documentation's sections 5, 9 and 10 (logi_checks.cpp).
+// documentation's sections 5, 9 and 10 (logi_checks.cpp; those of the
+// safety guard, logi_safety_checks.cpp).
 
 #include <rapidcheck.h>
 #include <rapidcheck/state.h>
@@ -15,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,8 +24,8 @@
 #include "client/logi/session.hpp"
 #include "link/link.hpp"
 #include "mocks/logi.hpp"
-#include "tests/property/planted_bug.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/property/planted_bug.hpp"
 
 namespace hil::client::logi::prop {
 
@@ -38,6 +40,8 @@ std::string dir_word(protocol::logi::Direction d);
 std::string ms(Duration d);
 /// A frame's bytes as text (LOGI frames are ASCII).
 std::string text_of(const protocol::Bytes& b);
+/// Whether `m` asks the car to move: MV with a direction, or ST:RUN.
+bool is_movement(const protocol::logi::Message& m);
 
 /// Every session runs this long in virtual time.
 inline constexpr Duration kSessionLength = seconds(60);
@@ -67,6 +71,9 @@ enum class Prop : std::uint8_t {
   stop_on_release,
   stale_after_2s,
   emergency_stop_order,
+  estop_st_stop_resent,
+  car_rests_after_estop,
+  move_timeout_stops,
   mode_conflict,
   safe_state_and_reconfirm,
   bad_checksum_dropped,
@@ -142,6 +149,15 @@ struct OpRecord {
   ConnectionState state_after = ConnectionState::disconnected;  ///< once settled
 };
 
+/// The car at an instant when an emergency stop's ST:STOP attempt, had it
+/// got through, must have stopped it: an attempt's time plus kBrakeBound.
+struct EstopSample {
+  std::size_t op = 0;  ///< index into Rig::ops of the emergency stop
+  Time at{0};
+  bool running = false;  ///< the car was in an auto run
+  bool at_rest = false;  ///< the chassis's wheels were still
+};
+
 /// A command the car accepted, and whether its state then showed it done.
 struct CarAccepted {
   Time at{0};
@@ -203,6 +219,7 @@ class Rig {
   std::vector<CarAccepted> car_accepted;
   /// Chassis checks that made a claim (not voided by later motion or loss).
   std::size_t stop_claims = 0;
+  std::vector<EstopSample> estop_samples;
 
  private:
   class Observer;
@@ -210,6 +227,7 @@ class Rig {
   void on_event(Time now, const Event& e);
   void check_chassis(Time due, std::size_t frame_index);
   void check_rest(Time due, std::size_t op_index);
+  void sample_estop(Time due, std::size_t op_index);
   bool at_rest();
   void on_car_accepted(Time at, const protocol::logi::Feedback& fb);
   OpRecord begin_op(OpRecord::Kind kind, int value);
@@ -220,6 +238,7 @@ class Rig {
   std::shared_ptr<Observer> observer_;
   std::multimap<Time, std::size_t> chassis_checks_;  // due -> index of the stop in car_frames
   std::multimap<Time, std::size_t> rest_checks_;     // due -> index of the release/stop in ops
+  std::multimap<Time, std::size_t> estop_samples_;   // due -> index of the emergency stop in ops
   std::vector<std::string> failures_[static_cast<int>(Prop::count_)];
 };
 
@@ -239,6 +258,52 @@ std::function<rc::Gen<CommandPtr>(const Model&)> gen_command(Focus focus);
 
 /// The check of property `p` over a finished session; empty when it holds.
 std::string check(Prop p, Rig& rig);
+
+// ---- what the checks share ----
+
+/// One event of a request: its index in Rig::events, its time, the event.
+struct Step {
+  std::size_t index;
+  Time at;
+  const Event* e;
+};
+/// Every event of each request, in order (its CommandEvents and
+/// FeedbackEvents; logi_checks.cpp).
+std::map<RequestId, std::vector<Step>> by_request(const Rig& rig);
+
+// ---- the safety guard's checks (logi_safety_checks.cpp) ----
+
+/// Requests written by an emergency stop (exempt from the single queue).
+std::set<RequestId> estop_requests(const Rig& rig);
+/// The request of the ST:STOP emergency stop `op` wrote, if it wrote one.
+std::optional<RequestId> estop_st_stop(const Rig& rig, const OpRecord& op);
+/// The MV:STOPs the client wrote on its own after a move timed out.
+std::set<RequestId> fail_safe_stops(const Rig& rig);
+/// Whether the faults destroyed (dropped or corrupted) a frame to the car
+/// holding `text` at exactly `at`.
+bool destroyed_at(const Rig& rig, Time at, const std::string& text);
+/// Each release of a held direction writes MV:STOP (at once on an idle line).
+std::string check_stop_on_release(const Rig& rig);
+/// The stale warning rises 2 s and 1 ns after the last STAT (or connect),
+/// and only a STAT clears it.
+std::string check_stale(const Rig& rig);
+/// An emergency stop writes MV:STOP, then ST:STOP unless the car is known in MAN.
+std::string check_estop_order(const Rig& rig);
+/// FB:MV:0 for an operator's move: the notice, MD:MAN, one retry.
+std::string check_mode_conflict(const Rig& rig);
+/// The safe state on a lost link; nothing written before the operator acts.
+std::string check_safe_state(Rig& rig);
+/// The emergency stop is never refused while connected and writes MV:STOP at once.
+std::string check_estop_accessible(const Rig& rig);
+/// Every emergency stop's ST:STOP is written at its press and again every
+/// 800 ms until the car answers it or it is cancelled; never uncertain.
+std::string check_estop_st_stop_resent(const Rig& rig);
+/// At the first 800 ms attempt slot of an emergency stop whose ST:STOP the
+/// faults did not destroy, the car stops: 520 ms on it runs no more and rests.
+std::string check_car_rests_after_estop(const Rig& rig);
+/// A timed-out MV:<dir> is not resent, and MV:STOP is the next command
+/// written (at the same instant when nothing else awaits feedback).
+std::string check_move_timeout_stops(const Rig& rig);
 
 /// Whether the session reached the situation property `p` is about (for
 /// the distribution rapidcheck prints: how often each rule was tested).

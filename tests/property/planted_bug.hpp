@@ -5,7 +5,10 @@
 // session over it.
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <iterator>
+#include <string_view>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -17,14 +20,50 @@ namespace hil::client::logi::prop {
 
 enum class PlantedBug : std::uint8_t {
   none,
-  no_backoff,          ///< reconnect at once after every loss
-  retry_run,           ///< ST:RUN is resent after a timeout like SP
-  no_stop_on_release,  ///< release() sends no MV:STOP
-  read_is_frame,       ///< each read is decoded alone: a partial frame is dropped
-  stale_at_5s,         ///< the stale warning waits 5 s instead of stale_after
-  no_sp_retry,         ///< SP is never resent after a timeout
-  st_stop_first,       ///< the emergency stop writes ST:STOP before MV:STOP
+  no_backoff,                  ///< reconnect at once after every loss
+  retry_run,                   ///< ST:RUN is resent after a timeout like SP
+  no_stop_on_release,          ///< release() sends no MV:STOP
+  read_is_frame,               ///< each read is decoded alone: a partial frame is dropped
+  stale_at_5s,                 ///< the stale warning waits 5 s instead of stale_after
+  no_sp_retry,                 ///< SP is never resent after a timeout
+  st_stop_first,               ///< the emergency stop writes ST:STOP before MV:STOP
+  st_stop_once,                ///< the emergency stop's ST:STOP is not resent until answered
+  no_stop_after_move_timeout,  ///< a timed-out MV:<dir> is not followed by MV:STOP
+  stale_at_2s,                 ///< the stale warning rises at exactly 2 s, not after
+  any_frame_clears_stale,      ///< any valid frame (an FB too) counts as fresh telemetry
 };
+
+/// A planted bug and the name HIL_LOGI_PLANTED_BUG gives it.
+struct PlantedBugName {
+  PlantedBug bug;
+  std::string_view name;
+};
+
+/// Every planted bug with its name, `none` first: the one list that names
+/// them, for the properties program and for whatever runs once per bug.
+inline constexpr PlantedBugName kPlantedBugs[] = {
+    {PlantedBug::none, "none"},
+    {PlantedBug::no_backoff, "no_backoff"},
+    {PlantedBug::retry_run, "retry_run"},
+    {PlantedBug::no_stop_on_release, "no_stop_on_release"},
+    {PlantedBug::read_is_frame, "read_is_frame"},
+    {PlantedBug::stale_at_5s, "stale_at_5s"},
+    {PlantedBug::no_sp_retry, "no_sp_retry"},
+    {PlantedBug::st_stop_first, "st_stop_first"},
+    {PlantedBug::st_stop_once, "st_stop_once"},
+    {PlantedBug::no_stop_after_move_timeout, "no_stop_after_move_timeout"},
+    {PlantedBug::stale_at_2s, "stale_at_2s"},
+    {PlantedBug::any_frame_clears_stale, "any_frame_clears_stale"},
+};
+// In the enum's order, one entry per bug: a bug added to the enum must be
+// added here (the last bug's value is the table's last index).
+static_assert([] {
+  for (std::size_t i = 0; i < std::size(kPlantedBugs); ++i) {
+    if (static_cast<std::size_t>(kPlantedBugs[i].bug) != i) return false;
+  }
+  return std::size(kPlantedBugs) ==
+         static_cast<std::size_t>(PlantedBug::any_frame_clears_stale) + 1;
+}());
 
 /// The LOGI client core with `bug` planted (none: the client as shipped).
 class PlantedBugCore : public LogiClientCore {
@@ -46,6 +85,20 @@ class PlantedBugCore : public LogiClientCore {
   }
   Duration stale_after() const override {
     return planted(PlantedBug::stale_at_5s) ? link::seconds(5) : LogiClientCore::stale_after();
+  }
+  Time stale_at(Time last_stat) const override {
+    if (planted(PlantedBug::stale_at_2s)) return last_stat + stale_after();
+    return LogiClientCore::stale_at(last_stat);
+  }
+  bool refreshes_status(const proto::Message& m) const override {
+    return planted(PlantedBug::any_frame_clears_stale) || LogiClientCore::refreshes_status(m);
+  }
+  bool resend_until_answered(const proto::Message& m) const override {
+    return !planted(PlantedBug::st_stop_once) && LogiClientCore::resend_until_answered(m);
+  }
+  bool stop_after_timeout(const proto::Message& m) const override {
+    return !planted(PlantedBug::no_stop_after_move_timeout) &&
+           LogiClientCore::stop_after_timeout(m);
   }
   bool stop_on_release() const override { return !planted(PlantedBug::no_stop_on_release); }
   std::vector<proto::Message> emergency_stop_commands() const override {

@@ -21,6 +21,10 @@
 //   - the stale timer not restarted by each DATA:
 //     DataIsTakenAsSentAndGoesStaleExactly500MsAfterTheLast and
 //     OnACleanLinkEveryTaskEndsWithTheVehiclesAnswer.
+// The bugs of tests/property/wr8_planted_bug.hpp are planted in the client
+// as built (its core's protected rule functions) by Wr8PlantedBugs at the
+// end of this file, which shows that the property named for each catches
+// it from a fixed seed and passes on the same sessions without it.
 // RC_PARAMS="seed=..." printed with a failure replays it.
 
 #include <gtest/gtest.h>
@@ -34,6 +38,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <set>
 #include <string>
 #include <utility>
@@ -50,8 +55,10 @@
 #include "protocol/wr8/codec.hpp"
 #include "sim/presets.hpp"
 #include "tests/client/client_test_support.hpp"
+#include "tests/property/planted_check.hpp"
 #include "tests/property/random_faults.hpp"
 #include "tests/property/session_commands.hpp"
+#include "tests/property/wr8_planted_bug.hpp"
 
 namespace hil::client::wr8 {
 namespace {
@@ -109,13 +116,15 @@ struct Tap : link::LinkObserver {
 enum class OperatorAct : std::uint8_t { connect, disconnect };
 
 struct Wr8Rig {
-  explicit Wr8Rig(link::FaultProfile faults) {
+  /// The client is hil's, with `bug` planted in its core (none: as shipped).
+  explicit Wr8Rig(link::FaultProfile faults, prop::PlantedBug bug = prop::PlantedBug::none) {
     mocks::ServerOptions options = test::on_mem("wr8");
     options.faults = std::move(faults);
     options.observers.push_back(std::make_shared<Tap>(connections));
     car.start_car(sim::wr8_vehicle(), std::move(options), mocks::Wr8Config{});
     session = std::make_unique<Wr8Session>(
-        car.context, link::MemEndpoint{"wr8"}, ClientConfig{}, [this](Time now, const Event& e) {
+        car.context, std::make_unique<prop::PlantedBugCore>(bug, ClientConfig{}),
+        link::MemEndpoint{"wr8"}, [this](Time now, const Event& e) {
           events.emplace_back(now, e);
           if (const auto* r = std::get_if<RequestEvent>(&e)) {
             if (r->state == RequestState::sent) {
@@ -295,8 +304,7 @@ void check_coi_correlation(const Wr8Rig& rig) {
 void check_cancellations(const Wr8Rig& rig) {
   std::set<Time> lost;
   for (const auto& [t, c] : rig.of<ConnectionEvent>()) {
-    if (c.state == ConnectionState::reconnecting ||
-        c.state == ConnectionState::disconnected)
+    if (c.state == ConnectionState::reconnecting || c.state == ConnectionState::disconnected)
       lost.insert(t);
   }
   for (const auto& [t, r] : rig.of<RequestEvent>()) {
@@ -600,11 +608,12 @@ struct CarMisbehaves : Wr8Command {
 /// disconnects and connects (each submit checks the COI or the refusal at
 /// once), then 40 s for every answer, timeout and reconnect to play out;
 /// `check` reads the whole run.
-void after_a_random_session(void (*check)(const Wr8Rig&)) {
+void after_a_random_session(void (*check)(const Wr8Rig&),
+                            prop::PlantedBug bug = prop::PlantedBug::none) {
   // Faults that keep the oracle sound. WR8 packets carry no checksum, so a
   // corrupted COI or code would be a different valid packet that no client
   // can tell from the real one: corruption and byte drops are left out.
-  Wr8Rig rig(*hil::test::gen_faults_without_corruption(25, 400, 4000));
+  Wr8Rig rig(*hil::test::gen_faults_without_corruption(25, 400, 4000), bug);
   rig.acts.emplace_back(rig.now(), OperatorAct::connect);
   rig.session->connect();
   rc::state::check(
@@ -673,6 +682,56 @@ RC_GTEST_PROP(Wr8ClientProperties, OnACleanLinkEveryTaskEndsWithTheVehiclesAnswe
   RC_ASSERT(rig.of<LoginEvent>().size() == 1u);
   RC_ASSERT(rig.connections.size() == 1u);
 }
+
+// ---- the properties have teeth ----
+// Each bug of tests/property/wr8_planted_bug.hpp, planted in the client on
+// its own, makes the property named for it fail within a fixed number of
+// random sessions (from one fixed seed, tests/property/planted_check.hpp),
+// and the same property passes on the same sessions without the bug.
+
+struct PlantedCase {
+  const char* name;
+  prop::PlantedBug bug;
+  const char* property;
+  void (*check)(const Wr8Rig&);
+};
+
+rc::detail::TestResult run_planted(const PlantedCase& c, prop::PlantedBug bug, int sessions) {
+  return logi::prop::run_planted(c.property, sessions,
+                                 [&c, bug] { after_a_random_session(c.check, bug); });
+}
+
+// The case's name in CTest's name for it, instead of its bytes.
+void PrintTo(const PlantedCase& c, std::ostream* os) {
+  *os << c.name;
+}
+
+class Wr8PlantedBugs : public ::testing::TestWithParam<PlantedCase> {};
+
+TEST_P(Wr8PlantedBugs, IsCaughtByItsPropertyWhichPassesWithoutIt) {
+  const PlantedCase& c = GetParam();
+  logi::prop::expect_caught_and_clean(c.property, c.name, [&c](bool planted, int sessions) {
+    return run_planted(c, planted ? c.bug : prop::PlantedBug::none, sessions);
+  });
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Wr8, Wr8PlantedBugs,
+    ::testing::Values(
+        PlantedCase{"TaskBeforeAuthReply", prop::PlantedBug::task_before_auth,
+                    "NothingButAuthGoesOutBeforeTheLoginOnEveryConnection", check_login_first},
+        PlantedCase{"NewestTaskAnswer", prop::PlantedBug::newest_task_answer,
+                    "EveryAnswerMatchesItsOpenRequestByCoiAcrossTheWrapAndEveryTimeoutComesOnTime",
+                    check_coi_correlation},
+        // End to end: an answer given to the wrong request ends a drive short.
+        PlantedCase{"NewestTaskAnswerEndsADriveShort", prop::PlantedBug::newest_task_answer,
+                    "ADriveReportedCompletedHasMovedTheCarItsDistance", check_drives},
+        PlantedCase{"NoBackoff", prop::PlantedBug::no_backoff,
+                    "ReconnectsBackOff1248SAndALoginWithoutReplyFailsAtExactly2S",
+                    check_reconnects}),
+    [](const ::testing::TestParamInfo<PlantedCase>& param) {
+      return std::string(param.param.name);
+    });
 
 }  // namespace
 }  // namespace hil::client::wr8

@@ -9,19 +9,15 @@
 # gets answers it cannot tell apart from its requests' and reports results
 # it never saw.
 #
-# Everything else is arduino_good.py, so a scenario that checks the order
-# of requests and answers on the wire is what rejects it.
+# It is arduino_good.py with that one bug planted (`--bug pipelining`), so a
+# scenario that checks the order of requests and answers on the wire is
+# what rejects it.
 #
 # Usage: arduino_pipelining_bug.py PTY
 
+import sys
+
 import arduino_good
 
-
-class PipeliningClient(arduino_good.ArduinoClient):
-    def request(self, cmd, payload):
-        self.send(cmd, payload)
-        arduino_good.say("ok %s" % cmd)
-
-
 if __name__ == "__main__":
-    arduino_good.run(PipeliningClient)
+    sys.exit(arduino_good.main(["--bug", "pipelining"] + sys.argv[1:]))

@@ -8,16 +8,26 @@
 # It is written from the LOGI protocol notes alone (no hil code), the way a
 # client team would write theirs: a stream-safe frame parser, one command
 # in flight with an 800 ms feedback timeout, SP/MD/MV:STOP retried twice,
-# ST:RUN and GS never resent without "confirm", reconnect after 1 s, 2 s,
-# 3 s and then every 3 s, a stale warning after 2 s without STAT, and
-# movement refused until a mode and a speed were sent on the connection.
+# ST:RUN and GS never resent without "confirm", MV:STOP after a move that
+# got no feedback, the emergency stop's ST:STOP repeated every timeout
+# until the car answers it, reconnect after 1 s, 2 s, 3 s and then every
+# 3 s, a stale warning after more than 2 s without STAT (cleared only by
+# a STAT, on this connection or the next), movement refused (and reported
+# disabled) until a mode and a speed were sent on the connection, and each
+# dropped frame reported as a parse error. Each action runs as its own
+# task, so an estop that arrives while a slow command waits goes out at
+# once; result lines still come in the order the actions came.
 #
 # The deliberately broken clients next to it (logi_*_bug.py) are this
 # client with one method replaced, so the gate can show that it rejects
-# exactly that bug.
+# exactly that bug. `--bug NAME` plants one more realistic bug, a small
+# change to this file's own code, so the LOGI scenario library's gate
+# tests can show which scenario rejects it (BUGS below lists them).
 #
-# Usage: logi_good.py HOST PORT   (or HIL_HOST / HIL_PORT in the environment)
+# Usage: logi_good.py [--bug NAME] HOST PORT
+#        (or HIL_HOST / HIL_PORT in the environment)
 
+import argparse
 import asyncio
 import os
 import signal
@@ -32,30 +42,57 @@ STALE_AFTER_S = 2.0
 CONNECT_TIMEOUT_S = 10.0
 DIRECTIONS = ("STOP", "FWD", "BWD", "LEFT", "RIGHT", "LF", "RF", "LB", "RB", "CW", "CCW")
 
+# The bugs `--bug NAME` plants, each the rule of the LOGI car's
+# documentation that it breaks.
+BUGS = {
+    "backoff-never-restarts":
+        "the reconnect waits keep growing after a connection that was up (section 5.1)",
+    "estop-st-stop-first":
+        "the emergency stop writes ST:STOP before MV:STOP (section 5.5)",
+    "exit-without-stop":
+        "at the end of stdin it disconnects without stopping a car that may be moving",
+    "drop-keeps-in-flight":
+        "a dropped connection cancels the queue but not the command in flight, which times out later",
+    "retry-moves":
+        "a move (MV:<dir>) is resent after a feedback timeout, like SP (section 5.3)",
+    "retry-gs":
+        "GS is resent after a feedback timeout without the operator's confirmation (section 5.3)",
+    "any-frame-fresh":
+        "any valid frame, FB included, clears the stale warning, not only STAT (section 5.5)",
+}
+
 
 def build_frame(payload):
     base = "LOGI:" + payload
     return "%s:%02X#" % (base, sum(base.encode("ascii")) & 0xFF)
 
 
-def frame_payload(raw):
-    """The payload of one whole frame (bytes), or None if it is not a valid one."""
+def check_frame(raw):
+    """(payload, None) for a valid whole frame (bytes), or (None, why) with
+    why naming what was wrong: "bad_format: ..." or "bad_checksum: ..."."""
     try:
         text = raw.decode("ascii")
     except UnicodeDecodeError:
-        return None
+        return None, "bad_format: a byte outside ASCII"
     if not text.startswith("LOGI:") or not text.endswith("#"):
-        return None
+        return None, "bad_format: not a LOGI:...# frame"
     base, sep, cs = text[:-1].rpartition(":")
-    if not sep or len(cs) != 2 or cs != cs.upper():
-        return None
-    try:
-        if int(cs, 16) != sum(base.encode("ascii")) & 0xFF:
-            return None
-    except ValueError:
-        return None
+    if not sep or len(base) <= len("LOGI"):
+        return None, "bad_format: no ':' before the checksum"
+    if len(cs) != 2 or cs != cs.upper() or any(ch not in "0123456789ABCDEF" for ch in cs):
+        return None, "bad_format: checksum '%s' is not two uppercase hex digits" % cs
+    expected = sum(base.encode("ascii")) & 0xFF
+    if int(cs, 16) != expected:
+        return None, "bad_checksum: checksum %s, computed %02X" % (cs, expected)
     payload = base[len("LOGI:"):]
-    return payload or None
+    if not payload:
+        return None, "bad_format: an empty payload"
+    return payload, None
+
+
+def frame_payload(raw):
+    """The payload of one whole frame (bytes), or None if it is not a valid one."""
+    return check_frame(raw)[0]
 
 
 class StreamFrames:
@@ -66,6 +103,8 @@ class StreamFrames:
 
     def __init__(self):
         self.buf = b""
+        self.skipped = 0  # bytes discarded since the last header
+        self.garbage = []  # how many bytes each run of garbage had, once a header ended it
 
     def feed(self, data):
         self.buf += data
@@ -74,8 +113,14 @@ class StreamFrames:
             start = self.buf.find(b"LOGI:")
             if start < 0:
                 # Keep what could be the start of a header cut in two.
+                self.skipped += max(0, len(self.buf) - 4)
                 self.buf = self.buf[-4:]
                 return frames
+            if start > 0 or self.skipped:
+                self.garbage.append(self.skipped + start)
+                self.skipped = 0
+                self.buf = self.buf[start:]
+                start = 0
             end = self.buf.find(b"#", start)
             if end < 0:
                 self.buf = self.buf[start:]
@@ -86,6 +131,7 @@ class StreamFrames:
             # A header inside the candidate: the frame before it was cut off.
             restart = self.buf.rfind(b"LOGI:", start + 1, end)
             if restart >= 0:
+                self.garbage.append(restart - start)
                 start = restart
             frames.append(self.buf[start:end + 1])
             self.buf = self.buf[end + 1:]
@@ -110,9 +156,10 @@ class Command:
 
 
 class LogiClient:
-    def __init__(self, host, port):
+    def __init__(self, host, port, bug=None):
         self.host = host
         self.port = port
+        self.bug = bug  # one of BUGS, or None for the correct client
         self.loop = asyncio.get_running_loop()
         self.state = "disconnected"
         self.want_connected = False
@@ -129,6 +176,7 @@ class LogiClient:
         self.stale = False
         self.stale_timer = None
         self.confirmable = None
+        self.movement_reported = None  # the movement state last reported, once one was
 
     # ---- hooks the broken clients replace ----
 
@@ -143,6 +191,7 @@ class LogiClient:
     def set_state(self, state):
         self.state = state
         say("event connection " + state)
+        self.update_movement()
         if state == "connected":
             for w in self.connected_waiters:
                 if not w.done():
@@ -170,7 +219,7 @@ class LogiClient:
                 if not self.want_connected:
                     return
                 self.lost()
-            if got_valid_frame:
+            if got_valid_frame and self.bug != "backoff-never-restarts":
                 failures = 0
             self.set_state("reconnecting")
             await asyncio.sleep(self.reconnect_delay(failures))
@@ -187,10 +236,15 @@ class LogiClient:
                 data = b""
             if not data:
                 return any_valid
-            for raw in frames.feed(data):
-                payload = frame_payload(raw)
+            got = frames.feed(data)
+            for count in getattr(frames, "garbage", ()):
+                say("event parse_error garbage: %d bytes that start no frame" % count)
+            if hasattr(frames, "garbage"):
+                frames.garbage = []
+            for raw in got:
+                payload, why = check_frame(raw)
                 if payload is None:
-                    sys.stderr.write("dropped a bad frame: %r\n" % raw)
+                    say("event parse_error " + why)
                     continue
                 any_valid = True
                 self.on_frame(payload)
@@ -208,10 +262,12 @@ class LogiClient:
         self.mode_sent = self.speed_sent = False
         self.confirmable = None
         self.last_status = {}
-        self.stale = False
-        for c in self.in_flight + self.queue:
+        # The stale warning stays up until a STAT arrives, on this connection or the next.
+        dropped = self.queue if self.bug == "drop-keeps-in-flight" else self.in_flight + self.queue
+        for c in list(dropped):
             self.finish(c, "cancelled")
-        self.in_flight = []
+        if self.bug != "drop-keeps-in-flight":
+            self.in_flight = []
         self.queue = []
 
     async def connect(self):
@@ -253,6 +309,11 @@ class LogiClient:
             say("event stale")
 
     def on_frame(self, payload):
+        if self.bug == "any-frame-fresh":
+            if self.stale:
+                self.stale = False
+                say("event fresh")
+            self.arm_stale()
         if payload.startswith("STAT:"):
             fields = {}
             for item in payload[len("STAT:"):].split(","):
@@ -318,13 +379,28 @@ class LogiClient:
 
     def on_timeout(self, c):
         c.timer = None
-        if c.retries_left > 0 and self.writer is not None:
+        if (c.retries_left > 0 or self.resent_anyway(c)) and self.writer is not None:
             c.retries_left -= 1
+            self.send(c)
+            return
+        if c.emergency and c.kind == "ST:STOP" and self.writer is not None:
+            # The stop that ends an auto run: repeated until the car answers.
             self.send(c)
             return
         if c.kind in ("ST:RUN", "GS"):
             self.confirmable = c
+        if c.kind.startswith("MV:") and c.kind != "MV:STOP":
+            # The car may have taken the move: fail safe with MV:STOP, first in line.
+            self.queue.insert(0, Command("MV:STOP", "MV:STOP", self.loop))
         self.finish(c, "uncertain")
+
+    def resent_anyway(self, c):
+        """Whether a planted bug resends a command the rules say must not be."""
+        if c.sends > MAX_RETRIES:
+            return False
+        if self.bug == "retry-moves" and c.kind.startswith("MV:"):
+            return True
+        return self.bug == "retry-gs" and c.kind == "GS"
 
     def pump(self):
         """One command in flight: the next one goes when the line is free."""
@@ -351,8 +427,21 @@ class LogiClient:
         if result == "rejected":
             return False, "rejected by the car (FB:%s:0)" % kind.split(":")[0]
         if result == "uncertain":
-            return False, "no feedback to %s, uncertain" % kind
+            why = "no feedback to %s, uncertain" % kind
+            if kind in ("ST:RUN", "GS"):
+                why += "; 'confirm' sends it again"
+            return False, why
         return False, "cancelled: the connection was lost"
+
+    def update_movement(self):
+        """Reports the movement controls enabled or disabled when that changes."""
+        refused = self.movement_refused()
+        enabled = refused is None
+        if self.movement_reported == enabled:
+            return
+        self.movement_reported = enabled
+        say("event movement enabled" if enabled else "event movement disabled " +
+            ("not connected" if self.state != "connected" else "mode and speed not sent"))
 
     def movement_refused(self):
         if self.state != "connected":
@@ -372,6 +461,8 @@ class LogiClient:
         stops = [Command("MV:STOP", "MV:STOP", self.loop)]
         if self.known_mode != "MAN":
             stops.append(Command("ST:STOP", "ST:STOP", self.loop))
+        if self.bug == "estop-st-stop-first":
+            stops.reverse()
         for c in stops:
             c.emergency = True
             c.mode_switch_left = 0
@@ -403,12 +494,14 @@ class LogiClient:
             ok, why = await self.command("SP:%03d" % int(arg), "SP")
             if ok:
                 self.speed_sent = True
+                self.update_movement()
             return ok, why
         if verb == "mode" and arg is not None and arg.upper() in ("MAN", "AUTO"):
             m = arg.upper()
             ok, why = await self.command("MD:" + m, "MD:" + m)
             if ok:
                 self.mode_sent = True
+                self.update_movement()
             return ok, why
         if verb == "press" and arg is not None and arg.upper() in DIRECTIONS:
             d = arg.upper()
@@ -449,7 +542,7 @@ class LogiClient:
         return False, "not an action this client knows"
 
     async def shut_down(self):
-        if self.state == "connected" and self.may_be_moving():
+        if self.state == "connected" and self.may_be_moving() and self.bug != "exit-without-stop":
             try:
                 await asyncio.wait_for(self.emergency_stop(), 3.0)
             except asyncio.TimeoutError:
@@ -475,40 +568,73 @@ def stdin_lines(loop, queue):
     loop.call_soon_threadsafe(queue.put_nowait, None)
 
 
+def parse_args():
+    parser = argparse.ArgumentParser(description="A LOGI client for hil's external-client contract")
+    parser.add_argument("host", nargs="?", default=os.environ.get("HIL_HOST", "127.0.0.1"))
+    parser.add_argument("port", nargs="?", type=int, default=int(os.environ.get("HIL_PORT", "9000")))
+    parser.add_argument("--bug", choices=sorted(BUGS), metavar="NAME",
+                        help="plant one known bug: " + "; ".join(
+                            "%s: %s" % (name, what) for name, what in sorted(BUGS.items())))
+    return parser.parse_args()
+
+
+def say_result(text, act):
+    if not act.done():
+        act.cancel()
+        say("fail %s: cancelled" % text)
+        return
+    ok, why = act.result()
+    say("ok " + text if ok else "fail %s: %s" % (text, why))
+
+
+async def report_in_order(pending, wake):
+    """Prints each action's result line once it has ended, in the order the
+    actions came, however they overlap (an estop beside a slow speed)."""
+    while True:
+        while pending and pending[0][1].done():
+            say_result(*pending.pop(0))
+        if pending:
+            await asyncio.wait([pending[0][1]])
+            continue
+        wake.clear()
+        await wake.wait()
+
+
 async def main(client_class):
-    host = sys.argv[1] if len(sys.argv) > 1 else os.environ.get("HIL_HOST", "127.0.0.1")
-    port = int(sys.argv[2] if len(sys.argv) > 2 else os.environ.get("HIL_PORT", "9000"))
+    args = parse_args()
     loop = asyncio.get_running_loop()
-    client = client_class(host, port)
+    client = client_class(args.host, args.port, args.bug)
     lines = asyncio.Queue()
     threading.Thread(target=stdin_lines, args=(loop, lines), daemon=True).start()
     stop = loop.create_future()
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, lambda: stop.done() or stop.set_result(True))
+    # Each action runs as its own task, so one that arrives while another is
+    # under way (a scheduled estop) is carried out at once.
+    pending = []
+    wake = asyncio.Event()
+    reporter = loop.create_task(report_in_order(pending, wake))
     while True:
         get = loop.create_task(lines.get())
         await asyncio.wait([get, stop], return_when=asyncio.FIRST_COMPLETED)
         if stop.done():
             get.cancel()
-            await client.shut_down()
-            return 130
+            break
         line = get.result()
         if line is None:
             break
         text = line.split("#")[0].strip()
-        if not text:
-            continue
-        act = loop.create_task(client.action(text))
-        await asyncio.wait([act, stop], return_when=asyncio.FIRST_COMPLETED)
-        if not act.done():
-            act.cancel()
-            say("fail %s: cancelled" % text)
-            await client.shut_down()
-            return 130
-        ok, why = act.result()
-        say("ok " + text if ok else "fail %s: %s" % (text, why))
+        if text:
+            pending.append((text, loop.create_task(client.action(text))))
+            wake.set()
+    if pending and not stop.done():
+        everything = asyncio.gather(*(act for _, act in pending), return_exceptions=True)
+        await asyncio.wait([everything, stop], return_when=asyncio.FIRST_COMPLETED)
+    reporter.cancel()
+    for text, act in list(pending):
+        say_result(text, act)
     await client.shut_down()
-    return 0
+    return 130 if stop.done() else 0
 
 
 def run(client_class=LogiClient):
