@@ -60,3 +60,17 @@ if(hil_linker STREQUAL "mold")
   add_link_options(-fuse-ld=mold)
 endif()
 message(STATUS "hil linker: ${hil_linker}")
+
+# Compressed debug sections: every program's line tables are written
+# zlib-compressed (gdb, llvm-symbolizer and the sanitizers read them). A
+# tree's programs take about a third less disk (a test program: 23.0 MB
+# against 15.1 MB) for no measurable link time; the full CI run holds three
+# trees on one disk (docs/ci.md, "Disk").
+option(HIL_COMPRESS_DEBUG_SECTIONS "Link programs with zlib-compressed debug sections" ON)
+if(HIL_COMPRESS_DEBUG_SECTIONS)
+  include(CheckLinkerFlag)
+  check_linker_flag(CXX -Wl,--compress-debug-sections=zlib HIL_HAS_COMPRESS_DEBUG_SECTIONS)
+  if(HIL_HAS_COMPRESS_DEBUG_SECTIONS)
+    add_link_options(-Wl,--compress-debug-sections=zlib)
+  endif()
+endif()
