@@ -52,12 +52,25 @@ print_times() {
       $((stage_seconds[i] / 60)) $((stage_seconds[i] % 60))
   done
   printf '  %-34s %5d s  (%d min %02d s)\n' "total" "$total" $((total / 60)) $((total % 60))
+  local tree sizes=()
+  for tree in build build-asan build-tsan; do
+    [ ! -d "$tree" ] || sizes+=("$tree $(gib "$(tree_kib "$tree")")")
+  done
+  local joined
+  joined=$(printf '%s, ' "${sizes[@]}")
+  echo "trees: ${joined%, }; disk: $(gib "$(free_kib)") free"
 }
 on_exit() {
   local status=$?
   if [ "$status" -ne 0 ]; then
     stage ""
     print_times
+    local free
+    free=$(free_kib)
+    if [ "$free" -lt 1048576 ]; then
+      echo "ci/run-tests.sh: the disk that holds $(pwd) has $(gib "$free") free: a build or" \
+        "test that failed may have found it full (docs/ci.md, \"Disk\")" >&2
+    fi
   fi
   rm -f "$log"
   exit "$status"
@@ -65,8 +78,33 @@ on_exit() {
 log=$(mktemp)
 trap on_exit EXIT
 
+# Disk: the trees a run builds need room on the disk that holds them
+# (docs/ci.md, "Disk"). A disk with less free space than the run still
+# needs gets a warning at the start; a failed run says how much was left.
+gib() { awk -v k="$1" 'BEGIN { printf "%.1f GiB", k / 1048576 }'; }
+free_kib() { df -Pk . | awk 'NR == 2 { print $4 }'; }
+tree_kib() { du -sk "$@" 2>/dev/null | awk '{ s += $1 } END { print s + 0 }'; }
+disk_check() {
+  # The trees' sizes in KiB, as measured in docs/ci.md, with room for the
+  # tests' scratch files.
+  local need=$((2 * 1048576)) trees=(build)
+  if [ "$default_only" = 0 ]; then
+    [ "${HIL_SKIP_ASAN:-0}" = 1 ] || { need=$((need + 4 * 1048576)); trees+=(build-asan); }
+    [ "${HIL_SKIP_TSAN:-0}" = 1 ] || { need=$((need + 1048576)); trees+=(build-tsan); }
+  fi
+  local have free
+  have=$(tree_kib "${trees[@]}")
+  free=$(free_kib)
+  echo "disk: $(gib "$free") free; this run's trees need about $(gib "$need") ($(gib "$have") built already)"
+  if [ $((free + have)) -lt "$need" ]; then
+    echo "ci/run-tests.sh: warning: the disk that holds $(pwd) has $(gib "$free") free, and" \
+      "this run needs about $(gib $((need - have))) more; a build may stop with 'Disk full'" >&2
+  fi
+}
+
 stage "install dependencies"
 bash ci/install-deps.sh
+disk_check
 
 # Number of tests CTest ran, from its closing line ("... out of N").
 ran() { sed -n 's/.*tests failed out of \([0-9]*\).*/\1/p' "$log" | tail -1; }
