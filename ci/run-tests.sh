@@ -56,8 +56,8 @@ print_times() {
   for tree in build build-asan build-tsan; do
     [ ! -d "$tree" ] || sizes+=("$tree $(gib "$(tree_kib "$tree")")")
   done
-  local joined
-  joined=$(printf '%s, ' "${sizes[@]}")
+  local joined="none"
+  [ "${#sizes[@]}" = 0 ] || joined=$(printf '%s, ' "${sizes[@]}")
   echo "trees: ${joined%, }; disk: $(gib "$(free_kib)") free"
 }
 on_exit() {
@@ -83,7 +83,8 @@ trap on_exit EXIT
 # needs gets a warning at the start; a failed run says how much was left.
 gib() { awk -v k="$1" 'BEGIN { printf "%.1f GiB", k / 1048576 }'; }
 free_kib() { df -Pk . | awk 'NR == 2 { print $4 }'; }
-tree_kib() { du -sk "$@" 2>/dev/null | awk '{ s += $1 } END { print s + 0 }'; }
+# The size of the trees that exist among "$@" (0 when none does).
+tree_kib() { { du -sk "$@" 2>/dev/null || true; } | awk '{ s += $1 } END { print s + 0 }'; }
 disk_check() {
   # The trees' sizes in KiB, as measured in docs/ci.md, with room for the
   # tests' scratch files.
