@@ -87,7 +87,7 @@ protocol::Bytes bytes_of(const nlohmann::json& record) {
 
 std::shared_ptr<WireLog> WireLog::open(const std::filesystem::path& path, WireLogOptions options,
                                        std::error_code& ec) {
-  auto file = CaptureFile::open(path, CaptureFile::Mode::append, ec);
+  auto file = CaptureFile::open(path, options.mode, ec);
   if (!file) return nullptr;
   return std::shared_ptr<WireLog>(new WireLog(path, std::move(*file), std::move(options)));
 }
@@ -183,6 +183,12 @@ void WireLog::on_close(Time at, const LinkClose& close) {
     }
   }
   if (!leftovers.empty()) r["unfinished"] = std::move(leftovers);
+  write_line(r);
+}
+
+void WireLog::on_note(Time at, const char* event, const nlohmann::ordered_json& fields) {
+  auto r = record(event, at);
+  for (const auto& [key, value] : fields.items()) r[key] = value;
   write_line(r);
 }
 

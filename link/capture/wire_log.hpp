@@ -27,6 +27,9 @@ struct WireLogOptions {
   std::shared_ptr<const ProtocolAdapter> protocol;
   /// Source of "wall_us"; wall_time_us() when empty. Tests pin it.
   std::function<std::int64_t()> wall_clock_us;
+  /// `append` (the default) adds to the file, so several links may share
+  /// it; `truncate` starts it empty (a probe capture is one file per run).
+  CaptureFile::Mode mode = CaptureFile::Mode::append;
 };
 
 /// A LinkObserver that appends one NDJSON record per event to a file. Each
@@ -49,6 +52,9 @@ class WireLog final : public LinkObserver {
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override;
   void on_fault(const FaultEvent& event) override;
   void on_close(Time at, const LinkClose& close) override;
+  /// A record of a kind the link itself never writes (a probe's `exchange`
+  /// markers): `link`, `event`, `t_ms` and `wall_us`, then `fields`.
+  void on_note(Time at, const char* event, const nlohmann::ordered_json& fields);
 
   /// The first write error, if any; later records are still attempted.
   std::error_code error() const { return file_.error(); }
