@@ -112,6 +112,8 @@ void register_world(CLI::App& app, std::function<int()>& run);
 void register_mock(CLI::App& app, std::function<int()>& run);
 /// `hil run`: scenario files, the table, JUnit and the report folder (apps/hil/run_command.cpp).
 void register_run(CLI::App& app, std::function<int()>& run);
+/// `hil conform probe` and `hil conform check` (conform_command.cpp).
+void register_conform(CLI::App& app, std::function<int()>& run);
 /// hil profiles [CAR]: the registry of car profiles (protocol/common/car_profile.hpp).
 void register_profiles(CLI::App& app, std::function<int()>& run);
 

@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
       "  hil world render scenarios/worlds/corridor.yaml -o corridor.svg\n"
       "  hil run scenarios/ --junit hil.xml --report-dir hil-report\n"
       "  hil profiles                                each car's dialects and their sources\n"
+      "  hil conform probe arduino --target pty:///dev/ttyUSB0 -o car.ndjson\n"
+      "  hil conform check car.ndjson --all-profiles  which profile the car plays\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode =
@@ -47,6 +49,7 @@ int main(int argc, char** argv) {
   hil::apps::register_mock(app, run);
   hil::apps::register_run(app, run);
   hil::apps::register_profiles(app, run);
+  hil::apps::register_conform(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&
