@@ -69,14 +69,24 @@ SideFrames cut(const Capture& capture, const Probe& probe, const link::ProtocolA
   return side;
 }
 
+bool is_text(const protocol::Bytes& raw) {
+  return !raw.empty() && std::all_of(raw.begin(), raw.end(), [](std::uint8_t b) {
+    return (b >= 0x20 && b < 0x7F) || b == '\r' || b == '\n' || b == '\t';
+  });
+}
+
+// A frame for a person: a text frame (LOGI, Arduino, a Leka robot's line)
+// as its text with CR and LF escaped; a binary one as its kind and hex.
 std::string frame_text(const link::ProtocolAdapter& adapter, const link::WireFrame& frame) {
   std::string text;
-  if (adapter.text_frames()) {
+  if (adapter.text_frames() || is_text(frame.raw)) {
     for (const auto b : frame.raw) {
       if (b == '\r') {
         text += "\\r";
       } else if (b == '\n') {
         text += "\\n";
+      } else if (b == '\t') {
+        text += "\\t";
       } else if (b >= 0x20 && b < 0x7F) {
         text.push_back(static_cast<char>(b));
       } else {
