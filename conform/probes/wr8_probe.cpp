@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "conform/probe.hpp"
+#include "conform/probes/probe_builder.hpp"
 #include "protocol/wr8/codec.hpp"
 #include "protocol/wr8/message.hpp"
 #include "protocol/wr8/svgui.hpp"
@@ -35,45 +35,6 @@ using std::chrono::milliseconds;
 constexpr Duration kByteGap = milliseconds(5);
 /// An answer over TCP on Wi-Fi, and then some.
 constexpr Duration kReply = milliseconds(300);
-
-Bytes join(std::initializer_list<Bytes> parts) {
-  Bytes out;
-  for (const auto& p : parts)
-    out.insert(out.end(), p.begin(), p.end());
-  return out;
-}
-
-Bytes text_bytes(std::string_view text) {
-  return Bytes(text.begin(), text.end());
-}
-
-std::vector<ProbeWrite> once(Bytes bytes) {
-  return {ProbeWrite{Duration{0}, std::move(bytes)}};
-}
-
-std::vector<ProbeWrite> byte_by_byte(const Bytes& bytes) {
-  std::vector<ProbeWrite> writes;
-  for (const auto b : bytes)
-    writes.push_back({writes.empty() ? Duration{0} : kByteGap, Bytes{b}});
-  return writes;
-}
-
-class Builder {
- public:
-  explicit Builder(Probe& probe) : probe_(probe) {}
-
-  void add(std::string name, std::string what, ExchangeKind kind, std::vector<ProbeWrite> writes,
-           Duration listen = kReply, bool physical = false) {
-    probe_.exchanges.push_back(
-        {std::move(name), std::move(what), kind, std::move(writes), physical, listen});
-  }
-  void connect(std::string name, std::string what, Duration listen = kReply) {
-    add(std::move(name), std::move(what), ExchangeKind::connect, {}, listen);
-  }
-
- private:
-  Probe& probe_;
-};
 
 // ------------------------------------------------------------- document
 
@@ -115,72 +76,78 @@ constexpr float kI = 0.25F;
 constexpr float kD = 0.05F;
 constexpr std::int32_t kServoZero = 90;
 
-void document_login(Builder& b) {
+void document_login(ProbeBuilder& b) {
   using wr8::TaskCode;
   b.add("task-before-auth", "TASK check (COI 1) before any AUTH: dropped unanswered",
-        ExchangeKind::error, once(doc_task(1, TaskCode::check)));
+        ExchangeKind::error, ProbeBuilder::once(doc_task(1, TaskCode::check)));
   b.add("auth-bad", "AUTH with a wrong 10-byte string: no answer, the car closes after 1 s",
-        ExchangeKind::error, once(doc_auth("HIL-WR8-00")), milliseconds(1500));
+        ExchangeKind::error, ProbeBuilder::once(doc_auth("HIL-WR8-00")), milliseconds(1500));
   b.connect("reconnect-after-refusal", "open a new connection after the refused login");
   b.add("auth", "AUTH with the profile's string: AUTH-REPLY (device, id, state now)",
-        ExchangeKind::command, once(doc_good_auth()), kReply, true);
+        ExchangeKind::command, ProbeBuilder::once(doc_good_auth()), kReply, true);
   b.add("auth-again", "AUTH again while logged in: AUTH-REPLY again", ExchangeKind::command,
-        once(doc_good_auth()), kReply, true);
+        ProbeBuilder::once(doc_good_auth()), kReply, true);
 }
 
-void document_commands(Builder& b) {
+void document_commands(ProbeBuilder& b) {
   using wr8::SettingCode;
   using wr8::TaskCode;
-  b.add("empty", "EMPTY keepalive: no answer", ExchangeKind::command, once(doc(wr8::Empty{})));
+  b.add("empty", "EMPTY keepalive: no answer", ExchangeKind::command,
+        ProbeBuilder::once(doc(wr8::Empty{})));
   b.add("check", "TASK check COI 2: RESPONSE completed", ExchangeKind::command,
-        once(doc_task(2, TaskCode::check)));
+        ProbeBuilder::once(doc_task(2, TaskCode::check)));
   b.add("check-coi-0", "TASK check COI 0 (the lowest COI)", ExchangeKind::boundary,
-        once(doc_task(0, TaskCode::check)));
+        ProbeBuilder::once(doc_task(0, TaskCode::check)));
   b.add("check-coi-255", "TASK check COI 255 (the highest COI)", ExchangeKind::boundary,
-        once(doc_task(255, TaskCode::check)));
+        ProbeBuilder::once(doc_task(255, TaskCode::check)));
   b.add("get-settings", "TASK get-settings COI 3: SETTINGS with all four, then completed",
-        ExchangeKind::command, once(doc_task(3, TaskCode::get_settings)));
+        ExchangeKind::command, ProbeBuilder::once(doc_task(3, TaskCode::get_settings)));
   b.add("settings", "SETTINGS COI 4 P 1.5 I 0.25 D 0.05 servo zero 90: completed",
-        ExchangeKind::command, once(doc_settings(4, kP, kI, kD, kServoZero)));
+        ExchangeKind::command, ProbeBuilder::once(doc_settings(4, kP, kI, kD, kServoZero)));
   b.add("settings-no-entries", "SETTINGS COI 5 with no entries: completed", ExchangeKind::boundary,
-        once(doc(wr8::Settings{5, {}})));
+        ProbeBuilder::once(doc(wr8::Settings{5, {}})));
   b.add("settings-min", "SETTINGS COI 6 P I D 0, servo zero 0 (each field's lowest): completed",
-        ExchangeKind::boundary, once(doc_settings(6, 0, 0, 0, 0)), milliseconds(500));
+        ExchangeKind::boundary, ProbeBuilder::once(doc_settings(6, 0, 0, 0, 0)), milliseconds(500));
   // Sent while every gain is 0: a car that takes 1001 cm against its
   // document then has no gain to drive with.
   b.add("drive-over-max", "TASK drive 1001 cm COI 23 with every gain 0: error", ExchangeKind::error,
-        once(doc_task(23, TaskCode::drive, {i32(1001)})));
+        ProbeBuilder::once(doc_task(23, TaskCode::drive, {i32(1001)})));
   b.add("settings-max", "SETTINGS COI 8 P I D 100, servo zero 180 (each field's highest)",
-        ExchangeKind::boundary, once(doc_settings(8, 100, 100, 100, 180)), milliseconds(500));
+        ExchangeKind::boundary, ProbeBuilder::once(doc_settings(8, 100, 100, 100, 180)),
+        milliseconds(500));
   const float above_max_gain = std::nextafter(100.0F, 1000.0F);
   b.add("settings-p-over", "SETTINGS COI 9 P just above 100 (the next float32): error",
         ExchangeKind::error,
-        once(doc_setting(9, SettingCode::p, wr8::Word::from_f32(above_max_gain))));
+        ProbeBuilder::once(doc_setting(9, SettingCode::p, wr8::Word::from_f32(above_max_gain))));
   b.add("settings-i-negative", "SETTINGS COI 10 I -0.5: error", ExchangeKind::error,
-        once(doc_setting(10, SettingCode::i, wr8::Word::from_f32(-0.5F))));
+        ProbeBuilder::once(doc_setting(10, SettingCode::i, wr8::Word::from_f32(-0.5F))));
   b.add("settings-servo-over", "SETTINGS COI 11 servo zero 181: error", ExchangeKind::error,
-        once(doc_setting(11, SettingCode::servo_zero, wr8::Word::from_i32(181))));
+        ProbeBuilder::once(doc_setting(11, SettingCode::servo_zero, wr8::Word::from_i32(181))));
   b.add("settings-servo-under", "SETTINGS COI 12 servo zero -1: error", ExchangeKind::error,
-        once(doc_setting(12, SettingCode::servo_zero, wr8::Word::from_i32(-1))));
+        ProbeBuilder::once(doc_setting(12, SettingCode::servo_zero, wr8::Word::from_i32(-1))));
   b.add("settings-restore", "SETTINGS COI 13 back to the defaults: completed",
-        ExchangeKind::command, once(doc_settings(13, kP, kI, kD, kServoZero)), milliseconds(500));
+        ExchangeKind::command, ProbeBuilder::once(doc_settings(13, kP, kI, kD, kServoZero)),
+        milliseconds(500));
 
   b.add("drive", "TASK drive 10 cm COI 20: started, then completed", ExchangeKind::command,
-        once(doc_task(20, TaskCode::drive, {i32(10)})), milliseconds(2500));
+        ProbeBuilder::once(doc_task(20, TaskCode::drive, {i32(10)})), milliseconds(2500));
   b.add("drive-min", "TASK drive 1 cm COI 21 (the shortest): started, then completed",
-        ExchangeKind::boundary, once(doc_task(21, TaskCode::drive, {i32(1)})), milliseconds(1500));
+        ExchangeKind::boundary, ProbeBuilder::once(doc_task(21, TaskCode::drive, {i32(1)})),
+        milliseconds(1500));
   b.add("drive-zero", "TASK drive 0 cm COI 22: error", ExchangeKind::error,
-        once(doc_task(22, TaskCode::drive, {i32(0)})));
+        ProbeBuilder::once(doc_task(22, TaskCode::drive, {i32(0)})));
   b.add("turn", "TASK turn 15 degrees COI 24: started, then completed", ExchangeKind::command,
-        once(doc_task(24, TaskCode::turn, {i32(15)})), milliseconds(800));
+        ProbeBuilder::once(doc_task(24, TaskCode::turn, {i32(15)})), milliseconds(800));
   b.add("turn-min", "TASK turn -30 degrees COI 25 (the lowest): started, then completed",
-        ExchangeKind::boundary, once(doc_task(25, TaskCode::turn, {i32(-30)})), milliseconds(800));
+        ExchangeKind::boundary, ProbeBuilder::once(doc_task(25, TaskCode::turn, {i32(-30)})),
+        milliseconds(800));
   b.add("turn-max", "TASK turn 30 degrees COI 26 (the highest): started, then completed",
-        ExchangeKind::boundary, once(doc_task(26, TaskCode::turn, {i32(30)})), milliseconds(800));
+        ExchangeKind::boundary, ProbeBuilder::once(doc_task(26, TaskCode::turn, {i32(30)})),
+        milliseconds(800));
   b.add("turn-over", "TASK turn 31 degrees COI 27: error", ExchangeKind::error,
-        once(doc_task(27, TaskCode::turn, {i32(31)})));
+        ProbeBuilder::once(doc_task(27, TaskCode::turn, {i32(31)})));
   b.add("turn-under", "TASK turn -31 degrees COI 28: error", ExchangeKind::error,
-        once(doc_task(28, TaskCode::turn, {i32(-31)})));
+        ProbeBuilder::once(doc_task(28, TaskCode::turn, {i32(-31)})));
   b.add("motion-busy",
         "TASK turn 0 COI 29, 10 ms later TASK drive 5 cm COI 30: the drive is refused while "
         "the turn runs",
@@ -197,55 +164,59 @@ void document_commands(Builder& b) {
         milliseconds(2500));
 }
 
-void document_errors(Builder& b) {
+void document_errors(ProbeBuilder& b) {
   using wr8::TaskCode;
   // Each malformed TASK or SETTINGS still carries its COI at byte 1.
   b.add("task-bad-size", "TASK COI 40 whose size byte (3) is no multiple of 4: error",
-        ExchangeKind::error, once(wr8::raw_packet(3, Bytes{40, 1, 3, 0x0A, 0, 0})));
+        ExchangeKind::error, ProbeBuilder::once(wr8::raw_packet(3, Bytes{40, 1, 3, 0x0A, 0, 0})));
   b.add("task-missing-parameter", "TASK drive COI 41 without its distance: error",
-        ExchangeKind::error, once(doc_task(41, TaskCode::drive)));
+        ExchangeKind::error, ProbeBuilder::once(doc_task(41, TaskCode::drive)));
   b.add("task-unknown-code", "TASK COI 42 with task code 9: error", ExchangeKind::error,
-        once(doc_task(42, static_cast<TaskCode>(9))));
+        ProbeBuilder::once(doc_task(42, static_cast<TaskCode>(9))));
   b.add("settings-bad-size", "SETTINGS COI 43 whose size byte (4) is no multiple of 5: error",
-        ExchangeKind::error, once(wr8::raw_packet(4, Bytes{43, 4, 0, 0, 0, 0})));
+        ExchangeKind::error, ProbeBuilder::once(wr8::raw_packet(4, Bytes{43, 4, 0, 0, 0, 0})));
   b.add("settings-unknown-type", "SETTINGS COI 44 with setting type 7: error", ExchangeKind::error,
-        once(wr8::encode_unchecked(
+        ProbeBuilder::once(wr8::encode_unchecked(
             wr8::Settings{44, {{static_cast<wr8::SettingCode>(7), wr8::Word::from_i32(1)}}})));
   b.add("unknown-packet-code", "code 7 (no packet) and two bytes: skipped unanswered",
-        ExchangeKind::error, once(Bytes{0x07, 0x2A, 0x2A}));
+        ExchangeKind::error, ProbeBuilder::once(Bytes{0x07, 0x2A, 0x2A}));
   b.add("vehicle-packet", "a RESPONSE (a vehicle's packet) sent to the car: skipped unanswered",
-        ExchangeKind::error, once(doc(wr8::Response{45, wr8::ResponseCode::completed})));
+        ExchangeKind::error,
+        ProbeBuilder::once(doc(wr8::Response{45, wr8::ResponseCode::completed})));
   // 63 values is the most a size byte counting bytes can declare (252).
   b.add("oversized", "TASK check COI 46 with 63 parameters (256 bytes, the longest TASK): error",
         ExchangeKind::error,
-        once(doc_task(46, TaskCode::check, std::vector<wr8::Word>(63, wr8::Word{}))));
+        ProbeBuilder::once(doc_task(46, TaskCode::check, std::vector<wr8::Word>(63, wr8::Word{}))));
   b.add("garbage-between-frames",
         "FF FE, TASK check COI 47, 7F 80, TASK check COI 48 in one write: both completed",
         ExchangeKind::framing,
-        once(join({Bytes{0xFF, 0xFE}, doc_task(47, TaskCode::check), Bytes{0x7F, 0x80},
-                   doc_task(48, TaskCode::check)})));
+        ProbeBuilder::once(ProbeBuilder::join({Bytes{0xFF, 0xFE}, doc_task(47, TaskCode::check),
+                                               Bytes{0x7F, 0x80}, doc_task(48, TaskCode::check)})));
   b.add("split-bytes", "SETTINGS COI 49 (the defaults) one byte every 5 ms: completed",
-        ExchangeKind::framing, byte_by_byte(doc_settings(49, kP, kI, kD, kServoZero)));
+        ExchangeKind::framing,
+        ProbeBuilder::bytewise(doc_settings(49, kP, kI, kD, kServoZero), kByteGap));
   b.add("two-frames-one-write", "TASK check COI 50 and COI 51 in one write: both completed",
         ExchangeKind::framing,
-        once(join({doc_task(50, TaskCode::check), doc_task(51, TaskCode::check)})));
+        ProbeBuilder::once(
+            ProbeBuilder::join({doc_task(50, TaskCode::check), doc_task(51, TaskCode::check)})));
 }
 
-void document_probe(Builder& b) {
+void document_probe(ProbeBuilder& b) {
   using wr8::TaskCode;
   b.connect("connect", "open the connection: no DATA before a login");
   document_login(b);
   document_commands(b);
   document_errors(b);
-  b.add("telemetry", "listen: DATA every 100 ms (state, time, odometry, speed, angle, battery)",
-        ExchangeKind::telemetry, {}, milliseconds(1100));
+  b.listen("telemetry", "listen: DATA every 100 ms (state, time, odometry, speed, angle, battery)",
+           milliseconds(1100));
   b.connect("reconnect", "close and open again: the session ends, no DATA");
   b.add("task-after-reconnect", "TASK check COI 60 on the new connection: dropped, no login yet",
-        ExchangeKind::error, once(doc_task(60, TaskCode::check)));
+        ExchangeKind::error, ProbeBuilder::once(doc_task(60, TaskCode::check)));
   b.add("auth-after-reconnect", "AUTH with the profile's string: AUTH-REPLY, DATA again",
-        ExchangeKind::command, once(doc_good_auth()), kReply, true);
+        ExchangeKind::command, ProbeBuilder::once(doc_good_auth()), kReply, true);
   b.add("stop", "TASK turn 0 COI 61 (wheels straight): started, completed; then the close",
-        ExchangeKind::stop, once(doc_task(61, TaskCode::turn, {i32(0)})), milliseconds(800));
+        ExchangeKind::stop, ProbeBuilder::once(doc_task(61, TaskCode::turn, {i32(0)})),
+        milliseconds(800));
 }
 
 // ------------------------------------------------------------- svgui-2019
@@ -264,40 +235,44 @@ constexpr std::uint8_t kWheels = 2;
 constexpr std::uint8_t kSignals = 3;
 
 Bytes auth_2019() {
-  return v19(svgui::Auth{text_bytes("konnichiwa")});
+  return v19(svgui::Auth{ProbeBuilder::bytes("konnichiwa")});
 }
 Bytes auth_head() {
-  Bytes text = text_bytes("konnichiwa");
+  Bytes text = ProbeBuilder::bytes("konnichiwa");
   text.push_back(0);
   return svgui::encode_prefixed(svgui::Auth{text}, kHead);
 }
 
-void v2019_commands(Builder& b) {
+void v2019_commands(ProbeBuilder& b) {
   b.add("auth-head-form", "the head GUI's AUTH (length byte 12, NUL at the end): no answer",
-        ExchangeKind::error, once(auth_head()));
+        ExchangeKind::error, ProbeBuilder::once(auth_head()));
   b.add("auth-bad", "AUTH whose text does not end in konnichiwa: no answer, kept open",
-        ExchangeKind::error, once(v19(svgui::Auth{text_bytes("sayonara!!")})));
+        ExchangeKind::error,
+        ProbeBuilder::once(v19(svgui::Auth{ProbeBuilder::bytes("sayonara!!")})));
   b.add("auth", "AUTH konnichiwa (length byte 11): AUTH-REPLY 1 2 WAIT", ExchangeKind::command,
-        once(auth_2019()));
-  b.add("auth-again", "AUTH again: the same AUTH-REPLY", ExchangeKind::command, once(auth_2019()));
+        ProbeBuilder::once(auth_2019()));
+  b.add("auth-again", "AUTH again: the same AUTH-REPLY", ExchangeKind::command,
+        ProbeBuilder::once(auth_2019()));
   b.add("wheels", "TASK wheels 15 degrees COI 2: ANSWER 2 done when the wheels are there",
-        ExchangeKind::command, once(v19_task(2, kWheels, {15})), milliseconds(800));
+        ExchangeKind::command, ProbeBuilder::once(v19_task(2, kWheels, {15})), milliseconds(800));
   b.add("wheels-int-max", "TASK wheels 2147483647 degrees COI 3 (int32's highest): done",
         ExchangeKind::boundary,
-        once(v19_task(3, kWheels, {std::numeric_limits<std::int32_t>::max()})), milliseconds(800));
+        ProbeBuilder::once(v19_task(3, kWheels, {std::numeric_limits<std::int32_t>::max()})),
+        milliseconds(800));
   b.add("wheels-int-min", "TASK wheels -2147483648 degrees COI 4 (int32's lowest): done",
         ExchangeKind::boundary,
-        once(v19_task(4, kWheels, {std::numeric_limits<std::int32_t>::min()})), milliseconds(800));
+        ProbeBuilder::once(v19_task(4, kWheels, {std::numeric_limits<std::int32_t>::min()})),
+        milliseconds(800));
   b.add("task-coi-0", "TASK wheels 0 COI 0 (the idle COI): done with COI 0", ExchangeKind::boundary,
-        once(v19_task(0, kWheels, {0})), milliseconds(800));
+        ProbeBuilder::once(v19_task(0, kWheels, {0})), milliseconds(800));
   b.add("task-coi-255", "TASK wheels 0 COI 255 (the highest COI): done", ExchangeKind::boundary,
-        once(v19_task(255, kWheels, {0})));
+        ProbeBuilder::once(v19_task(255, kWheels, {0})));
   b.add("forward", "TASK forward 10 cm COI 5: ANSWER done (no started)", ExchangeKind::command,
-        once(v19_task(5, kForward, {10})), milliseconds(2000));
+        ProbeBuilder::once(v19_task(5, kForward, {10})), milliseconds(2000));
   b.add("forward-back", "TASK forward -10 cm COI 6 (backwards): done", ExchangeKind::boundary,
-        once(v19_task(6, kForward, {-10})), milliseconds(2000));
+        ProbeBuilder::once(v19_task(6, kForward, {-10})), milliseconds(2000));
   b.add("forward-zero", "TASK forward 0 cm COI 7: done", ExchangeKind::boundary,
-        once(v19_task(7, kForward, {0})), milliseconds(800));
+        ProbeBuilder::once(v19_task(7, kForward, {0})), milliseconds(800));
   b.add("busy",
         "TASK forward 5 cm COI 8, 50 ms later TASK wheels 0 COI 9: the second is dropped while "
         "the first runs",
@@ -305,29 +280,31 @@ void v2019_commands(Builder& b) {
         {{Duration{0}, v19_task(8, kForward, {5})}, {milliseconds(50), v19_task(9, kWheels, {0})}},
         milliseconds(2000));
   b.add("signals", "TASK turn signals COI 10: done after 2 s", ExchangeKind::command,
-        once(v19_task(10, kSignals)), milliseconds(2500));
+        ProbeBuilder::once(v19_task(10, kSignals)), milliseconds(2500));
   // The vehicle reads int32 at bytes 2, 7, 12 and 17: these values read
   // back as p 1, i 0, d 0, servo zero 90 (the defaults), so the garbling
   // moves nothing. COI 0 leaves the vehicle idle.
   b.add("settings",
         "SETTINGS COI 0 whose garbled read is p 1 i 0 d 0 servo zero 90: no answer, not busy",
-        ExchangeKind::command, once(v19(svgui::Settings{0, {1, 0, 0, 0x5A000000}})));
+        ExchangeKind::command, ProbeBuilder::once(v19(svgui::Settings{0, {1, 0, 0, 0x5A000000}})));
   b.add("task-after-settings", "TASK wheels 0 COI 11 after a COI 0 SETTINGS: done",
-        ExchangeKind::command, once(v19_task(11, kWheels, {0})));
+        ExchangeKind::command, ProbeBuilder::once(v19_task(11, kWheels, {0})));
 }
 
-void v2019_errors(Builder& b) {
+void v2019_errors(ProbeBuilder& b) {
   b.add("task-type-4", "TASK type 4 (the document's get-settings) COI 0: no action, no answer",
-        ExchangeKind::error, once(v19_task(0, 4)));
+        ExchangeKind::error, ProbeBuilder::once(v19_task(0, 4)));
   b.add("task-unknown-type", "TASK type 9 COI 0: no action, no answer", ExchangeKind::error,
-        once(v19_task(0, 9)));
+        ProbeBuilder::once(v19_task(0, 9)));
   b.add("task-missing-parameter", "TASK forward COI 20 without a parameter: dropped unread",
-        ExchangeKind::error, once(v19_task(20, kForward)));
+        ExchangeKind::error, ProbeBuilder::once(v19_task(20, kForward)));
   b.add("task-short", "TASK wheels COI 21 declaring 2 parameters, carrying 1: dropped unread",
-        ExchangeKind::error, once(join({Bytes{8, 3, 21, kWheels, 2}, Bytes{0, 0, 0, 0}})));
+        ExchangeKind::error,
+        ProbeBuilder::once(ProbeBuilder::join({Bytes{8, 3, 21, kWheels, 2}, Bytes{0, 0, 0, 0}})));
   b.add("unknown-packet-code", "a packet of code 7: no answer", ExchangeKind::error,
-        once(Bytes{2, 7, 0}));
-  b.add("length-zero", "a length byte 0 alone: no answer", ExchangeKind::error, once(Bytes{0}));
+        ProbeBuilder::once(Bytes{2, 7, 0}));
+  b.add("length-zero", "a length byte 0 alone: no answer", ExchangeKind::error,
+        ProbeBuilder::once(Bytes{0}));
   // Length byte 0x80 is negative to the program, which reads whatever came.
   // The codec frames no packet of 128 bytes: a 30-parameter TASK is made
   // one parameter longer by hand.
@@ -338,32 +315,34 @@ void v2019_errors(Builder& b) {
   oversized.insert(oversized.end(), wheels.begin(), wheels.end());
   b.add("oversized",
         "length byte 80 and a 128-byte TASK wheels 0 COI 22 (31 parameters): read whole, done",
-        ExchangeKind::error, once(oversized));
+        ExchangeKind::error, ProbeBuilder::once(oversized));
   b.add("garbage-between-frames",
         "TASK wheels 0 COI 23, FF FE, TASK wheels 0 COI 24 in one write: read as one packet",
         ExchangeKind::framing,
-        once(join({v19_task(23, kWheels, {0}), Bytes{0xFF, 0xFE}, v19_task(24, kWheels, {0})})));
+        ProbeBuilder::once(ProbeBuilder::join(
+            {v19_task(23, kWheels, {0}), Bytes{0xFF, 0xFE}, v19_task(24, kWheels, {0})})));
   b.add("split-bytes", "TASK wheels 0 COI 25 one byte every 5 ms: every byte a packet, no answer",
-        ExchangeKind::framing, byte_by_byte(v19_task(25, kWheels, {0})));
+        ExchangeKind::framing, ProbeBuilder::bytewise(v19_task(25, kWheels, {0}), kByteGap));
   b.add("two-frames-one-write",
         "TASK wheels 0 COI 26 and COI 27 in one write: read as one, only 26 is done",
         ExchangeKind::framing,
-        once(join({v19_task(26, kWheels, {0}), v19_task(27, kWheels, {0})})));
+        ProbeBuilder::once(
+            ProbeBuilder::join({v19_task(26, kWheels, {0}), v19_task(27, kWheels, {0})})));
 }
 
-void v2019_probe(Builder& b) {
+void v2019_probe(ProbeBuilder& b) {
   b.connect("connect", "open the connection: DATA every 100 ms from the start");
   b.add("task-before-auth", "TASK wheels 0 COI 1 before any AUTH: served, ANSWER 1 done",
-        ExchangeKind::command, once(v19_task(1, kWheels, {0})));
+        ExchangeKind::command, ProbeBuilder::once(v19_task(1, kWheels, {0})));
   v2019_commands(b);
   v2019_errors(b);
-  b.add("telemetry", "listen: DATA every 100 ms (state, time, encoder, steering, batteries)",
-        ExchangeKind::telemetry, {}, milliseconds(1100));
+  b.listen("telemetry", "listen: DATA every 100 ms (state, time, encoder, steering, batteries)",
+           milliseconds(1100));
   b.connect("reconnect", "close and open again: DATA from the start again");
   b.add("task-after-reconnect", "TASK wheels 0 COI 30 on the new connection: served, done",
-        ExchangeKind::command, once(v19_task(30, kWheels, {0})));
+        ExchangeKind::command, ProbeBuilder::once(v19_task(30, kWheels, {0})));
   b.add("stop", "TASK wheels 0 COI 31 (wheels straight): done; then the close", ExchangeKind::stop,
-        once(v19_task(31, kWheels, {0})), milliseconds(500));
+        ProbeBuilder::once(v19_task(31, kWheels, {0})), milliseconds(500));
 }
 
 // ------------------------------------------------------------- svgui-head
@@ -383,15 +362,16 @@ Bytes set_request() {
   return head(svgui::SetRequest{});
 }
 
-void head_commands(Builder& b) {
+void head_commands(ProbeBuilder& b) {
   b.add("auth-v2019-form", "the v2019 GUI's AUTH (length byte 11, no NUL): AUTH-REPLY and MAP",
-        ExchangeKind::command, once(auth_2019()), kReply, true);
+        ExchangeKind::command, ProbeBuilder::once(auth_2019()), kReply, true);
   b.add("auth-bad", "AUTH whose text does not end in konnichiwa: no answer, kept open",
-        ExchangeKind::error, once(head(svgui::Auth{text_bytes("sayonara!!")})));
+        ExchangeKind::error,
+        ProbeBuilder::once(head(svgui::Auth{ProbeBuilder::bytes("sayonara!!")})));
   b.add("auth", "AUTH konnichiwa and NUL: AUTH-REPLY 1 2 WAIT, then the MAP", ExchangeKind::command,
-        once(auth_head()), kReply, true);
+        ProbeBuilder::once(auth_head()), kReply, true);
   b.add("set-request", "SET-REQUEST: a SET of the twelve settings in force", ExchangeKind::command,
-        once(set_request()));
+        ProbeBuilder::once(set_request()));
   auto changed = kHeadSet;
   changed[0] = 2.5;  // steering p
   b.add("set", "SET with steering p 2.5, 50 ms later SET-REQUEST: no answer to SET, the SET back",
@@ -409,63 +389,66 @@ void head_commands(Builder& b) {
   b.add("set-nan", "SET with a NaN, then SET-REQUEST: the SET is dropped, the earlier one back",
         ExchangeKind::error, {{Duration{0}, head_set(nan)}, {milliseconds(50), set_request()}});
   b.add("set-defaults", "SET with the defaults: no answer", ExchangeKind::command,
-        once(head_set(kHeadSet)));
+        ProbeBuilder::once(head_set(kHeadSet)));
   b.add("control", "CONTROL x 0 y 0.2, 100 ms later x 0 y 0: a short creep, no answer",
         ExchangeKind::command,
         {{Duration{0}, head_control(0, 0.2)}, {milliseconds(100), head_control(0, 0)}});
   b.add("control-x-max", "CONTROL x 1 y 0 (full right, no speed): no answer",
-        ExchangeKind::boundary, once(head_control(1, 0)));
+        ExchangeKind::boundary, ProbeBuilder::once(head_control(1, 0)));
   b.add("control-x-min", "CONTROL x -1 y 0 (full left, no speed): no answer",
-        ExchangeKind::boundary, once(head_control(-1, 0)));
+        ExchangeKind::boundary, ProbeBuilder::once(head_control(-1, 0)));
   b.add("control-y-max", "CONTROL x 0 y 1, 50 ms later x 0 y 0: full speed for 50 ms",
         ExchangeKind::boundary,
         {{Duration{0}, head_control(0, 1)}, {milliseconds(50), head_control(0, 0)}});
   b.add("control-x-over", "CONTROL x 1.5 y 0: clamped to full right, no answer",
-        ExchangeKind::error, once(head_control(1.5, 0)));
+        ExchangeKind::error, ProbeBuilder::once(head_control(1.5, 0)));
   b.add("control-nan", "CONTROL with a NaN axis: dropped", ExchangeKind::error,
-        once(head_control(std::numeric_limits<double>::quiet_NaN(), 0)));
+        ProbeBuilder::once(head_control(std::numeric_limits<double>::quiet_NaN(), 0)));
 }
 
-void head_errors(Builder& b) {
+void head_errors(ProbeBuilder& b) {
   b.add("task-v2019", "a v2019 TASK wheels 0 COI 1 (no packet of head): no answer",
-        ExchangeKind::error, once(v19_task(1, kWheels, {0})));
+        ExchangeKind::error, ProbeBuilder::once(v19_task(1, kWheels, {0})));
   b.add("unknown-packet-code", "a packet of code 11: no answer", ExchangeKind::error,
-        once(Bytes{2, 11, 0}));
+        ProbeBuilder::once(Bytes{2, 11, 0}));
   b.add("control-short", "CONTROL cut to 10 bytes (length byte 10): no answer", ExchangeKind::error,
-        once(Bytes{10, 10, 0, 0, 0, 1, 0, 0, 0, 0, 0}));
-  b.add("length-zero", "a length byte 0 alone: no answer", ExchangeKind::error, once(Bytes{0}));
+        ProbeBuilder::once(Bytes{10, 10, 0, 0, 0, 1, 0, 0, 0, 0, 0}));
+  b.add("length-zero", "a length byte 0 alone: no answer", ExchangeKind::error,
+        ProbeBuilder::once(Bytes{0}));
   b.add("split-bytes", "SET-REQUEST one byte every 5 ms: each byte read as a length byte",
-        ExchangeKind::framing, byte_by_byte(set_request()));
+        ExchangeKind::framing, ProbeBuilder::bytewise(set_request(), kByteGap));
   // Each of these leaves bytes unread in the head program, which reads one
   // packet per arrival: a reconnect follows each.
   b.add("two-frames-one-write",
         "SET-REQUEST twice in one write: one SET back, the second request waits unread",
-        ExchangeKind::framing, once(join({set_request(), set_request()})));
+        ExchangeKind::framing,
+        ProbeBuilder::once(ProbeBuilder::join({set_request(), set_request()})));
   b.connect("reconnect", "close and open again: the unread bytes go, DATA from the start");
   b.add("garbage-between-frames",
         "SET-REQUEST, FF FE, SET-REQUEST in one write: one SET back, the rest unread",
-        ExchangeKind::framing, once(join({set_request(), Bytes{0xFF, 0xFE}, set_request()})));
+        ExchangeKind::framing,
+        ProbeBuilder::once(ProbeBuilder::join({set_request(), Bytes{0xFF, 0xFE}, set_request()})));
   b.connect("reconnect-2", "close and open again");
   Bytes oversized{0x80};
   for (int k = 0; k < 128; ++k)
     oversized.push_back(0x7F);
   b.add("oversized", "length byte 80 and 128 bytes: the program reads no packet",
-        ExchangeKind::error, once(oversized));
+        ExchangeKind::error, ProbeBuilder::once(oversized));
 }
 
-void head_probe(Builder& b) {
+void head_probe(ProbeBuilder& b) {
   b.connect("connect", "open the connection: HIGH-FREQ and LOW-FREQ DATA from the start");
   b.add("set-request-before-auth", "SET-REQUEST before any AUTH: served, a SET back",
-        ExchangeKind::command, once(set_request()));
+        ExchangeKind::command, ProbeBuilder::once(set_request()));
   head_commands(b);
-  b.add("telemetry", "listen: HIGH-FREQ DATA every 50 ms, LOW-FREQ DATA every 1000 ms",
-        ExchangeKind::telemetry, {}, milliseconds(2100));
+  b.listen("telemetry", "listen: HIGH-FREQ DATA every 50 ms, LOW-FREQ DATA every 1000 ms",
+           milliseconds(2100));
   head_errors(b);
   b.connect("reconnect-3", "close and open again after the unreadable length byte");
   b.add("set-request-after-reconnect", "SET-REQUEST on the new connection: served, a SET back",
-        ExchangeKind::command, once(set_request()));
+        ExchangeKind::command, ProbeBuilder::once(set_request()));
   b.add("stop", "CONTROL x 0 y 0: the car holds still; then the close", ExchangeKind::stop,
-        once(head_control(0, 0)));
+        ProbeBuilder::once(head_control(0, 0)));
 }
 
 }  // namespace
@@ -473,23 +456,19 @@ void head_probe(Builder& b) {
 
 Probe make_wr8_probe(std::string_view profile) {
   using namespace wr8_probe;
-  Probe probe;
-  probe.version = "wr8-probe/1";
   // A TCP server: nothing restarts when the connection opens.
-  probe.settle = milliseconds(100);
-  wr8_probe::Builder b(probe);
+  ProbeBuilder b("wr8-probe/1", milliseconds(100), kReply);
   const auto version = svgui::version_of_profile(profile);
   if (!version) {
-    probe.telemetry_kinds = {"DATA"};
     document_probe(b);
-  } else if (*version == kV2019) {
-    probe.telemetry_kinds = {"DATA"};
-    v2019_probe(b);
-  } else {
-    probe.telemetry_kinds = {"HIGH_FREQ_DATA", "LOW_FREQ_DATA"};
-    head_probe(b);
+    return b.take({"DATA"});
   }
-  return probe;
+  if (*version == kV2019) {
+    v2019_probe(b);
+    return b.take({"DATA"});
+  }
+  head_probe(b);
+  return b.take({"HIGH_FREQ_DATA", "LOW_FREQ_DATA"});
 }
 
 }  // namespace hil::conform
