@@ -96,7 +96,21 @@ MockCar::MockCar(CarOptions options) : kind_(options.kind), name_(options.name) 
   sim::VehicleDef def = vehicle_preset(kind_);
   def.name = name_;
   vehicle_ = &world_->add_vehicle(std::move(def));
-  firmware_ = make_firmware(kind_, *world_, *vehicle_, options.configs);
+  if (!options.replay) {
+    firmware_ = make_firmware(kind_, *world_, *vehicle_, options.configs);
+    return;
+  }
+  ReplaySpec& replay = *options.replay;
+  if (!replay.capture)
+    replay.capture = std::make_shared<const link::Capture>(link::read_capture(replay.path));
+  if (replay.capture->header.car != to_string(kind_)) {
+    throw std::invalid_argument((replay.path.empty() ? std::string("the capture") : replay.path) +
+                                " is a capture of a " + replay.capture->header.car +
+                                " car, not of a " + std::string(to_string(kind_)) + " car");
+  }
+  firmware_ =
+      std::make_unique<ReplayFirmware>(*world_, *vehicle_, kind_, replay.capture, replay.unmatched,
+                                       options.configs, std::move(replay.log));
 }
 
 MockCar::~MockCar() = default;

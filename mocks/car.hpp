@@ -15,6 +15,7 @@
 #include "mocks/firmware.hpp"
 #include "mocks/leka.hpp"
 #include "mocks/logi.hpp"
+#include "mocks/replay.hpp"
 #include "mocks/wr8.hpp"
 #include "mocks/wr8_svgui.hpp"
 #include "sim/arena.hpp"
@@ -65,6 +66,12 @@ struct CarOptions {
   std::uint64_t seed = 1;  ///< sensor noise and sensor faults
   std::string name = "car0";
   FirmwareConfigs configs;
+  /// Play a recorded car (mocks/replay.hpp) instead of the mock firmware;
+  /// the capture must be of `kind` (std::invalid_argument otherwise), and
+  /// is read from its path when not given (link::CaptureError when it
+  /// cannot be). `configs` then set the mock that answers what the capture
+  /// has no recording for, in the capture's profile.
+  std::optional<ReplaySpec> replay;
 };
 
 class MockCar {
