@@ -149,6 +149,7 @@ RunningCar MockDesk::start_car(std::size_t i) {
       log(name + ": " + l);
     };
     options.configs.svgui.log = options.configs.wr8.log;
+    if (options.replay) options.replay->log = options.configs.wr8.log;
   }
   RunningCar running;
   try {
@@ -159,7 +160,7 @@ RunningCar MockDesk::start_car(std::size_t i) {
   for (const auto& b : plan_.behaviours)
     running.car->firmware().arm(b);
   mocks::ServerOptions server;
-  server.listen = endpoint_for(args_.listen, args_.car.profile, plan_.kind, i);
+  server.listen = endpoint_for(args_.listen, plan_.profile, plan_.kind, i);
   server.faults = plan_.faults;
   server.seed = mocks::car_seed(plan_.seed, i);
   server.wire_log_path = args_.desk.wire_log;
@@ -171,7 +172,7 @@ RunningCar MockDesk::start_car(std::size_t i) {
   }
   running.server =
       std::make_unique<mocks::MockServer>(context_, running.car->firmware(), std::move(server));
-  const auto listening = endpoint_for(args_.listen, args_.car.profile, plan_.kind, i);
+  const auto listening = endpoint_for(args_.listen, plan_.profile, plan_.kind, i);
   try {
     running.server->start();
   } catch (const std::exception& e) {
@@ -218,6 +219,18 @@ void MockDesk::start_cars() {
             << plan_.faults.rules.size() << " fault rule(s), " << plan_.behaviours.size()
             << " behaviour(s), seed " << plan_.seed << " (replay with --seed " << plan_.seed
             << "); Ctrl-C stops" << std::endl;
+  if (const auto& replay = plan_.base.replay) {
+    const auto* fw = dynamic_cast<const mocks::ReplayFirmware*>(&cars_.front().car->firmware());
+    const auto& header = replay->capture->header;
+    const std::size_t requests = fw ? fw->index().answers.size() : 0;
+    std::cout << "replaying " << replay->path << " (" << header.probe_version << ", profile "
+              << plan_.profile << ", " << requests << " recorded request"
+              << (requests == 1 ? "" : "s") << "); requests with no recording: "
+              << (replay->unmatched == mocks::Unmatched::mock
+                      ? "the " + plan_.profile + " mock answers"
+                      : std::string("left unanswered"))
+              << std::endl;
+  }
 }
 
 // "<name> <address>" per car, whole or not at all: a script waiting for
@@ -346,6 +359,17 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
                   "Scripted behaviours to arm at start (YAML, docs/mocks.md)");
   cmd->add_option("--seed", args->car.seed,
                   "Seed for sensor noise and faults (printed when chosen at random)");
+  auto* replay_option = cmd->add_option(
+      "--replay", args->car.replay,
+      "Play a real car recorded by `hil conform probe` instead of the mock: each request gets "
+      "the answer recorded for it (the same bytes, else the same kind) after the recorded "
+      "latency, telemetry comes on the recorded schedule (docs/mocks.md, \"Replaying a recorded "
+      "car\")");
+  cmd->add_option("--unmatched", args->car.unmatched,
+                  "With --replay, a request the capture has no recording for: mock (the "
+                  "capture's profile's mock answers it, the default) or silent (no answer)")
+      ->check(CLI::IsMember({"mock", "silent"}))
+      ->needs(replay_option);
   cmd->add_option("--log", args->desk.wire_log,
                   "Write every byte of every connection to an NDJSON wire log");
   cmd->add_option("--count", args->count,
@@ -390,6 +414,7 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "  hil mock arduino --pty /tmp/robot0            # open /tmp/robot0 at 9600 baud\n"
       "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil mock logi --view                          # and watch it on http://127.0.0.1:8080/\n"
+      "  hil mock logi --replay car.ndjson             # the car `hil conform probe` recorded\n"
       "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
   cmd->callback([&run, args, view_option] {
     args->desk.view = view_option->count() > 0;

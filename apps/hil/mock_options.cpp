@@ -8,6 +8,7 @@
 #include <random>
 
 #include "base/duration.hpp"
+#include "link/capture/probe_capture.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/behaviour_yaml.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -67,9 +68,10 @@ void load_files(const MockCarArgs& args, MockPlan& plan) {
 }
 
 // --profile, --auth, --reply-latency and --data-hz on the car's configs.
-void configure_car(const MockCarArgs& args, mocks::FirmwareConfigs& configs, mocks::CarKind kind) {
+void configure_car(const MockCarArgs& args, const std::string& profile,
+                   mocks::FirmwareConfigs& configs, mocks::CarKind kind) {
   try {
-    mocks::apply_profile(configs, kind, args.profile);
+    mocks::apply_profile(configs, kind, profile);
   } catch (const protocol::ProfileError& e) {
     throw MockStartError{std::string("--profile: ") + e.what(), 2};
   }
@@ -106,6 +108,50 @@ void configure_car(const MockCarArgs& args, mocks::FirmwareConfigs& configs, moc
   }
 }
 
+// --replay and --unmatched: the capture read and checked against the car
+// and --profile; the car then plays the capture's profile.
+void load_replay(const MockCarArgs& args, MockPlan& plan) {
+  plan.profile = args.profile;
+  if (args.replay.empty()) return;
+  std::shared_ptr<const link::Capture> capture;
+  try {
+    capture = std::make_shared<const link::Capture>(link::read_capture(args.replay));
+  } catch (const link::CaptureError& e) {
+    throw MockStartError{std::string("--replay: ") + e.what(), 2};
+  }
+  const auto& header = capture->header;
+  if (header.car != args.kind) {
+    throw MockStartError{"--replay: " + args.replay + " is a capture of a " + header.car +
+                             " car, not of a " + args.kind + " car (hil mock " + header.car +
+                             " --replay " + args.replay + " plays it)",
+                         2};
+  }
+  std::string profile;
+  try {
+    profile = std::string(protocol::find_car_profile(header.car, header.profile).name);
+  } catch (const protocol::ProfileError& e) {
+    throw MockStartError{"--replay: " + args.replay + ": " + e.what(), 2};
+  }
+  if (!args.profile.empty()) {
+    if (const auto problem = protocol::car_profile_problem(args.kind, args.profile);
+        !problem.empty()) {
+      throw MockStartError{"--profile: " + problem, 2};
+    }
+    if (protocol::find_car_profile(args.kind, args.profile).name != profile) {
+      throw MockStartError{"--profile " + args.profile + ": " + args.replay +
+                               " was recorded in profile " + profile +
+                               " (leave --profile out with --replay)",
+                           2};
+    }
+  }
+  plan.profile = profile;
+  mocks::ReplaySpec spec;
+  spec.path = args.replay;
+  spec.capture = std::move(capture);
+  spec.unmatched = mocks::parse_unmatched(args.unmatched).value_or(mocks::Unmatched::mock);
+  plan.base.replay = std::move(spec);
+}
+
 // --count and --port for this kind of car, and the open files they need.
 void check_fleet(const MockArgs& args, bool serial) {
   if (serial && args.count > kMaxSerialCars) {
@@ -137,8 +183,10 @@ MockPlan plan_mock(const MockArgs& args) {
   // the library's constant 1 s, which their timings rely on.
   plan.base.configs.wr8.wrong_auth_max_delay = link::seconds(30);
   load_files(args.car, plan);
-  configure_car(args.car, plan.base.configs, plan.kind);
-  plan.serial = std::holds_alternative<link::PtyEndpoint>(mocks::default_endpoint(plan.kind, 0));
+  load_replay(args.car, plan);
+  configure_car(args.car, plan.profile, plan.base.configs, plan.kind);
+  plan.serial = std::holds_alternative<link::PtyEndpoint>(
+      mocks::default_endpoint(plan.kind, 0, plan.profile));
   check_fleet(args, plan.serial);
   plan.seed = args.car.seed ? *args.car.seed : std::random_device{}();
   const auto view_port = parse_view_port(args.desk.view_port);

@@ -26,6 +26,8 @@ struct MockCarArgs {
   std::string faults;
   std::string behaviours;
   std::optional<std::uint64_t> seed;
+  std::string replay;              ///< a probe capture to play; empty: the mock firmware
+  std::string unmatched = "mock";  ///< what answers a request the capture has no recording for
 };
 
 // Where car N listens.
@@ -81,6 +83,8 @@ struct MockStartError {
 struct MockPlan {
   mocks::CarKind kind{};
   mocks::CarOptions base;
+  /// The car's profile: --profile's, or the capture's with --replay.
+  std::string profile;
   link::FaultProfile faults;
   std::vector<mocks::Behaviour> behaviours;
   bool serial = false;  ///< cars on ptys (else TCP)

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -262,6 +264,114 @@ TEST(HilMock, APortInUseIsReportedWithTheFix) {
       << second.output;
   EXPECT_NE(second.output.find("choose another --port"), std::string::npos);
   EXPECT_EQ(first.interrupt(), 0);
+}
+
+// ---------------------------------------------------------------- --replay
+
+/// A LOGI capture as `hil conform probe` writes one, in a temporary file:
+/// the car refused MD:MAN (FB:MD:0, which the mock would accept) and sent
+/// STAT with DIS 777 every 100 ms.
+class ReplayCapture {
+ public:
+  ReplayCapture()
+      : path_(std::filesystem::temp_directory_path() /
+              ("hil-replay-cli-" + std::to_string(::getpid()) + ".ndjson")) {
+    std::ofstream out(path_);
+    out << R"({"event":"probe","t_ms":0,"probe":"logi-probe/1","car":"logi","profile":"guide","target":"tcp://car:9000"})"
+        << "\n"
+        << R"({"event":"exchange","t_ms":0,"index":0,"name":"connect","kind":"connect","what":"open"})"
+        << "\n"
+        << R"({"event":"open","t_ms":0,"client":"probe","car":"tcp://car:9000"})"
+        << "\n"
+        << R"({"event":"exchange_end","t_ms":100,"index":0})"
+        << "\n"
+        << R"({"event":"exchange","t_ms":100,"index":1,"name":"manual","kind":"command","what":"MD:MAN"})"
+        << "\n"
+        << R"({"event":"sent","t_ms":110,"dir":"to_car","text":"LOGI:MD:MAN:0C#"})"
+        << "\n"
+        << R"({"event":"delivered","t_ms":130,"dir":"to_client","text":"LOGI:FB:MD:0:22#"})"
+        << "\n"
+        << R"({"event":"exchange_end","t_ms":200,"index":1})"
+        << "\n"
+        << R"({"event":"exchange","t_ms":200,"index":2,"name":"telemetry","kind":"telemetry","what":"STAT"})"
+        << "\n";
+    for (int ms = 250; ms < 1000; ms += 100) {
+      out << R"({"event":"delivered","t_ms":)" << ms
+          << R"(,"dir":"to_client","text":"LOGI:STAT:SP:050,STA:000,RUN:0,MODE:AUTO,MAN:STOP,DIS:777,TRK:0000,DEV:0,OBS:0,RPM:0:0:0:0:B6#"})"
+          << "\n";
+    }
+    out << R"({"event":"exchange_end","t_ms":1000,"index":2})"
+        << "\n";
+  }
+  ~ReplayCapture() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  std::string path() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+TEST(HilMock, ReplayPlaysTheRecordedCarAndTheMockAnswersTheRest) {
+  const ReplayCapture capture;
+  const auto wire_log = std::filesystem::temp_directory_path() /
+                        ("hil-replay-cli-wire-" + std::to_string(::getpid()) + ".ndjson");
+  HilProcess mock(
+      {"mock", "logi", "--replay", capture.path(), "--port", "0", "--log", wire_log.string()});
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  EXPECT_TRUE(mock.wait_for_line("replaying " + capture.path())) << mock.output();
+  EXPECT_NE(mock.output().find("1 recorded request)"), std::string::npos) << mock.output();
+  Conn client = tcp_connect(port);
+  ASSERT_TRUE(client.ok());
+  // The recorded telemetry, not the mock's (DIS 232 on the warehouse).
+  EXPECT_TRUE(client.read_until("DIS:777")) << client.received;
+  // The recorded refusal, where the mock accepts.
+  ASSERT_TRUE(client.send("LOGI:MD:MAN:0C#"));
+  EXPECT_TRUE(client.read_until("LOGI:FB:MD:0:22#")) << client.received;
+  // No recording of GS: the guide mock answers, and the desk says so.
+  ASSERT_TRUE(client.send("LOGI:GS:001:CA#"));
+  EXPECT_TRUE(client.read_until("LOGI:FB:GS:1:2C#")) << client.received;
+  EXPECT_TRUE(mock.wait_for_line("no recording for LOGI:GS:001:CA#")) << mock.output();
+  EXPECT_EQ(client.received.find("DIS:232"), std::string::npos) << client.received;
+  EXPECT_EQ(mock.interrupt(), 0) << mock.output();
+  // --log works as for any mock: the recorded answer is in the wire log.
+  std::ifstream log(wire_log);
+  const std::string logged((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_NE(logged.find("LOGI:FB:MD:0:22#"), std::string::npos);
+  std::filesystem::remove(wire_log);
+}
+
+TEST(HilMock, ReplaySilentLeavesUnrecordedRequestsUnanswered) {
+  const ReplayCapture capture;
+  HilProcess mock(
+      {"mock", "logi", "--replay", capture.path(), "--unmatched", "silent", "--port", "0"});
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  Conn client = tcp_connect(port);
+  ASSERT_TRUE(client.send("LOGI:GS:001:CA#"));
+  EXPECT_TRUE(mock.wait_for_line("left unanswered")) << mock.output();
+  EXPECT_FALSE(client.read_until("FB:GS", 1s)) << client.received;
+  EXPECT_EQ(mock.interrupt(), 0);
+}
+
+TEST(HilMock, AReplayThatCannotBePlayedIsRefused) {
+  const ReplayCapture capture;
+  expect_refused({"mock", "wr8", "--replay", capture.path(), "--port", "0"},
+                 "is a capture of a logi car, not of a wr8 car");
+  expect_refused(
+      {"mock", "logi", "--replay", capture.path(), "--profile", "firmware", "--port", "0"},
+      "was recorded in profile guide");
+  expect_refused({"mock", "logi", "--replay", capture.path(), "--profile", "nope", "--port", "0"},
+                 "--profile: logi has no profile 'nope'");
+  expect_refused({"mock", "logi", "--replay", "/nonexistent/car.ndjson", "--port", "0"},
+                 "--replay: /nonexistent/car.ndjson: cannot open");
+  expect_refused(
+      {"mock", "logi", "--replay", HIL_SOURCE_DIR "/tests/apps/data/bad-world.yaml", "--port", "0"},
+      "bad-world.yaml:1: ");
+  expect_refused({"mock", "logi", "--unmatched", "silent", "--port", "0"},
+                 "--unmatched requires --replay");
 }
 
 }  // namespace
