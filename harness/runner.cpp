@@ -152,6 +152,7 @@ bool ScenarioRun::build_car() {
     // count from time 0 with the reference client.
     car.configs.logi.grid_from_first_connection = external_client(scenario_, options_);
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));
+    car.replay = scenario_.replay;
     car_ = std::make_unique<mocks::MockCar>(std::move(car));
   } catch (const std::exception& e) {
     out_.error = std::string("the world cannot be built: ") + e.what();

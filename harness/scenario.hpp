@@ -199,6 +199,10 @@ struct Scenario {
   std::string description;
   std::vector<std::string> tags;
   mocks::CarKind car = mocks::CarKind::logi;
+  /// `car: {kind: ..., replay: FILE}`: the car plays a probe capture
+  /// (mocks/replay.hpp) instead of its mock firmware; the capture is read
+  /// when the scenario loads.
+  std::optional<mocks::ReplaySpec> replay;
   /// The car's profile (protocol/common/car_profile.hpp), mock and
   /// reference client alike; empty: the car's default.
   std::string profile;

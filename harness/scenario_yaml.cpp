@@ -7,6 +7,7 @@
 
 #include "base/enum_names.hpp"
 #include "harness/scenario_parts.hpp"
+#include "link/capture/probe_capture.hpp"
 #include "protocol/common/car_profile.hpp"
 
 namespace hil::harness {
@@ -40,6 +41,8 @@ const Keys kTopKeys = {"name",          "description", "tags",     "car",     "p
                        "reply_latency", "world",       "seed",     "timeout", "settle",
                        "at_end",        "variables",   "faults",   "client",  "setup",
                        "steps",         "teardown",    "schedule", "expect"};
+
+const Keys kCarKeys = {"kind", "replay", "unmatched"};
 
 constexpr auto kAtEndNames = base::enum_names<AtEnd>(
     {AtEnd::at_rest, "at_rest"}, {AtEnd::moving, "moving"}, {AtEnd::any, "any"});
@@ -92,7 +95,10 @@ class ScenarioReader : public config::Reader {
       for (const auto& t : n)
         scenario.tags.push_back(scalar(t, "a tag"));
     }
-    const auto car = required(root, "car", "the scenario");
+    const auto car_node = required(root, "car", "the scenario");
+    // `car: logi`, or `car: {kind: logi, replay: FILE, unmatched: silent}`.
+    if (car_node.IsMap()) check_keys(car_node, kCarKeys, "'car'");
+    const auto car = car_node.IsMap() ? required(car_node, "kind", "'car'") : car_node;
     const std::string car_text = scalar(car, "'car'");
     const auto kind = mocks::parse_car_kind(car_text);
     if (!kind) {
@@ -107,6 +113,7 @@ class ScenarioReader : public config::Reader {
         fail(n, "'profile': " + problem);
       }
     }
+    if (car_node.IsMap()) read_replay(root, car_node, scenario);
     if (auto n = root["world"]) scenario.world = read_existing_file(facts_, n, "world file");
     if (auto n = root["seed"]) scenario.seed = whole(n, "'seed'", 0);
     if (auto n = root["timeout"]) {
@@ -116,6 +123,47 @@ class ScenarioReader : public config::Reader {
     if (auto n = root["settle"]) scenario.settle = duration(n, "'settle'");
     if (auto n = root["reply_latency"]) scenario.reply_latency = duration(n, "'reply_latency'");
     if (auto n = root["at_end"]) scenario.at_end = at_end(n);
+  }
+
+  /// `replay: FILE` and `unmatched:` in a `car:` map: the capture read,
+  /// of this car, its profile the scenario's.
+  void read_replay(const YAML::Node& root, const YAML::Node& car, Scenario& scenario) {
+    const auto file = car["replay"];
+    if (!file) {
+      if (car["unmatched"]) fail(car["unmatched"], "'unmatched' needs 'replay' in 'car'");
+      return;
+    }
+    mocks::ReplaySpec replay;
+    replay.path = read_existing_file(facts_, file, "capture file");
+    try {
+      replay.capture = std::make_shared<const link::Capture>(link::read_capture(replay.path));
+    } catch (const link::CaptureError& e) {
+      fail(file, std::string("the capture cannot be read: ") + e.what());
+    }
+    const auto& header = replay.capture->header;
+    const std::string car_text(mocks::to_string(scenario.car));
+    if (header.car != car_text) {
+      fail(file, "'" + file.Scalar() + "' is a capture of a " + header.car + " car, not of a " +
+                     car_text + " car");
+    }
+    if (const auto problem = protocol::car_profile_problem(header.car, header.profile);
+        !problem.empty()) {
+      fail(file, "the capture's profile: " + problem);
+    }
+    const std::string recorded(protocol::find_car_profile(header.car, header.profile).name);
+    if (scenario.profile.empty()) {
+      scenario.profile = facts_.profile = recorded;
+    } else if (protocol::find_car_profile(car_text, scenario.profile).name != recorded) {
+      fail(root["profile"], "'profile' " + scenario.profile + " differs from the capture's, " +
+                                recorded + " (leave 'profile' out to play the capture)");
+    }
+    if (auto n = car["unmatched"]) {
+      const std::string word = scalar(n, "'unmatched'");
+      const auto parsed = mocks::parse_unmatched(word);
+      if (!parsed) fail(n, "'unmatched' must be mock or silent, got '" + word + "'");
+      replay.unmatched = *parsed;
+    }
+    scenario.replay = std::move(replay);
   }
 
   /// `at_end: moving`: how the car must be once the client has stopped.

@@ -53,6 +53,14 @@ WRONG = {
     "a WR8 profile misspelt": "name: t\ncar: wr8\nprofile: svgui-2020\nsteps: [connect]\n",
     "a reply latency without a unit": "name: t\ncar: arduino\nreply_latency: 20\nsteps: [PING]\n",
     "an end state misspelt": "name: t\ncar: logi\nat_end: movin\nsteps: [connect]\n",
+    "a replay without its car": "name: t\ncar: {replay: car.ndjson}\nsteps: [connect]\n",
+    "unmatched without a replay": "name: t\ncar: {kind: logi, unmatched: silent}\nsteps: [connect]\n",
+    "an unmatched policy misspelt": (
+        "name: t\ncar: {kind: logi, replay: car.ndjson, unmatched: mocked}\nsteps: [connect]\n"
+    ),
+    "another car's profile with a replay": (
+        "name: t\ncar: {kind: logi, replay: car.ndjson}\nprofile: readme\nsteps: [connect]\n"
+    ),
 }
 
 # And these are right in ways that are easy to get wrong in a schema.
@@ -67,6 +75,10 @@ RIGHT = {
     ),
     "faults off in YAML 1.1": "name: t\ncar: logi\nfaults: off\nsteps:\n  - faults: off\n",
     "a scenario that ends moving": "name: t\ncar: logi\nat_end: moving\nsteps: [connect]\n",
+    "a replayed car": (
+        "name: t\ncar: {kind: logi, replay: ../captures/car.ndjson, unmatched: silent}\n"
+        "steps: [connect]\n"
+    ),
     "an exec client": (
         "name: t\ncar: wr8\nclient: {exec: 'c {host} {port}', startup_timeout: 5s}\n"
         "steps: [connect]\n"
