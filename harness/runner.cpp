@@ -24,6 +24,7 @@
 #include "link/endpoint.hpp"
 #include "mocks/car.hpp"
 #include "mocks/server.hpp"
+#include "protocol/common/car_profile.hpp"
 #include "sim/arena_yaml.hpp"
 
 namespace hil::harness {
@@ -152,7 +153,7 @@ bool ScenarioRun::build_car() {
     // count from time 0 with the reference client.
     car.configs.logi.grid_from_first_connection = external_client(scenario_, options_);
     if (!scenario_.world.empty()) car.arena = sim::load_arena(world_path(scenario_));
-    car.replay = scenario_.replay;
+    car.replay = options_.replay ? options_.replay : scenario_.replay;
     car_ = std::make_unique<mocks::MockCar>(std::move(car));
   } catch (const std::exception& e) {
     out_.error = std::string("the world cannot be built: ") + e.what();
@@ -336,7 +337,31 @@ std::uint64_t chosen_seed(const Scenario& scenario, const RunOptions& options) {
 
 }  // namespace
 
+namespace {
+
+// Why the capture of --replay cannot play `scenario`'s car, or nullopt.
+std::optional<std::string> replay_mismatch(const Scenario& scenario,
+                                           const mocks::ReplaySpec& replay) {
+  if (!replay.capture) return std::nullopt;
+  const auto& header = replay.capture->header;
+  const std::string car(mocks::to_string(scenario.car));
+  if (header.car != car)
+    return "its car is " + car + " and --replay " + replay.path + " is a capture of " + header.car;
+  const auto& wanted = protocol::find_car_profile(car, scenario.profile).name;
+  const auto& recorded = protocol::find_car_profile(car, header.profile).name;
+  if (wanted != recorded) {
+    return "its car plays profile " + std::string(wanted) + " and --replay " + replay.path +
+           " was probed in profile " + std::string(recorded);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options) {
+  if (options.replay) {
+    if (auto why = replay_mismatch(scenario, *options.replay)) return why;
+  }
   const auto* reference = std::get_if<ReferenceClient>(&scenario.client);
   if (!options.client_exec || reference == nullptr || reference->settings.empty())
     return std::nullopt;

@@ -28,6 +28,10 @@ struct RunOptions {
   /// Runs every scenario against this external program instead of its own
   /// client (placeholders as in ExecClient::command).
   std::optional<std::string> client_exec;
+  /// Plays every scenario's car from this probe capture instead of its
+  /// mock firmware (`hil run --replay`); a scenario of another car, or of
+  /// another profile than the capture's, is skipped (skip_reason()).
+  std::optional<mocks::ReplaySpec> replay;
   /// Where reports may put files of this run (wire log); empty: nowhere.
   std::string work_dir;
   /// Room for real time in every expectation (check() in
@@ -52,7 +56,10 @@ struct RunOptions {
 /// that sets options of hil's reference client (`client: reference:
 /// settings:`) is skipped when RunOptions::client_exec puts an external
 /// program in that client's place: hil cannot give the program those
-/// options, and its verdict would judge a client set up otherwise.
+/// options, and its verdict would judge a client set up otherwise. With
+/// RunOptions::replay, a scenario of another car or profile than the
+/// capture's is skipped: its client would speak to a car it was not
+/// written for.
 std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options);
 
 /// Never throws for a scenario's own failures; they are in the outcome. A

@@ -24,6 +24,7 @@
 #include "harness/report.hpp"
 #include "harness/runner.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "link/capture/probe_capture.hpp"
 #include "link/faults/profile_yaml.hpp"
 
 namespace hil::apps {
@@ -43,7 +44,9 @@ struct RunArgs {
   std::vector<std::string> tags;
   std::vector<std::string> exclude_tags;
   std::optional<std::string> client_exec;
-  std::string slack;  ///< as written ("100ms"); empty: the runner's default
+  std::string replay;     ///< a probe capture every scenario's car plays; empty: none
+  std::string unmatched;  ///< with replay: mock or silent
+  std::string slack;      ///< as written ("100ms"); empty: the runner's default
   std::vector<std::string> sets;
   int jobs = 0;
   bool list = false;
@@ -89,6 +92,8 @@ std::string repro_command(const RunArgs& args, const std::string& file,
   for (const auto& s : args.sets)
     out += " --set " + shell_quote(s);
   if (args.client_exec) out += " --client-exec " + shell_quote(*args.client_exec);
+  if (!args.replay.empty()) out += " --replay " + shell_quote(args.replay);
+  if (!args.unmatched.empty()) out += " --unmatched " + args.unmatched;
   if (args.allow_outside_paths) out += " --allow-outside-paths";
   if (!args.slack.empty()) out += " --slack " + shell_quote(args.slack);
   return out;
@@ -271,8 +276,9 @@ Batch make_batch(const RunArgs& args, const std::vector<Planned>& plan) {
 // -v, each run as it finishes.
 class BatchRunner {
  public:
-  BatchRunner(const RunArgs& args, const std::vector<Planned>& plan, Batch& batch)
-      : args_(args), plan_(plan), batch_(batch) {}
+  BatchRunner(const RunArgs& args, const std::vector<Planned>& plan, Batch& batch,
+              std::optional<mocks::ReplaySpec> replay)
+      : args_(args), plan_(plan), batch_(batch), replay_(std::move(replay)) {}
 
   void run() {
     const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
@@ -315,6 +321,7 @@ class BatchRunner {
     harness::RunOptions options;
     options.seed = task.seed;
     options.client_exec = args_.client_exec;
+    options.replay = replay_;
     // A scenario may start one program, its declared client: print the
     // exact command line before it starts (once per scenario file).
     options.on_client_command = [this, file = p.file](const std::string& command) {
@@ -348,6 +355,7 @@ class BatchRunner {
   const RunArgs& args_;
   const std::vector<Planned>& plan_;
   Batch& batch_;
+  std::optional<mocks::ReplaySpec> replay_;
   std::atomic<std::size_t> next_{0};
   std::atomic<std::size_t> done_{0};
   std::mutex progress_;
@@ -389,9 +397,34 @@ int report_results(const RunArgs& args, const std::vector<ReportEntry>& entries)
   return status;
 }
 
+// --replay: the capture read once for every run; nullopt without it.
+// Throws std::runtime_error with the reader's file:line message.
+std::optional<mocks::ReplaySpec> load_replay(const RunArgs& args) {
+  if (args.replay.empty()) {
+    if (!args.unmatched.empty()) throw std::runtime_error("--unmatched needs --replay");
+    return std::nullopt;
+  }
+  mocks::ReplaySpec replay;
+  replay.path = args.replay;
+  try {
+    replay.capture = std::make_shared<const link::Capture>(link::read_capture(args.replay));
+  } catch (const link::CaptureError& e) {
+    throw std::runtime_error(std::string("--replay: ") + e.what());
+  }
+  if (!args.unmatched.empty()) replay.unmatched = *mocks::parse_unmatched(args.unmatched);
+  return replay;
+}
+
 int run_scenarios(const RunArgs& args) {
   const auto overrides = variable_overrides(args);
   if (!overrides) return 2;
+  std::optional<mocks::ReplaySpec> replay;
+  try {
+    replay = load_replay(args);
+  } catch (const std::exception& e) {
+    std::cerr << "hil run: " << e.what() << '\n';
+    return 2;
+  }
   const auto files = find_files(args);
   if (!files) return 2;
   if (files->empty()) {
@@ -407,7 +440,7 @@ int run_scenarios(const RunArgs& args) {
   }
   if (args.list) return list_plan(args, plan);
   Batch batch = make_batch(args, plan);
-  BatchRunner(args, plan, batch).run();
+  BatchRunner(args, plan, batch, std::move(replay)).run();
   return report_results(args, batch.entries);
 }
 
@@ -445,6 +478,14 @@ void register_run(CLI::App& app, std::function<int()>& run) {
                   "Run every scenario against this program instead of its client "
                   "({host} {port} {pty} {actions} ... as in docs/client-contract.md)")
       ->type_name("CMD");
+  cmd->add_option("--replay", args->replay,
+                  "Play every scenario's car from this probe capture (hil conform probe) instead "
+                  "of its mock; scenarios of another car or profile are skipped")
+      ->type_name("CAPTURE");
+  cmd->add_option("--unmatched", args->unmatched,
+                  "With --replay: a request the capture has no answer for gets the mock's answer "
+                  "(mock, the default) or none (silent)")
+      ->check(CLI::IsMember({"mock", "silent"}));
   cmd->add_option("--slack", args->slack,
                   "Room for real time: windows where something must happen grow by D, windows "
                   "where it must not shrink by D (default 100ms in real time, 0 in virtual time)")

@@ -235,5 +235,30 @@ TEST(HilRunCli, ListPrintsWhatWouldRunWithoutRunningIt) {
   EXPECT_THAT(broken.output, HasSubstr("does not load: " + kData + "/more/broken.yaml:6:5:"));
 }
 
+// The LOGI scenarios tagged `replay` need nothing the LOGI probe does not
+// record (answers, silences, the STAT period; no motion, no exact STAT
+// grid, no mode the car keeps), and pass against a recorded car: a probe
+// of hil's own mock, scenarios/captures/logi-probe.ndjson.
+TEST(HilRunCli, TheReplayTaggedLogiScenariosPassAgainstARecordedCar) {
+  expect_run(says("run scenarios/logi --tags replay --replay scenarios/captures/logi-probe.ndjson",
+                  0, {"16 passed, 0 failed"}));
+}
+
+TEST(HilRunCli, ReplaySkipsScenariosOfAnotherCarAndRefusesABadCapture) {
+  expect_run(
+      says("run scenarios/arduino/arduino-commands.yaml --replay "
+           "scenarios/captures/logi-probe.ndjson",
+           0,
+           {"its car is arduino and --replay scenarios/captures/logi-probe.ndjson is a "
+            "capture of logi",
+            "0 passed, 0 failed, 1 skipped"}));
+  expect_run(
+      says("run scenarios/logi/logi-buttons.yaml --replay "
+           "scenarios/captures/logi-session.txt",
+           2, {"hil run: --replay: ", "logi-session.txt:1:"}));
+  expect_run(says("run scenarios/logi/logi-buttons.yaml --unmatched silent", 2,
+                  {"--unmatched needs --replay"}));
+}
+
 }  // namespace
 }  // namespace hil::test
