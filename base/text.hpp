@@ -1,7 +1,7 @@
 #pragma once
 // Text that leaves hil for other programs: UTF-8 read one character at a
-// time, and XML escaping for the SVG pictures and the HTML and JUnit
-// reports.
+// time, XML escaping for the SVG pictures and the HTML and JUnit reports,
+// and control bytes escaped for one-line frame texts.
 
 #include <cstddef>
 #include <string>
@@ -20,5 +20,10 @@ std::size_t utf8_at(std::string_view text, std::size_t i, char32_t& code_point);
 /// control characters XML 1.0 cannot carry (even as references) are
 /// written "\xNN".
 std::string xml_escape(std::string_view text);
+
+/// `text` as one printable line, for frames in reports and tables: CR, LF
+/// and tab become "\r", "\n" and "\t", other control bytes (and DEL)
+/// "\xNN"; everything else, UTF-8 included, is kept.
+std::string escape_controls(std::string_view text);
 
 }  // namespace hil

@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "base/text.hpp"
 #include "link/protocol_adapter.hpp"
 
 namespace hil::conform {
@@ -80,21 +81,7 @@ bool is_text(const protocol::Bytes& raw) {
 std::string frame_text(const link::ProtocolAdapter& adapter, const link::WireFrame& frame) {
   std::string text;
   if (adapter.text_frames() || is_text(frame.raw)) {
-    for (const auto b : frame.raw) {
-      if (b == '\r') {
-        text += "\\r";
-      } else if (b == '\n') {
-        text += "\\n";
-      } else if (b == '\t') {
-        text += "\\t";
-      } else if (b >= 0x20 && b < 0x7F) {
-        text.push_back(static_cast<char>(b));
-      } else {
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "\\x%02X", b);
-        text += hex;
-      }
-    }
+    text = escape_controls(std::string(frame.raw.begin(), frame.raw.end()));
   } else {
     text = frame.kind.empty() ? std::string("?") : frame.kind;
     text += " " + protocol::to_hex(frame.raw);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "base/enum_names.hpp"
+#include "base/text.hpp"
 
 namespace hil::harness {
 namespace {
@@ -30,28 +31,6 @@ bool flag(const nlohmann::json& data, const char* key, bool fallback) {
   if (!data.is_object()) return fallback;
   const auto it = data.find(key);
   return it != data.end() && it->is_boolean() ? it->get<bool>() : fallback;
-}
-
-// Frame text as one printable line: control bytes become \r, \n, \xNN.
-std::string printable(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '\r') {
-      out += "\\r";
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (u < 0x20 || u == 0x7F) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02X", u);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out;
 }
 
 std::string fixed(double value, int decimals) {
@@ -80,7 +59,7 @@ std::string describe_wire(const Record& r) {
       who = "frame";
     }
     std::string bytes = field(d, "text");
-    bytes = bytes.empty() ? field(d, "hex") : printable(bytes);
+    bytes = bytes.empty() ? field(d, "hex") : escape_controls(bytes);
     if (bytes.empty()) bytes = field(d, "frame");
     std::string out = who + "  " + bytes;
     if (!flag(d, "valid", true)) {
@@ -119,7 +98,7 @@ std::string describe_client(const Record& r) {
     if (flag(d, "ok", true)) return out + "ok";
     return out + "failed: " + field(d, "reason");
   }
-  if (r.kind == ClientKind::output) return "output: " + printable(field(d, "line"));
+  if (r.kind == ClientKind::output) return "output: " + escape_controls(field(d, "line"));
   if (r.kind == ClientKind::exit) return "exit code " + field(d, "code");
   if (r.kind == ClientKind::origin) return field(d, "text");
   return {};

@@ -57,5 +57,13 @@ TEST(XmlEscape, KeepsLineBreaksAndTabsAndShowsTheRest) {
   EXPECT_EQ(xml_escape(""), "");
 }
 
+TEST(EscapeControls, WritesLineEndsTabsAndControlBytesAsEscapes) {
+  EXPECT_EQ(escape_controls("OK\r\n"), "OK\\r\\n");
+  EXPECT_EQ(escape_controls("a\tb"), "a\\tb");
+  EXPECT_EQ(escape_controls(std::string("\x01\x7F", 2)), "\\x01\\x7F");
+  EXPECT_EQ(escape_controls(std::string("\0", 1)), "\\x00");
+  EXPECT_EQ(escape_controls("caf\xC3\xA9 ^01|ACK|PONG*5E$"), "caf\xC3\xA9 ^01|ACK|PONG*5E$");
+}
+
 }  // namespace
 }  // namespace hil

@@ -29,10 +29,6 @@ Time at_ms(int ms) {
   return Time(std::chrono::milliseconds(ms));
 }
 
-protocol::Bytes bytes_of(std::string_view text) {
-  return {text.begin(), text.end()};
-}
-
 std::string stat_frame(int distance_cm) {
   logi::Status status;
   status.speed_percent = 50;
@@ -54,14 +50,14 @@ class ReplayScenario : public ::testing::Test {
     CaptureRecorder r({"logi-probe/1", "logi", "guide", "tcp://car:9000", 0}, log);
     r.begin_exchange(at_ms(0), "connect", ExchangeKind::connect, "open");
     r.opened(at_ms(0), "probe", "tcp://car:9000");
-    r.received(at_ms(50), bytes_of(stat_frame(100)));
+    r.received(at_ms(50), protocol::to_bytes(stat_frame(100)));
     r.begin_exchange(at_ms(100), "manual", ExchangeKind::command, "MD:MAN");
-    r.sent(at_ms(120), bytes_of(logi::frame_text("MD:MAN")));
-    r.received(at_ms(150), bytes_of(logi::frame_text("FB:MD:0")));
-    r.received(at_ms(150), bytes_of(stat_frame(101)));
+    r.sent(at_ms(120), protocol::to_bytes(logi::frame_text("MD:MAN")));
+    r.received(at_ms(150), protocol::to_bytes(logi::frame_text("FB:MD:0")));
+    r.received(at_ms(150), protocol::to_bytes(stat_frame(101)));
     r.begin_exchange(at_ms(200), "telemetry", ExchangeKind::telemetry, "STAT");
     for (int i = 2; i < 10; ++i)
-      r.received(at_ms(50 + 100 * i), bytes_of(stat_frame(100 + i)));
+      r.received(at_ms(50 + 100 * i), protocol::to_bytes(stat_frame(100 + i)));
     r.end_exchange(at_ms(1000));
   }
 

@@ -31,10 +31,6 @@ using link::CaptureRecorder;
 using link::ExchangeKind;
 using link::milliseconds;
 
-protocol::Bytes bytes_of(std::string_view text) {
-  return {text.begin(), text.end()};
-}
-
 std::string stat_frame(int distance_cm) {
   logi::Status status;
   status.speed_percent = 50;
@@ -52,21 +48,21 @@ link::Capture logi_capture() {
   int next_stat = 0;
   const auto stats_until = [&](int ms) {
     for (; 50 + 100 * next_stat <= ms; ++next_stat)
-      r.received(at_ms(50 + 100 * next_stat), bytes_of(stat_frame(100 + next_stat)));
+      r.received(at_ms(50 + 100 * next_stat), protocol::to_bytes(stat_frame(100 + next_stat)));
   };
   r.begin_exchange(at_ms(0), "connect", ExchangeKind::connect, "the car takes a connection");
   r.opened(at_ms(0), "probe", "tcp://car:9000");
   stats_until(100);
   r.begin_exchange(at_ms(100), "manual", ExchangeKind::command, "MD:MAN");
-  r.sent(at_ms(120), bytes_of(logi::frame_text("MD:MAN")));
-  r.received(at_ms(145), bytes_of(logi::frame_text("FB:MD:1")));
+  r.sent(at_ms(120), protocol::to_bytes(logi::frame_text("MD:MAN")));
+  r.received(at_ms(145), protocol::to_bytes(logi::frame_text("FB:MD:1")));
   stats_until(200);
   r.begin_exchange(at_ms(200), "speed", ExchangeKind::command, "SP:050");
-  r.sent(at_ms(220), bytes_of(logi::frame_text("SP:050")));
+  r.sent(at_ms(220), protocol::to_bytes(logi::frame_text("SP:050")));
   stats_until(250);
-  r.received(at_ms(260), bytes_of(logi::frame_text("FB:SP:0")));
+  r.received(at_ms(260), protocol::to_bytes(logi::frame_text("FB:SP:0")));
   r.begin_exchange(at_ms(280), "bad checksum", ExchangeKind::error, "ignored");
-  r.sent(at_ms(300), bytes_of("LOGI:SP:050:00#"));
+  r.sent(at_ms(300), protocol::to_bytes("LOGI:SP:050:00#"));
   stats_until(340);
   r.begin_exchange(at_ms(340), "telemetry", ExchangeKind::telemetry, "STAT");
   stats_until(1000);
@@ -105,7 +101,7 @@ class ReplayRig {
   }
   void write(link::Time at, std::string_view bytes) {
     run_until(at);
-    firmware_.receive(at, protocol::ByteView(bytes_of(bytes)));
+    firmware_.receive(at, protocol::ByteView(protocol::to_bytes(bytes)));
     collect(at);
   }
   /// Wakes the firmware whenever it asks, up to `t`.
@@ -306,7 +302,7 @@ TEST(ReplayFirmware, TheCarClosingAfterARequestIsReplayedOnTime) {
   CaptureRecorder r({"logi-probe/1", "logi", "guide", "tcp://car:9000", 0});
   r.begin_exchange(at_ms(0), "hang up", ExchangeKind::error, "the car closes");
   r.opened(at_ms(0), "probe", "tcp://car:9000");
-  r.sent(at_ms(100), bytes_of(logi::frame_text("MD:AUTO")));
+  r.sent(at_ms(100), protocol::to_bytes(logi::frame_text("MD:AUTO")));
   r.closed(at_ms(1100), {link::LinkClose::By::car, link::CloseMode::graceful, "car closed"});
   r.end_exchange(at_ms(1200));
   ReplayRig rig(r.take());
@@ -331,8 +327,8 @@ link::Capture arduino_capture() {
   r.begin_exchange(at_ms(0), "open", ExchangeKind::connect, "the port opens");
   r.opened(at_ms(0), "probe", "pty:///dev/ttyACM0");
   r.begin_exchange(at_ms(1900), "ping", ExchangeKind::command, "PING");
-  r.sent(at_ms(2000), bytes_of(arduino_frame(1, arduino::Ping{})));
-  r.received(at_ms(2012), bytes_of(arduino_frame(1, arduino::Ack{"PONG"})));
+  r.sent(at_ms(2000), protocol::to_bytes(arduino_frame(1, arduino::Ping{})));
+  r.received(at_ms(2012), protocol::to_bytes(arduino_frame(1, arduino::Ack{"PONG"})));
   r.end_exchange(at_ms(2100));
   return r.take();
 }
@@ -372,7 +368,7 @@ TEST(ReplayFirmwareArduino, AnUnrecordedCommandIsTheMocksOrNobodys) {
     auto plain = make_firmware(CarKind::arduino, world, vehicle, configs);
     plain->connect(at_ms(0));
     plain->take_output();
-    plain->receive(at_ms(300), bytes_of(arduino_frame(2, arduino::SetSpeed{200})));
+    plain->receive(at_ms(300), protocol::to_bytes(arduino_frame(2, arduino::SetSpeed{200})));
     for (auto due = plain->next_wakeup(); due && *due <= at_ms(1000); due = plain->next_wakeup())
       plain->wake(*due);
     const auto out = plain->take_output();
@@ -408,8 +404,8 @@ TEST(MockCarReplay, ReadsTheCaptureFileAndPlaysIt) {
     CaptureRecorder r({"logi-probe/1", "logi", "guide", "tcp://car:9000", 0}, log);
     r.begin_exchange(at_ms(0), "manual", ExchangeKind::command, "MD:MAN");
     r.opened(at_ms(0), "probe", "tcp://car:9000");
-    r.sent(at_ms(20), bytes_of(logi::frame_text("MD:MAN")));
-    r.received(at_ms(31), bytes_of(logi::frame_text("FB:MD:1")));
+    r.sent(at_ms(20), protocol::to_bytes(logi::frame_text("MD:MAN")));
+    r.received(at_ms(31), protocol::to_bytes(logi::frame_text("FB:MD:1")));
     r.end_exchange(at_ms(100));
   }
   CarOptions options;
@@ -420,7 +416,7 @@ TEST(MockCarReplay, ReadsTheCaptureFileAndPlaysIt) {
   ASSERT_NE(dynamic_cast<ReplayFirmware*>(&car.firmware()), nullptr);
   auto& fw = car.firmware();
   fw.connect(at_ms(0));
-  fw.receive(at_ms(10), bytes_of(logi::frame_text("MD:MAN")));
+  fw.receive(at_ms(10), protocol::to_bytes(logi::frame_text("MD:MAN")));
   EXPECT_EQ(fw.next_wakeup(), std::optional<link::Time>(at_ms(21)));
   fw.wake(at_ms(21));
   const auto out = fw.take_output();
