@@ -356,6 +356,27 @@ TEST(HilMock, ReplaySilentLeavesUnrecordedRequestsUnanswered) {
   EXPECT_EQ(mock.interrupt(), 0);
 }
 
+TEST(HilMock, ReplayTakesFaultsLikeAnyMock) {
+  const ReplayCapture capture;
+  const auto faults = std::filesystem::temp_directory_path() /
+                      ("hil-replay-cli-faults-" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(faults) << "rules:\n  - kind: drop\n    direction: to_client\n"
+                           "    match: \"FB:MD\"\n";
+  HilProcess mock(
+      {"mock", "logi", "--replay", capture.path(), "--faults", faults.string(), "--port", "0"});
+  int port = -1;
+  ASSERT_NO_FATAL_FAILURE(wait_for_port(mock, port));
+  Conn client = tcp_connect(port);
+  ASSERT_TRUE(client.ok());
+  EXPECT_TRUE(client.read_until("DIS:777")) << client.received;
+  // The recorded answer is dropped on its way to the client.
+  ASSERT_TRUE(client.send("LOGI:MD:MAN:0C#"));
+  EXPECT_TRUE(mock.wait_for_line("drop")) << mock.output();
+  EXPECT_EQ(client.received.find("FB:MD"), std::string::npos) << client.received;
+  EXPECT_EQ(mock.interrupt(), 0) << mock.output();
+  std::filesystem::remove(faults);
+}
+
 TEST(HilMock, AReplayThatCannotBePlayedIsRefused) {
   const ReplayCapture capture;
   expect_refused({"mock", "wr8", "--replay", capture.path(), "--port", "0"},
