@@ -1,5 +1,8 @@
 #include "apps/common/program.hpp"
 
+#include <pthread.h>
+#include <signal.h>
+
 #include "base/enum_names.hpp"
 #include "protocol/common/car_profile.hpp"
 
@@ -92,7 +95,16 @@ std::string signal_name(int signal) {
   return "signal " + std::to_string(signal);
 }
 
+void unblock_signals(std::initializer_list<int> signals) {
+  sigset_t set;
+  sigemptyset(&set);
+  for (const int signal : signals)
+    sigaddset(&set, signal);
+  pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+}
+
 ProgramLoop::ProgramLoop(std::initializer_list<int> stop_signals) : signals_(io_) {
+  unblock_signals(stop_signals);
   for (const int signal : stop_signals)
     signals_.add(signal);
 }

@@ -32,6 +32,12 @@ inline constexpr int kExitFailed = 1;  ///< an action or command failed
 inline constexpr int kExitUsage = 2;   ///< bad usage or a script error
 inline constexpr int kExitInterrupted = 130;
 
+/// Unblocks `signals` in the calling thread, and so in every thread it
+/// starts afterwards: a program whose parent left its stop signals blocked
+/// (a supervisor, a test harness, a shell script) would otherwise never see
+/// Ctrl-C or SIGTERM. Call it before any thread starts.
+void unblock_signals(std::initializer_list<int> signals);
+
 /// --port (a device path or a hil endpoint) and --baud (0..4000000), as the
 /// serial clients take them; the --port option, for what else it needs.
 CLI::Option* add_serial_options(CLI::App& app, std::string& port, unsigned& baud,

@@ -3,13 +3,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <functional>
 #include <iostream>
 #include <string_view>
 
+#include "apps/common/program.hpp"
 #include "apps/hil/cli_common.hpp"
 
 int main(int argc, char** argv) {
+  // Before any thread starts: `hil mock`, `hil proxy` and `hil conform
+  // probe` stop on these even when started with them blocked.
+  hil::apps::unblock_signals({SIGINT, SIGTERM});
   CLI::App app{"hil: test harness and mock cars for robot-car client software"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "hil 0.1.0");

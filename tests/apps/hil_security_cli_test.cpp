@@ -3,6 +3,8 @@
 // shows every program a scenario starts, keeps scenario paths inside the
 // scenario's library and writes its JUnit file whole.
 
+#include <pthread.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -91,6 +93,28 @@ TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
   EXPECT_THAT(std::string(reply), HasSubstr("HTTP/1."));
   ::close(fd);
   mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
+}
+
+// hil started with Ctrl-C and SIGTERM blocked, as a parent process (a
+// supervisor, a test harness) may leave them: it unblocks them, and stops
+// on Ctrl-C as when started from a shell.
+TEST(StopSignals, HilStartedWithItsStopSignalsBlockedStillStopsOnCtrlC) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"proxy", "--listen", "tcp://127.0.0.1:0", "--upstream",
+                                 "tcp://127.0.0.1:9"},
+        std::vector<std::string>{"mock", "logi", "--port", "0"}}) {
+    sigset_t blocked;
+    sigset_t before;
+    sigemptyset(&blocked);
+    sigaddset(&blocked, SIGINT);
+    sigaddset(&blocked, SIGTERM);
+    // A spawned process starts with its parent thread's signal mask.
+    pthread_sigmask(SIG_BLOCK, &blocked, &before);
+    HilProcess hil(args);
+    pthread_sigmask(SIG_SETMASK, &before, nullptr);
+    ASSERT_TRUE(hil.wait_for_line("tcp://127.0.0.1:")) << hil.output();
+    EXPECT_EQ(hil.interrupt(), 0) << args[0] << ": " << hil.output();
+  }
 }
 
 TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
