@@ -116,7 +116,7 @@ INSTANTIATE_TEST_SUITE_P(MockCars, EveryCar,
 TEST(MockCar, NamesAndDefaultsOfTheFourCars) {
   for (const auto kind : {CarKind::logi, CarKind::wr8, CarKind::arduino, CarKind::leka}) {
     EXPECT_EQ(parse_car_kind(to_string(kind)), kind);
-    MockCar car(CarOptions{kind, sim::default_warehouse_arena(), 1, "c", {}});
+    MockCar car(CarOptions{kind, sim::default_warehouse_arena(), 1, "c", {}, {}});
     EXPECT_EQ(car.firmware().protocol(), to_string(kind));
   }
   EXPECT_FALSE(parse_car_kind("tesla"));
