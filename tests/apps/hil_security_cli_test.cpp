@@ -20,6 +20,7 @@
 
 #include "tests/apps/hil_cli_support.hpp"
 #include "tests/harness/scratch_dir.hpp"
+#include "tests/support/sanitizers.hpp"
 #include "tests/support/text.hpp"
 
 namespace hil::test {
@@ -95,6 +96,19 @@ TEST(DefaultBind, TheLiveViewServesOnLoopbackOnly) {
   mock.interrupt();  // right after start-up: may beat the Ctrl-C handler
 }
 
+// Ctrl-C, and its exit status. Under ThreadSanitizer, about one run in 20
+// to 40 on a loaded machine loses a SIGINT sent right after start-up: the
+// process then sleeps in epoll_wait with nothing pending or blocked, its
+// handler never run, also with a timer waking it every second. The default
+// and ASan trees never lost one (0 of 40 under the same load), so there a
+// single Ctrl-C must do; under TSan a second one follows after 3 s, and
+// that stage checks the shutdown for data races.
+std::optional<int> ctrl_c(HilProcess& process) {
+  if (!kThreadSanitizerBuild) return process.interrupt();
+  if (auto status = process.interrupt(std::chrono::seconds(3))) return status;
+  return process.interrupt();
+}
+
 // hil started with Ctrl-C and SIGTERM blocked, as a parent process (a
 // supervisor, a test harness) may leave them: it unblocks them, and stops
 // on Ctrl-C as when started from a shell.
@@ -113,7 +127,7 @@ TEST(StopSignals, HilStartedWithItsStopSignalsBlockedStillStopsOnCtrlC) {
     HilProcess hil(args);
     pthread_sigmask(SIG_SETMASK, &before, nullptr);
     ASSERT_TRUE(hil.wait_for_line("tcp://127.0.0.1:")) << hil.output();
-    EXPECT_EQ(hil.interrupt(), 0) << args[0] << ": " << hil.output();
+    EXPECT_EQ(ctrl_c(hil), 0) << args[0] << ": " << hil.output();
   }
 }
 
@@ -124,7 +138,7 @@ TEST(DefaultBind, TheProxyOnLoopbackSaysNothingAndOnEveryInterfaceWarns) {
         expect_says(proxy, "clients connect to", "clients connect to tcp://127.0.0.1:"));
     EXPECT_THAT(proxy.output(), Not(HasSubstr("reachable from other machines")));
     // Ctrl-C right after start-up is caught like any later one.
-    EXPECT_EQ(proxy.interrupt(), 0) << proxy.output();
+    EXPECT_EQ(ctrl_c(proxy), 0) << proxy.output();
   }
   HilProcess proxy({"proxy", "--listen", "tcp://0.0.0.0:0", "--upstream", "tcp://127.0.0.1:9"});
   ASSERT_NO_FATAL_FAILURE(expect_warns_of_every_interface(proxy));
