@@ -142,7 +142,7 @@ class AnswerIndexer {
     to_car_->feed(e.bytes, frames);
     for (auto& f : frames) {
       auto seq = seq_of(f.raw);
-      answers_.push_back({std::move(f.raw), f.valid ? std::move(f.kind) : std::string(), {}});
+      answers_.push_back({std::move(f.raw), f.valid ? std::move(f.kind) : std::string(), {}, {}});
       requests_.push_back({answers_.size() - 1, e.at, write, f.valid, std::move(seq)});
     }
   }
