@@ -339,7 +339,8 @@ TEST(ExternalClient, TheActionsFileHoldsEveryActionInScenarioOrder) {
 // A LOGI client in Python's standard library: `connect` opens the car's
 // TCP port, the MAN actions become their frames, every action is answered
 // `ok`. With "stop" as its argument it sends MV:STOP when its input ends,
-// as the contract asks; without, it walks away from a moving car.
+// as the contract asks, and waits for the car's answer; without, it walks
+// away from a moving car.
 constexpr const char* kPythonLogiClient = R"py(
 import os, socket, sys
 def frame(payload):
@@ -357,7 +358,15 @@ for line in sys.stdin:
     print("ok", flush=True)
 if car is not None and sys.argv[1:] == ["stop"]:
     car.sendall(frame("MV:STOP"))
-    car.recv(64)
+    # Exit only once the car has answered the stop (its second FB:MV; the
+    # first answered FWD): closing with bytes unread sends a reset, which
+    # can discard the stop before hil has read it.
+    seen = b""
+    while seen.count(b"FB:MV") < 2:
+        chunk = car.recv(4096)
+        if not chunk:
+            break
+        seen += chunk
 )py";
 
 /// The Python client above, in `dir`, started after `delay` of its own.
