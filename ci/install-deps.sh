@@ -20,6 +20,10 @@ packages=(
   libcpp-httplib-dev         # hil mock --view: the live view's web server
   chromium chromium-driver   # the live view's browser test (~130 MB download, ~440 MB installed)
   python3-jsonschema python3-yaml  # checks scenario files against scenarios/schema.json (tested)
+  gcc-avr avr-libc           # hil firmware build: the AVR compiler and C library for real sketches
+  arduino-core-avr arduino-mk  # the Arduino Uno core and the Makefile that builds a sketch with it
+  simavr                     # the emulator's command-line tool (run a sketch's ELF by hand)
+  libsimavr-dev libelf-dev   # the emulated ATmega328P that hil::mocks links (mocks/avr/)
 )
 
 if [ "$(id -u)" -ne 0 ]; then

@@ -23,3 +23,17 @@ endif()
 if(HIL_BUILD_BENCH)
   find_package(benchmark REQUIRED)
 endif()
+
+# simavr (libsimavr-dev) runs real AVR firmware on an emulated ATmega328P
+# (mocks/avr/); it loads ELF files through libelf.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(SIMAVR REQUIRED simavr)
+pkg_check_modules(LIBELF REQUIRED IMPORTED_TARGET libelf)
+# Linked statically: calls into the emulator's core from hil's run loop
+# (one per instruction) are about 15 % faster than through the shared
+# library's PLT (docs/performance.md, "Real firmware").
+find_library(HIL_SIMAVR_STATIC NAMES libsimavr.a REQUIRED)
+add_library(hil_simavr INTERFACE)
+target_include_directories(hil_simavr SYSTEM INTERFACE ${SIMAVR_INCLUDE_DIRS})
+target_link_libraries(hil_simavr INTERFACE ${HIL_SIMAVR_STATIC} PkgConfig::LIBELF)
+add_library(hil::simavr ALIAS hil_simavr)

@@ -116,5 +116,7 @@ void register_run(CLI::App& app, std::function<int()>& run);
 void register_conform(CLI::App& app, std::function<int()>& run);
 /// hil profiles [CAR]: the registry of car profiles (protocol/common/car_profile.hpp).
 void register_profiles(CLI::App& app, std::function<int()>& run);
+/// `hil firmware build`: an Arduino sketch into the emulated Uno's ELF (firmware_command.cpp).
+void register_firmware(CLI::App& app, std::function<int()>& run);
 
 }  // namespace hil::apps

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
       "  hil profiles                                each car's dialects and their sources\n"
       "  hil conform probe arduino --target pty:///dev/ttyUSB0 -o car.ndjson\n"
       "  hil conform check car.ndjson --all-profiles  which profile the car plays\n"
+      "  hil firmware build robot/robot.ino -o robot.elf  an Arduino sketch for the emulated Uno\n"
       "Run 'hil encode <protocol> --help' or 'hil decode <protocol> --help' for every form.\n");
 
   auto* encode =
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
   hil::apps::register_run(app, run);
   hil::apps::register_profiles(app, run);
   hil::apps::register_conform(app, run);
+  hil::apps::register_firmware(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&
