@@ -48,6 +48,7 @@ void apply_profile(FirmwareConfigs& configs, CarKind kind, std::string_view prof
   switch (kind) {
     case CarKind::arduino:
       configs.arduino.dialect = protocol::arduino::dialect_named(p.name);
+      if (configs.avr) configs.avr->profile = std::string(p.name);
       break;
     case CarKind::leka:
       configs.leka.dialect = protocol::leka::dialect_named(p.name);
@@ -74,6 +75,7 @@ std::unique_ptr<Firmware> make_firmware_of_kind(CarKind kind, sim::World& world,
         return std::make_unique<SvguiFirmware>(world, vehicle, configs.svgui);
       return std::make_unique<Wr8Firmware>(world, vehicle, configs.wr8);
     case CarKind::arduino:
+      if (configs.avr) return std::make_unique<AvrFirmware>(world, vehicle, *configs.avr);
       return std::make_unique<ArduinoFirmware>(world, vehicle, configs.arduino);
     case CarKind::leka:
       return std::make_unique<LekaFirmware>(world, vehicle, configs.leka);
@@ -86,8 +88,11 @@ std::unique_ptr<Firmware> make_firmware_of_kind(CarKind kind, sim::World& world,
 std::unique_ptr<Firmware> make_firmware(CarKind kind, sim::World& world, sim::Vehicle& vehicle,
                                         const FirmwareConfigs& configs) {
   auto firmware = make_firmware_of_kind(kind, world, vehicle, configs);
-  firmware->set_reply_latency(
-      configs.reply_latency.value_or(latency_of(protocol::default_car_profile(to_string(kind)))));
+  // A real firmware's answers take the emulated chip's own time.
+  const bool emulated = kind == CarKind::arduino && configs.avr;
+  firmware->set_reply_latency(emulated ? Duration{0}
+                                       : configs.reply_latency.value_or(latency_of(
+                                             protocol::default_car_profile(to_string(kind)))));
   return firmware;
 }
 

@@ -12,6 +12,7 @@
 #include "base/enum_names.hpp"
 #include "link/endpoint.hpp"
 #include "mocks/arduino.hpp"
+#include "mocks/avr/avr_firmware.hpp"
 #include "mocks/firmware.hpp"
 #include "mocks/leka.hpp"
 #include "mocks/logi.hpp"
@@ -42,6 +43,10 @@ struct FirmwareConfigs {
   /// of `wr8` when its version is set (profiles svgui-2019, svgui-head).
   SvguiConfig svgui;
   ArduinoConfig arduino;
+  /// The Arduino car as a real firmware image on the emulated ATmega328P
+  /// (mocks/avr/avr_firmware.hpp); used instead of `arduino` when set. Its
+  /// answers take the chip's own time: `reply_latency` is not added.
+  std::optional<AvrConfig> avr;
   LekaConfig leka;
   /// The firmware's processing time before each answer (Firmware::
   /// set_reply_latency); nullopt: the default profile's. Zero: in the same

@@ -139,19 +139,28 @@ std::optional<link::CloseMode> Firmware::take_close() {
   return mode;
 }
 
-void Firmware::send(ByteView frame) {
-  if (!connected_) return;
+void Firmware::queue_output(ByteView bytes) {
   if (reply_latency_ > Duration{0}) {
     Time due = now_ + reply_latency_;
     if (!delayed_.empty()) due = std::max(due, delayed_.back().due);
-    delayed_.push_back({due, Bytes(frame.begin(), frame.end())});
+    delayed_.push_back({due, Bytes(bytes.begin(), bytes.end())});
   } else if (!delayed_.empty()) {
-    delayed_.push_back({delayed_.back().due, Bytes(frame.begin(), frame.end())});
+    delayed_.push_back({delayed_.back().due, Bytes(bytes.begin(), bytes.end())});
   } else {
-    output_.insert(output_.end(), frame.begin(), frame.end());
+    output_.insert(output_.end(), bytes.begin(), bytes.end());
   }
-  stats_.bytes_out += frame.size();
+  stats_.bytes_out += bytes.size();
+}
+
+void Firmware::send(ByteView frame) {
+  if (!connected_) return;
+  queue_output(frame);
   ++stats_.frames_out;
+}
+
+void Firmware::send_bytes(ByteView bytes) {
+  if (!connected_) return;
+  queue_output(bytes);
 }
 
 void Firmware::send(std::string_view frame) {

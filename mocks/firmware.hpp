@@ -151,6 +151,10 @@ class Firmware {
   /// Queues one frame for the client (counts it).
   void send(ByteView frame);
   void send(std::string_view frame);
+  /// Queues bytes that are not one whole frame (a real firmware's UART
+  /// output, as it comes); count_frame_out() counts the frames in them.
+  void send_bytes(ByteView bytes);
+  void count_frame_out() { ++stats_.frames_out; }
   /// What the armed behaviours say about a command of `kind`; counts
   /// rejects and ignores.
   Disposition dispose(Time now, std::string_view kind);
@@ -199,6 +203,7 @@ class Firmware {
     Bytes bytes;
   };
   void release_delayed(Time now);
+  void queue_output(ByteView bytes);
 
   std::string_view protocol_;
   std::string_view profile_;

@@ -1,0 +1,444 @@
+#include "mocks/avr/chip.hpp"
+
+extern "C" {
+#include <avr_adc.h>
+#include <avr_extint.h>
+#include <avr_ioport.h>
+#include <avr_uart.h>
+#include <sim_avr.h>
+#include <sim_core.h>
+#include <sim_elf.h>
+#include <sim_interrupts.h>
+#include <sim_io.h>
+#include <sim_irq.h>
+}
+
+#include <algorithm>
+#include <array>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <stdexcept>
+
+namespace hil::mocks::avr {
+
+namespace {
+
+// ATmega328P data-space addresses (datasheet, "Register Summary").
+constexpr std::uint16_t kUcsr0a = 0xC0;
+constexpr std::uint16_t kUcsr0b = 0xC1;
+constexpr std::uint16_t kUbrr0l = 0xC4;
+constexpr std::uint16_t kUbrr0h = 0xC5;
+constexpr std::uint8_t kU2x0 = 1 << 1;
+constexpr std::uint8_t kRxen0 = 1 << 4;
+constexpr std::uint8_t kTxen0 = 1 << 3;
+
+// PINx, DDRx, PORTx of ports B, C and D.
+struct PortRegs {
+  std::uint16_t pin, ddr, port;
+};
+PortRegs port_regs(char port) {
+  switch (port) {
+    case 'B':
+      return {0x23, 0x24, 0x25};
+    case 'C':
+      return {0x26, 0x27, 0x28};
+    default:
+      return {0x29, 0x2A, 0x2B};
+  }
+}
+
+// A timer's control register A and its two compare registers (low byte),
+// and the COMnx1 bit that connects each output.
+struct TimerRegs {
+  std::uint16_t tccra, ocra, ocrb;
+};
+constexpr std::array<TimerRegs, 3> kTimers{
+    {{0x44, 0x47, 0x48}, {0x80, 0x88, 0x8A}, {0xB0, 0xB3, 0xB4}}};
+constexpr std::uint8_t kComA1 = 1 << 7;
+constexpr std::uint8_t kComB1 = 1 << 5;
+
+// ELF32 header fields (System V ABI): the AVR machine number, and the
+// avr-gcc architecture number in the low bits of e_flags.
+constexpr std::uint16_t kEmAvr = 83;
+constexpr std::uint32_t kEfAvrMachMask = 0x7F;
+constexpr std::uint32_t kAvr5 = 5;
+
+void quiet_logger(avr_t* avr, int level, const char* format, va_list ap);
+
+// simavr's logger is one function for the process; it hands each message
+// to the chip it came from.
+void install_logger() {
+  static std::once_flag once;
+  std::call_once(once, [] { avr_global_logger_set(&quiet_logger); });
+}
+
+std::string elf_family(std::uint32_t mach) {
+  switch (mach) {
+    case 2:
+      return "avr2 (ATtiny)";
+    case 25:
+      return "avr25 (ATtiny)";
+    case 4:
+      return "avr4 (ATmega8-class)";
+    case 51:
+      return "avr51 (ATmega128-class)";
+    case 6:
+      return "avr6 (ATmega2560-class)";
+    case 100:
+      return "avrtiny";
+    default:
+      return "avr" + std::to_string(mach);
+  }
+}
+
+}  // namespace
+
+struct Chip::Impl {
+  avr_t* avr = nullptr;
+  Chip* chip = nullptr;
+  std::uint64_t stop = 0;  // the running run_to()'s next stopping cycle
+  std::multimap<std::uint64_t, std::function<void()>> events;
+  std::deque<std::uint8_t> rx_waiting;  // beyond the chip's FIFO
+  bool rx_full = false;                 // the chip's FIFO said XOFF
+  std::function<void(std::uint8_t, std::uint64_t)> on_tx;
+  struct Watch {
+    std::function<void(bool)> fn;
+    int last = -1;
+    BoardPin pin;
+  };
+  std::vector<std::unique_ptr<Watch>> watches;
+  std::function<void(int)> on_conversion;
+  std::vector<std::string> messages;
+  bool driving = false;
+
+  avr_irq_t* uart_irq(int which) const {
+    return avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), which);
+  }
+  avr_irq_t* pin_irq(const BoardPin& pin) const {
+    return avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(static_cast<std::uint32_t>(pin.port)),
+                         pin.bit);
+  }
+
+  void datasheet_reset_values() {
+    // simavr turns the transmitter on at reset so that a test program can
+    // print without setting the UART up; the chip starts with it off, and
+    // a firmware that never calls Serial.begin() must stay silent.
+    avr->data[kUcsr0b] = 0;
+    // simavr polls an INT0/INT1 pin on every cycle while it is low in the
+    // low-level mode (the reset default), enabled or not: an encoder pin
+    // held low would slow the chip threefold. Off, a low level interrupts
+    // once, on the falling edge (docs/firmware.md, "What is emulated").
+    for (std::uint8_t n = 0; n < 2; ++n)
+      avr_extint_set_strict_lvl_trig(avr, n, 0);
+  }
+
+  void quiet_uart() {
+    // Off: printing what the firmware sends to stdout, and sleeping the
+    // host thread while the firmware polls an empty receiver.
+    std::uint32_t flags = 0;
+    avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
+    flags &= ~static_cast<std::uint32_t>(AVR_UART_FLAG_POLL_SLEEP | AVR_UART_FLAG_STDIO);
+    avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+  }
+
+  void pump_rx() {
+    // The receiver takes bytes only while it is on; the chip drops the rest.
+    while (!rx_waiting.empty() && !rx_full) {
+      const std::uint8_t byte = rx_waiting.front();
+      rx_waiting.pop_front();
+      if ((avr->data[kUcsr0b] & kRxen0) == 0) continue;
+      avr_raise_irq(uart_irq(UART_IRQ_INPUT), byte);
+    }
+  }
+};
+
+namespace {
+
+void quiet_logger(avr_t* avr, int level, const char* format, va_list ap) {
+  if (avr == nullptr || level > LOG_WARNING || avr->custom.data == nullptr) return;
+  auto* impl = static_cast<Chip::Impl*>(avr->custom.data);
+  if (impl->messages.size() >= 64) return;
+  std::array<char, 256> text{};
+  std::vsnprintf(text.data(), text.size(), format, ap);
+  std::string line(text.data());
+  while (!line.empty() && (line.back() == '\n' || line.back() == '\r'))
+    line.pop_back();
+  impl->messages.push_back(std::move(line));
+}
+
+void on_tx(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
+  auto* impl = static_cast<Chip::Impl*>(param);
+  if (impl->on_tx) impl->on_tx(static_cast<std::uint8_t>(value), impl->avr->cycle);
+}
+
+// The receive FIFO's flow control: XOFF 1 when it is full (or the
+// receiver goes off), XOFF 0 and XON 1 when there is room again.
+void on_xoff(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
+  static_cast<Chip::Impl*>(param)->rx_full = value != 0;
+}
+
+void on_xon(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
+  auto* impl = static_cast<Chip::Impl*>(param);
+  if (value == 0) return;
+  impl->rx_full = false;
+  impl->pump_rx();
+}
+
+void on_pin(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
+  auto* watch = static_cast<Chip::Impl::Watch*>(param);
+  const int level = value != 0 ? 1 : 0;
+  if (level == watch->last) return;
+  watch->last = level;
+  watch->fn(level != 0);
+}
+
+void on_adc_trigger(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
+  auto* impl = static_cast<Chip::Impl*>(param);
+  avr_adc_mux_t mux{};
+  std::memcpy(&mux, &value, sizeof mux);
+  if (impl->on_conversion && mux.kind == ADC_MUX_SINGLE) impl->on_conversion(mux.src);
+}
+
+void sleep_nowhere(avr_t* /*avr*/, avr_cycle_count_t /*cycles*/) {
+  // Virtual time: the clock jumps over a sleep; nothing waits.
+}
+
+std::uint32_t read_u32(const std::vector<unsigned char>& b, std::size_t at) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < 4; ++i)
+    v |= static_cast<std::uint32_t>(b[at + i]) << (8 * i);
+  return v;
+}
+
+}  // namespace
+
+ElfInfo check_elf(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(name + ": cannot read the firmware file");
+  std::vector<unsigned char> head(52);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  if (in.gcount() < 52 || head[0] != 0x7F || head[1] != 'E' || head[2] != 'L' || head[3] != 'F')
+    throw std::invalid_argument(name +
+                                ": not an ELF file (build the sketch with `hil firmware "
+                                "build SKETCH.ino`, or give its .elf)");
+  if (head[4] != 1 || head[5] != 1)
+    throw std::invalid_argument(name + ": a 64-bit or big-endian ELF file, not AVR firmware");
+  const std::uint16_t machine = static_cast<std::uint16_t>(head[18] | (head[19] << 8));
+  if (machine != kEmAvr)
+    throw std::invalid_argument(name + ": built for another processor (ELF machine " +
+                                std::to_string(machine) + "), not an AVR");
+  const std::uint32_t mach = read_u32(head, 36) & kEfAvrMachMask;
+  if (mach != kAvr5)
+    throw std::invalid_argument(name + ": built for the AVR family " + elf_family(mach) +
+                                "; hil emulates the ATmega328P (avr5)");
+
+  install_logger();
+  elf_firmware_t fw{};
+  if (elf_read_firmware(name.c_str(), &fw) != 0)
+    throw std::invalid_argument(name + ": cannot load the ELF file's sections");
+  ElfInfo info{path, fw.flashsize, fw.mmcu};
+  std::free(fw.flash);
+  std::free(fw.eeprom);
+  std::free(fw.fuse);
+  std::free(fw.lockbits);
+#if ELF_SYMBOLS
+  for (std::uint32_t i = 0; i < fw.symbolcount; ++i)
+    std::free(fw.symbol[i]);
+  std::free(fw.symbol);
+#endif
+  if (!info.mmcu.empty() && info.mmcu != "atmega328p" && info.mmcu != "atmega328")
+    throw std::invalid_argument(name + ": built for the " + info.mmcu +
+                                "; hil emulates the ATmega328P");
+  if (info.flash_bytes > Chip::kFlashBytes)
+    throw std::invalid_argument(name + ": " + std::to_string(info.flash_bytes) +
+                                " bytes of program, more than the ATmega328P's 32 KiB of flash");
+  return info;
+}
+
+Chip::Chip(const std::filesystem::path& elf)
+    : elf_(check_elf(elf)), impl_(std::make_unique<Impl>()) {
+  impl_->chip = this;
+  elf_firmware_t fw{};
+  if (elf_read_firmware(elf.string().c_str(), &fw) != 0)
+    throw std::invalid_argument(elf.string() + ": cannot load the ELF file's sections");
+  avr_t* avr = avr_make_mcu_by_name("atmega328p");
+  if (avr == nullptr) throw std::runtime_error("simavr has no ATmega328P core");
+  impl_->avr = avr;
+  avr->custom.data = impl_.get();
+  avr_init(avr);
+  avr->log = LOG_WARNING;
+  avr->frequency = kFrequencyHz;
+  avr->vcc = avr->avcc = avr->aref = 5000;
+  avr->sleep = &sleep_nowhere;
+  fw.tracecount = 0;  // a VCD trace request in the image writes no file
+  avr_load_firmware(avr, &fw);
+  avr->frequency = kFrequencyHz;
+  std::free(fw.flash);
+  std::free(fw.eeprom);
+  std::free(fw.fuse);
+  std::free(fw.lockbits);
+#if ELF_SYMBOLS
+  for (std::uint32_t i = 0; i < fw.symbolcount; ++i)
+    std::free(fw.symbol[i]);
+  std::free(fw.symbol);
+#endif
+  impl_->quiet_uart();
+  impl_->datasheet_reset_values();
+  avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUTPUT), &on_tx, impl_.get());
+  avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUT_XOFF), &on_xoff, impl_.get());
+  avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUT_XON), &on_xon, impl_.get());
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_OUT_TRIGGER),
+                          &on_adc_trigger, impl_.get());
+}
+
+Chip::~Chip() {
+  if (impl_ && impl_->avr) avr_terminate(impl_->avr);
+  if (impl_) std::free(impl_->avr);
+}
+
+std::uint64_t Chip::cycle() const {
+  return impl_->avr->cycle;
+}
+
+Chip::State Chip::state() const {
+  switch (impl_->avr->state) {
+    case cpu_Done:
+      return State::halted;
+    case cpu_Crashed:
+    case cpu_Stopped:
+      return State::crashed;
+    default:
+      return State::running;
+  }
+}
+
+void Chip::run_to(std::uint64_t target) {
+  avr_t* avr = impl_->avr;
+  auto& events = impl_->events;
+  for (;;) {
+    while (!events.empty() && events.begin()->first <= avr->cycle) {
+      auto fn = std::move(events.begin()->second);
+      events.erase(events.begin());
+      fn();
+    }
+    if (avr->cycle >= target || state() != State::running) return;
+    impl_->stop = events.empty() ? target : std::min(target, events.begin()->first);
+    // simavr's own loop (avr_run) looks at its timers after every
+    // instruction; here only when one is due, which is what makes the
+    // emulation fast enough (docs/performance.md).
+    avr_cycle_timer_pool_t* timers = &avr->cycle_timers;
+    while (avr->cycle < impl_->stop && avr->state == cpu_Running) {
+      const avr_flashaddr_t pc = avr_run_one(avr);
+      if (timers->timer != nullptr && timers->timer->when <= avr->cycle)
+        avr_cycle_timer_process(avr);
+      avr->pc = pc;
+      if (avr->interrupt_state) avr_service_interrupts(avr);
+    }
+    // Asleep: simavr's step moves the clock to the next timer (or stops a
+    // chip asleep with interrupts off for good).
+    if (avr->state == cpu_Sleeping) avr_run(avr);
+  }
+}
+
+void Chip::reset() {
+  avr_t* avr = impl_->avr;
+  avr_reset(avr);
+  avr->log = LOG_WARNING;
+  impl_->quiet_uart();
+  impl_->datasheet_reset_values();
+  impl_->rx_waiting.clear();
+  impl_->rx_full = false;
+  for (auto& w : impl_->watches)
+    w->last = -1;
+}
+
+void Chip::at_cycle(std::uint64_t cycle, std::function<void()> fn) {
+  impl_->events.emplace(cycle, std::move(fn));
+  impl_->stop = std::min(impl_->stop, cycle);
+}
+
+void Chip::uart_receive(std::uint8_t byte) {
+  // With the receiver off the byte is never sampled.
+  if ((impl_->avr->data[kUcsr0b] & kRxen0) == 0) return;
+  if (impl_->rx_waiting.size() >= 4096) {
+    ++overruns_;
+    return;
+  }
+  impl_->rx_waiting.push_back(byte);
+  impl_->pump_rx();
+}
+
+void Chip::on_uart_transmit(std::function<void(std::uint8_t, std::uint64_t)> fn) {
+  impl_->on_tx = std::move(fn);
+}
+
+bool Chip::uart_enabled() const {
+  return (impl_->avr->data[kUcsr0b] & (kRxen0 | kTxen0)) != 0;
+}
+
+std::uint32_t Chip::uart_baud() const {
+  const std::uint8_t* d = impl_->avr->data;
+  if (!uart_enabled()) return 0;
+  const std::uint32_t ubrr = (static_cast<std::uint32_t>(d[kUbrr0h] & 0x0F) << 8) | d[kUbrr0l];
+  const std::uint32_t divisor = (d[kUcsr0a] & kU2x0) != 0 ? 8 : 16;
+  return kFrequencyHz / (divisor * (ubrr + 1));
+}
+
+bool Chip::output_level(const BoardPin& pin) const {
+  const PortRegs r = port_regs(pin.port);
+  const std::uint8_t* d = impl_->avr->data;
+  const std::uint8_t mask = static_cast<std::uint8_t>(1 << pin.bit);
+  return (d[r.ddr] & mask) != 0 && (d[r.port] & mask) != 0;
+}
+
+int Chip::pwm_duty(const BoardPin& pin) const {
+  if (pin.pwm) {
+    const TimerRegs& t = kTimers.at(static_cast<std::size_t>(pin.pwm->timer));
+    const std::uint8_t* d = impl_->avr->data;
+    const bool a = pin.pwm->channel == 'A';
+    if ((d[t.tccra] & (a ? kComA1 : kComB1)) != 0) return d[a ? t.ocra : t.ocrb];
+  }
+  return output_level(pin) ? 255 : 0;
+}
+
+void Chip::drive(const BoardPin& pin, bool level) {
+  impl_->driving = true;
+  avr_raise_irq(impl_->pin_irq(pin), level ? 1 : 0);
+  impl_->driving = false;
+}
+
+void Chip::on_output_change(const BoardPin& pin, std::function<void(bool)> fn) {
+  auto watch = std::make_unique<Impl::Watch>();
+  watch->pin = pin;
+  Impl* impl = impl_.get();
+  watch->fn = [impl, pin, fn = std::move(fn)](bool level) {
+    // A pin the firmware reads is driven from outside; only its outputs count.
+    if (impl->driving) return;
+    const PortRegs r = port_regs(pin.port);
+    if ((impl->avr->data[r.ddr] & (1 << pin.bit)) == 0) return;
+    fn(level);
+  };
+  avr_irq_register_notify(impl_->pin_irq(pin), &on_pin, watch.get());
+  impl_->watches.push_back(std::move(watch));
+}
+
+void Chip::set_analog_millivolts(int adc_channel, std::uint32_t millivolts) {
+  avr_raise_irq(avr_io_getirq(impl_->avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0 + adc_channel),
+                millivolts);
+}
+
+void Chip::on_conversion(std::function<void(int)> fn) {
+  impl_->on_conversion = std::move(fn);
+}
+
+std::vector<std::string> Chip::take_messages() {
+  std::vector<std::string> out;
+  out.swap(impl_->messages);
+  return out;
+}
+
+}  // namespace hil::mocks::avr
