@@ -150,6 +150,7 @@ RunningCar MockDesk::start_car(std::size_t i) {
     };
     options.configs.svgui.log = options.configs.wr8.log;
     if (options.replay) options.replay->log = options.configs.wr8.log;
+    if (options.configs.avr) options.configs.avr->log = options.configs.wr8.log;
   }
   RunningCar running;
   try {
@@ -219,6 +220,10 @@ void MockDesk::start_cars() {
             << plan_.faults.rules.size() << " fault rule(s), " << plan_.behaviours.size()
             << " behaviour(s), seed " << plan_.seed << " (replay with --seed " << plan_.seed
             << "); Ctrl-C stops" << std::endl;
+  if (const auto& avr = plan_.base.configs.avr) {
+    std::cout << "firmware " << avr->elf.string() << " on an emulated ATmega328P at 16 MHz, pins "
+              << avr->pins.source << "; the board resets when the port opens" << std::endl;
+  }
   if (const auto& replay = plan_.base.replay) {
     const auto* fw = dynamic_cast<const mocks::ReplayFirmware*>(&cars_.front().car->firmware());
     const auto& header = replay->capture->header;
@@ -370,6 +375,18 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
                   "capture's profile's mock answers it, the default) or silent (no answer)")
       ->check(CLI::IsMember({"mock", "silent"}))
       ->needs(replay_option);
+  auto* sketch_option = cmd->add_option(
+      "--sketch", args->car.sketch,
+      "Arduino: build this sketch (.ino; cached by content) and run it on an emulated "
+      "ATmega328P wired to the simulated robot, instead of the behavioural mock "
+      "(docs/firmware.md)");
+  auto* elf_option = cmd->add_option(
+      "--elf", args->car.elf,
+      "Arduino: run this firmware image (an ELF for the ATmega328P) on the emulated board");
+  sketch_option->excludes(elf_option);
+  cmd->add_option("--pins", args->car.pins,
+                  "With --sketch or --elf: the pin map (YAML; default: pins.yaml beside the "
+                  "sketch, else the protocol document's wiring, docs/firmware.md)");
   cmd->add_option("--log", args->desk.wire_log,
                   "Write every byte of every connection to an NDJSON wire log");
   cmd->add_option("--count", args->count,
@@ -415,6 +432,7 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil mock logi --view                          # and watch it on http://127.0.0.1:8080/\n"
       "  hil mock logi --replay car.ndjson             # the car `hil conform probe` recorded\n"
+      "  hil mock arduino --sketch robot/robot.ino     # your own sketch on an emulated board\n"
       "Stops cleanly on Ctrl-C (SIGINT) or SIGTERM.");
   cmd->callback([&run, args, view_option] {
     args->desk.view = view_option->count() > 0;

@@ -10,6 +10,7 @@
 #include "base/duration.hpp"
 #include "link/capture/probe_capture.hpp"
 #include "link/faults/profile_yaml.hpp"
+#include "mocks/avr/firmware_source.hpp"
 #include "mocks/behaviour_yaml.hpp"
 #include "protocol/common/car_profile.hpp"
 #include "sim/arena_yaml.hpp"
@@ -152,6 +153,35 @@ void load_replay(const MockCarArgs& args, MockPlan& plan) {
   plan.base.replay = std::move(spec);
 }
 
+// --sketch, --elf and --pins: the firmware built (or found in the cache)
+// and checked, the pin map read, before any car starts.
+void load_firmware(const MockCarArgs& args, MockPlan& plan) {
+  if (args.sketch.empty() && args.elf.empty()) {
+    if (!args.pins.empty()) throw MockStartError{"--pins needs --sketch or --elf", 2};
+    return;
+  }
+  if (args.kind != "arduino") {
+    throw MockStartError{"--sketch and --elf run Arduino firmware on an emulated ATmega328P; a " +
+                             args.kind + " car has no such board",
+                         2};
+  }
+  if (!args.replay.empty())
+    throw MockStartError{"--replay plays a capture; leave out --sketch and --elf", 2};
+  mocks::avr::FirmwareSource source;
+  source.sketch = args.sketch;
+  source.elf = args.elf;
+  source.pins = args.pins;
+  try {
+    plan.base.configs.avr = mocks::avr::resolve_firmware(source);
+  } catch (const mocks::avr::SketchBuildError& e) {
+    std::string message = std::string("--sketch: ") + e.what();
+    if (!e.diagnostics().empty()) message += "\n" + e.diagnostics();
+    throw MockStartError{message, 1};
+  } catch (const std::exception& e) {
+    throw MockStartError{std::string(args.sketch.empty() ? "--elf: " : "--sketch: ") + e.what(), 2};
+  }
+}
+
 // --count and --port for this kind of car, and the open files they need.
 void check_fleet(const MockArgs& args, bool serial) {
   if (serial && args.count > kMaxSerialCars) {
@@ -184,6 +214,7 @@ MockPlan plan_mock(const MockArgs& args) {
   plan.base.configs.wr8.wrong_auth_max_delay = link::seconds(30);
   load_files(args.car, plan);
   load_replay(args.car, plan);
+  load_firmware(args.car, plan);
   configure_car(args.car, plan.profile, plan.base.configs, plan.kind);
   plan.serial = std::holds_alternative<link::PtyEndpoint>(
       mocks::default_endpoint(plan.kind, 0, plan.profile));

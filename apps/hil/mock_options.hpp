@@ -28,6 +28,9 @@ struct MockCarArgs {
   std::optional<std::uint64_t> seed;
   std::string replay;              ///< a probe capture to play; empty: the mock firmware
   std::string unmatched = "mock";  ///< what answers a request the capture has no recording for
+  std::string sketch;              ///< Arduino: a sketch to build and run on the emulated board
+  std::string elf;                 ///< Arduino: a firmware image to run on the emulated board
+  std::string pins;                ///< with sketch or elf: the pin map file
 };
 
 // Where car N listens.
