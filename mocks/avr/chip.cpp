@@ -31,6 +31,7 @@ constexpr std::uint16_t kUcsr0a = 0xC0;
 constexpr std::uint16_t kUcsr0b = 0xC1;
 constexpr std::uint16_t kUbrr0l = 0xC4;
 constexpr std::uint16_t kUbrr0h = 0xC5;
+constexpr std::uint16_t kUcsr0c = 0xC2;
 constexpr std::uint8_t kU2x0 = 1 << 1;
 constexpr std::uint8_t kRxen0 = 1 << 4;
 constexpr std::uint8_t kTxen0 = 1 << 3;
@@ -113,6 +114,33 @@ struct Chip::Impl {
   std::function<void(int)> on_conversion;
   std::vector<std::string> messages;
   bool driving = false;
+  avr_uart_t* uart = nullptr;            // UART0's own state
+  avr_cycle_timer_t rx_ready = nullptr;  // simavr's timer that hands a received byte over
+
+  // The line in front of the chip delivers each byte when its stop bit is
+  // in, the moment the USART sets RXC; simavr would wait one more byte
+  // time before handing it over. The first byte after the FIFO was empty
+  // is handed over on the next cycle instead: the timer simavr started for
+  // it is found (once, by its parameter: the UART) and brought forward.
+  void receive_now(std::uint8_t byte) {
+    avr_cycle_timer_pool_t* pool = &avr->cycle_timers;
+    std::vector<avr_cycle_timer_t> before;
+    for (auto* t = pool->timer; t != nullptr; t = t->next)
+      if (t->param == uart) before.push_back(t->timer);
+    const bool pumping =
+        rx_ready != nullptr && std::find(before.begin(), before.end(), rx_ready) != before.end();
+    avr_raise_irq(uart_irq(UART_IRQ_INPUT), byte);
+    if (pumping) return;  // bytes are waiting: they follow at the line's pace
+    if (rx_ready == nullptr) {
+      for (auto* t = pool->timer; t != nullptr; t = t->next)
+        if (t->param == uart && std::find(before.begin(), before.end(), t->timer) == before.end())
+          rx_ready = t->timer;
+      if (rx_ready == nullptr) return;
+    }
+    if (avr_cycle_timer_status(avr, rx_ready, uart) == 0) return;
+    avr_cycle_timer_cancel(avr, rx_ready, uart);
+    avr_cycle_timer_register(avr, 1, rx_ready, uart);
+  }
 
   avr_irq_t* uart_irq(int which) const {
     return avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), which);
@@ -135,6 +163,23 @@ struct Chip::Impl {
       avr_extint_set_strict_lvl_trig(avr, n, 0);
   }
 
+  // simavr counts a parity bit in every UART frame, parity or not, so its
+  // bytes take 11 bit times where the 8N1 line takes 10: each byte would
+  // come 10 % late. The byte time is set again from the frame format the
+  // firmware chose (UCSR0C, UCSR0B's UCSZ02) whenever it changes.
+  void fix_byte_time() {
+    const std::uint8_t* d = avr->data;
+    if ((d[kUcsr0b] & (kRxen0 | kTxen0)) == 0) return;
+    const std::uint32_t ubrr = (static_cast<std::uint32_t>(d[kUbrr0h] & 0x0F) << 8) | d[kUbrr0l];
+    const std::uint32_t per_bit = (ubrr + 1) * ((d[kUcsr0a] & kU2x0) != 0 ? 8U : 16U);
+    const std::uint8_t c = d[kUcsr0c];
+    const std::uint32_t size = ((c >> 1) & 0x3U) | ((d[kUcsr0b] & 0x04U) != 0 ? 4U : 0U);
+    const std::uint32_t data_bits = size <= 3 ? 5 + size : size == 7 ? 9 : 8;
+    const std::uint32_t parity = (c & 0x20U) != 0 ? 1 : 0;
+    const std::uint32_t stop_bits = (c & 0x08U) != 0 ? 2 : 1;
+    uart->cycles_per_byte = per_bit * (1 + data_bits + parity + stop_bits);
+  }
+
   void quiet_uart() {
     // Off: printing what the firmware sends to stdout, and sleeping the
     // host thread while the firmware polls an empty receiver.
@@ -150,7 +195,7 @@ struct Chip::Impl {
       const std::uint8_t byte = rx_waiting.front();
       rx_waiting.pop_front();
       if ((avr->data[kUcsr0b] & kRxen0) == 0) continue;
-      avr_raise_irq(uart_irq(UART_IRQ_INPUT), byte);
+      receive_now(byte);
     }
   }
 };
@@ -288,6 +333,11 @@ Chip::Chip(const std::filesystem::path& elf)
 #endif
   impl_->quiet_uart();
   impl_->datasheet_reset_values();
+  for (avr_io_t* io = avr->io_port; io != nullptr; io = io->next) {
+    if (std::strcmp(io->kind, "uart") == 0 && reinterpret_cast<avr_uart_t*>(io)->name == '0')
+      impl_->uart = reinterpret_cast<avr_uart_t*>(io);
+  }
+  if (impl_->uart == nullptr) throw std::runtime_error("simavr's ATmega328P has no UART0");
   avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUTPUT), &on_tx, impl_.get());
   avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUT_XOFF), &on_xoff, impl_.get());
   avr_irq_register_notify(impl_->uart_irq(UART_IRQ_OUT_XON), &on_xon, impl_.get());
@@ -327,6 +377,7 @@ void Chip::run_to(std::uint64_t target) {
     }
     if (avr->cycle >= target || state() != State::running) return;
     impl_->stop = events.empty() ? target : std::min(target, events.begin()->first);
+    impl_->fix_byte_time();
     // simavr's own loop (avr_run) looks at its timers after every
     // instruction; here only when one is due, which is what makes the
     // emulation fast enough (docs/performance.md).

@@ -24,6 +24,7 @@ AvrConfig resolve_firmware(const FirmwareSource& source) {
   } else {
     config.elf = source.elf;
   }
+  if (source.startup_delay) config.startup_delay = *source.startup_delay;
   const auto pins = pins_file_for(source);
   if (!pins.empty()) config.pins = load_pin_map(pins);
   return config.checked();

@@ -5,6 +5,7 @@
 // --sketch/--elf` and a scenario's `car: {firmware: ...}` give.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "mocks/avr/avr_firmware.hpp"
@@ -20,6 +21,9 @@ struct FirmwareSource {
   std::filesystem::path pins;
   /// Where built sketches are kept (SketchBuildOptions::cache_dir).
   std::filesystem::path cache_dir;
+  /// From the port opening to the first instruction (AvrConfig::
+  /// startup_delay); nullopt: the chip's own 66 ms.
+  std::optional<Duration> startup_delay;
 };
 
 /// The sketch's pin map file by the naming rule above, or empty.

@@ -203,6 +203,28 @@ TEST(AvrFirmware, OpeningThePortResetsTheBoardAndLosesWhatCameDuringTheStartUp) 
   EXPECT_TRUE(log.empty()) << log.front();
 }
 
+TEST(AvrFirmware, AByteIsTheSketchsTheMomentItsStopBitIsIn) {
+  // With no line in between, the request's 14 bytes reach the chip at
+  // once and its USART hands them over one per byte time (1.04 ms at
+  // 9,600 baud, 10 bits a byte), the first at once: the last is read at
+  // 13 x 1.04 = 13.54 ms. The sketch answers within microseconds and its
+  // 16 bytes leave one per byte time: the last is written to UDR0 at
+  // 13.54 + 15 x 1.04 = 29.17 ms, seen at the end of the board's 250 us
+  // slice.
+  Session board;
+  board.client->write(sketch_frame("01", "PING", " "));
+  const Time start = board.board->now();
+  std::optional<Time> done;
+  board.board->run_until_each(start + milliseconds(40), [&] {
+    if (!done && board.client->text().find('$') != std::string::npos) done = board.board->now();
+  });
+  ASSERT_TRUE(done);
+  EXPECT_EQ(board.client->take_text(), sketch_frame("01", "ACK", "PONG"));
+  const double ms = std::chrono::duration<double, std::milli>(*done - start).count();
+  EXPECT_GE(ms, 29.1);
+  EXPECT_LE(ms, 29.5);
+}
+
 // The bytes back and the world after a session, running the driver in
 // slices of `slice`.
 struct Outcome {
