@@ -12,16 +12,23 @@ namespace hil::conform {
 
 Capture probe_mock(const Probe& probe, std::string_view mock_profile, std::uint64_t seed) {
   const auto& profile = protocol::find_car_profile(mocks::to_string(probe.car), mock_profile);
-  auto driver = harness::make_run_driver(false);
   mocks::CarOptions options;
   options.kind = probe.car;
   options.seed = seed;
   mocks::apply_profile(options.configs, probe.car, profile.name);
+  return probe_in_virtual_time(probe, std::move(options), "mock:" + std::string(profile.name));
+}
+
+Capture probe_in_virtual_time(const Probe& probe, mocks::CarOptions options,
+                              const std::string& target, std::shared_ptr<link::WireLog> log) {
+  auto driver = harness::make_run_driver(false);
+  options.kind = probe.car;
+  const std::uint64_t seed = options.seed;
   mocks::MockCar car(std::move(options));
   // A serial car's line keeps its baud in virtual time: each byte takes
   // its ten bits of line time, as on the pty.
   link::MemEndpoint mem{"car0"};
-  const auto real = mocks::default_endpoint(probe.car, 0, profile.name);
+  const auto real = mocks::default_endpoint(probe.car, 0, car.firmware().profile());
   if (const auto* pty = std::get_if<link::PtyEndpoint>(&real)) mem.baud = pty->baud;
   mocks::ServerOptions server_options;
   server_options.listen = mem;
@@ -29,7 +36,7 @@ Capture probe_mock(const Probe& probe, std::string_view mock_profile, std::uint6
   server_options.seed = seed;
   mocks::MockServer server(driver->context(), car.firmware(), std::move(server_options));
   server.start();
-  CaptureRecorder recorder(capture_header(probe, "mock:" + std::string(profile.name), 0));
+  CaptureRecorder recorder(capture_header(probe, target, 0), std::move(log));
   auto run = run_probe(*driver, mem, probe, recorder);
   server.close();
   return std::move(run.capture);

@@ -3,6 +3,7 @@
 // same car in virtual time, once per profile, and compares each run with
 // the capture.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,7 @@
 #include "conform/compare.hpp"
 #include "conform/probe.hpp"
 #include "link/capture/probe_capture.hpp"
+#include "mocks/car.hpp"
 
 namespace hil::conform {
 
@@ -19,6 +21,14 @@ namespace hil::conform {
 /// (empty: the car's default), on the virtual-time driver over mem://
 /// (a serial car's line keeps its baud). Deterministic for one seed.
 Capture probe_mock(const Probe& probe, std::string_view mock_profile, std::uint64_t seed = 1);
+
+/// Runs `probe` against the car `options` make (a mock, or a real firmware
+/// on the emulated board: `options.configs.avr`), in virtual time as
+/// probe_mock does; `target` names it in the capture's header, and `log`,
+/// when given, gets every record as it happens (a capture file).
+Capture probe_in_virtual_time(const Probe& probe, mocks::CarOptions options,
+                              const std::string& target,
+                              std::shared_ptr<link::WireLog> log = nullptr);
 
 /// A capture that this hil cannot check; what() says why and what to do.
 class CheckError : public std::runtime_error {

@@ -14,6 +14,7 @@
 #include "conform/report.hpp"
 #include "harness/atomic_file.hpp"
 #include "link/endpoint.hpp"
+#include "mocks/avr/firmware_source.hpp"
 #include "protocol/common/car_profile.hpp"
 
 namespace hil::apps {
@@ -106,6 +107,44 @@ int run_probe_command(const std::string& car_name, const std::string& target_uri
   return 0;
 }
 
+// --sketch or --elf: the probe against a real firmware on the emulated
+// board, in virtual time (seconds, not the probe's minutes).
+int run_sketch_probe(const mocks::avr::FirmwareSource& source, const std::string& output,
+                     bool quiet) {
+  mocks::CarOptions options;
+  options.kind = mocks::CarKind::arduino;
+  try {
+    options.configs.avr = mocks::avr::resolve_firmware(source);
+  } catch (const mocks::avr::SketchBuildError& e) {
+    std::cerr << "hil conform probe: " << e.what() << "\n" << e.diagnostics();
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "hil conform probe: " << e.what() << "\n";
+    return 2;
+  }
+  const conform::Probe probe = conform::make_probe(mocks::CarKind::arduino, "");
+  std::shared_ptr<link::WireLog> log;
+  try {
+    log = link::open_capture_log(output, link::protocol_adapter("arduino", probe.profile));
+  } catch (const std::exception& e) {
+    std::cerr << "hil conform probe: " << e.what() << "\n";
+    return 2;
+  }
+  const std::string target = "avr:" + (source.sketch.empty() ? source.elf : source.sketch).string();
+  if (!quiet)
+    std::cerr << "hil conform probe: " << probe.version << ", " << probe.exchanges.size()
+              << " exchanges against " << target << " on the emulated ATmega328P (virtual time)\n";
+  const auto capture = conform::probe_in_virtual_time(probe, std::move(options), target, log);
+  if (log->error()) {
+    std::cerr << "hil conform probe: writing " << output << " failed: " << log->error().message()
+              << "\n";
+    return 1;
+  }
+  std::cout << "probe: " << capture.exchanges.size() << " exchanges recorded in " << output
+            << "\nnext: hil conform check " << output << " --all-profiles\n";
+  return 0;
+}
+
 struct CheckArgs {
   std::string capture;
   std::string profile;
@@ -167,15 +206,25 @@ void register_conform(CLI::App& app, std::function<int()>& run) {
     std::string output;
     bool yes = false;
     bool quiet = false;
+    mocks::avr::FirmwareSource firmware;
   };
   auto probe_args = std::make_shared<ProbeArgs>();
   auto* probe = conform->add_subcommand(
       "probe", "Run the car's probe against a car (real time) and record it as a capture");
   probe->add_option("car", probe_args->car, "logi, wr8, arduino or leka")->required();
-  probe
-      ->add_option("--target", probe_args->target,
-                   "The car: tcp://HOST:PORT, or pty:///dev/ttyUSB0?baud=9600 for a serial car")
-      ->required();
+  auto* target = probe->add_option(
+      "--target", probe_args->target,
+      "The car: tcp://HOST:PORT, or pty:///dev/ttyUSB0?baud=9600 for a serial car");
+  auto* sketch = probe->add_option(
+      "--sketch", probe_args->firmware.sketch,
+      "Arduino: instead of a car, this sketch built and run on the emulated ATmega328P, probed "
+      "in virtual time (docs/firmware.md)");
+  auto* elf = probe->add_option("--elf", probe_args->firmware.elf,
+                                "Arduino: as --sketch, for a firmware image built already");
+  probe->add_option("--pins", probe_args->firmware.pins,
+                    "With --sketch or --elf: the pin map (YAML)");
+  sketch->excludes(elf);
+  target->excludes(sketch)->excludes(elf);
   probe->add_option("--profile", probe_args->profile,
                     "The profile the probe's frames are written in (hil profiles CAR; default: "
                     "the car's default)");
@@ -188,9 +237,24 @@ void register_conform(CLI::App& app, std::function<int()>& run) {
       "stop at once.\nExamples:\n"
       "  hil conform probe logi --target tcp://192.168.4.1:8080 --yes -o logi-car.ndjson\n"
       "  hil conform probe arduino --target 'pty:///dev/ttyUSB0?baud=9600' --yes -o robot.ndjson\n"
-      "  hil conform probe wr8 --profile svgui-head --target tcp://127.0.0.1:5556 -o wr8.ndjson");
+      "  hil conform probe wr8 --profile svgui-head --target tcp://127.0.0.1:5556 -o wr8.ndjson\n"
+      "  hil conform probe arduino --sketch robot/robot.ino -o sketch.ndjson");
   probe->callback([&run, probe_args] {
     run = [probe_args] {
+      const auto& firmware = probe_args->firmware;
+      if (!firmware.sketch.empty() || !firmware.elf.empty()) {
+        if (probe_args->car != "arduino") {
+          std::cerr << "hil conform probe: --sketch and --elf run Arduino firmware; a "
+                    << probe_args->car << " car has no such board\n";
+          return 2;
+        }
+        return run_sketch_probe(firmware, probe_args->output, probe_args->quiet);
+      }
+      if (probe_args->target.empty()) {
+        std::cerr << "hil conform probe: --target is required (or --sketch/--elf for an Arduino "
+                     "sketch on the emulated board)\n";
+        return 2;
+      }
       return run_probe_command(probe_args->car, probe_args->target, probe_args->profile,
                                probe_args->output, probe_args->yes, probe_args->quiet);
     };
