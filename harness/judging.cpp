@@ -66,9 +66,10 @@ ExpectationOutcome end_outcome(const JudgedRun& run, const EndMotion& end) {
 
 }  // namespace
 
-Duration time_slack(const RunOptions& options, bool real_time) {
+Duration time_slack(const RunOptions& options, bool real_time, bool emulated_board) {
   if (options.time_slack) return *options.time_slack;
-  return real_time ? kRealTimeSlack : Duration(0);
+  if (real_time) return kRealTimeSlack;
+  return emulated_board ? kEmulatedBoardSlack : Duration(0);
 }
 
 std::vector<ExpectationOutcome> judge(const JudgedRun& run) {

@@ -52,8 +52,9 @@ struct JudgedRun {
 };
 
 /// The room for real time a run gets: RunOptions::time_slack, else
-/// kRealTimeSlack in real time and none in virtual time.
-Duration time_slack(const RunOptions& options, bool real_time);
+/// kRealTimeSlack in real time, kEmulatedBoardSlack for a real firmware on
+/// the emulated board in virtual time, and none for a mock in virtual time.
+Duration time_slack(const RunOptions& options, bool real_time, bool emulated_board);
 
 /// One outcome per expectation, in the scenario's order, then the exit's,
 /// then the car's at the end (unless the scenario says `at_end: any`).

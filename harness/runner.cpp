@@ -15,6 +15,7 @@
 #include <cstring>
 
 #include "harness/client_under_test.hpp"
+#include "harness/emulated_car.hpp"
 #include "harness/judging.hpp"
 #include "harness/origin.hpp"
 #include "harness/run_driver.hpp"
@@ -146,6 +147,13 @@ bool ScenarioRun::build_car() {
   car.seed = mocks::car_seed(out_.seed, 0);
   car.name = "car0";
   try {
+    // The emulated board first: the profile sets its framing too. A car
+    // played from a capture plays it, whatever firmware the scenario names.
+    if (!options_.replay) {
+      car.configs.avr = options_.firmware ? options_.firmware : scenario_.firmware;
+      if (car.configs.avr && options_.on_firmware_note)
+        car.configs.avr->log = options_.on_firmware_note;
+    }
     mocks::apply_profile(car.configs, scenario_.car, scenario_.profile);
     if (scenario_.reply_latency) car.configs.reply_latency = *scenario_.reply_latency;
     // An external client's run times count from its first connection (its
@@ -315,7 +323,9 @@ void ScenarioRun::end() {
   out_.session_end = session_end;
   out_.expectations = judge(JudgedRun{
       scenario_, out_.timeline, client_->external(), session_end, session_records, client_end,
-      time_slack(options_, driver_->real_time()), origin,
+      time_slack(options_, driver_->real_time(),
+                 dynamic_cast<const mocks::AvrFirmware*>(&car_->firmware()) != nullptr),
+      origin,
       EndMotion{run_end - client_end, run_end, motion.moving, motion.speed_mps, motion.driven}});
 }
 
@@ -356,11 +366,29 @@ std::optional<std::string> replay_mismatch(const Scenario& scenario,
   return std::nullopt;
 }
 
+// Why the firmware of --sketch or --elf cannot play `scenario`'s car, or nullopt.
+std::optional<std::string> firmware_mismatch(const Scenario& scenario, const RunOptions& options) {
+  const std::string& given = options.firmware_given;
+  if (scenario.car != mocks::CarKind::arduino) {
+    return "its car is " + std::string(mocks::to_string(scenario.car)) + " and " + given +
+           " runs on the emulated Arduino board";
+  }
+  if (scenario.replay) {
+    return "its car plays the capture " + scenario.replay->path + " (car: replay:), not " + given;
+  }
+  if (auto why = emulated_board_problem(scenario))
+    return *why + ": " + given + " runs on the emulated board as it is (docs/firmware.md)";
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options) {
   if (options.replay) {
     if (auto why = replay_mismatch(scenario, *options.replay)) return why;
+  }
+  if (options.firmware) {
+    if (auto why = firmware_mismatch(scenario, options)) return why;
   }
   const auto* reference = std::get_if<ReferenceClient>(&scenario.client);
   if (!options.client_exec || reference == nullptr || reference->settings.empty())

@@ -21,6 +21,11 @@ struct ClientSetup;
 /// The default slack of a run in real time: a loaded 2-core machine
 /// delays a frame or a client's answer by tens of milliseconds.
 inline constexpr Duration kRealTimeSlack = std::chrono::milliseconds(100);
+/// The default slack of a real firmware on the emulated board in virtual
+/// time: the sketch's own processing and the board's 250 us slices put its
+/// frames up to about a millisecond after the behavioural mock's, which
+/// answers in the instant the request's last byte is in (docs/firmware.md).
+inline constexpr Duration kEmulatedBoardSlack = std::chrono::milliseconds(2);
 
 struct RunOptions {
   /// Overrides the scenario's seed (and a random choice when it has none).
@@ -32,6 +37,16 @@ struct RunOptions {
   /// mock firmware (`hil run --replay`); a scenario of another car, or of
   /// another profile than the capture's, is skipped (skip_reason()).
   std::optional<mocks::ReplaySpec> replay;
+  /// Runs every Arduino scenario's car as this firmware on the emulated
+  /// board instead of its own car (`hil run --sketch/--elf`); a scenario of
+  /// another car, one that plays a capture, and one that asks for what the
+  /// board cannot do (emulated_board_problem()) are skipped (skip_reason()).
+  std::optional<mocks::AvrConfig> firmware;
+  /// How `firmware` was given, for the skip reasons ("--elf robot.elf").
+  std::string firmware_given = "the firmware";
+  /// Told each warning of an emulated board (this run's firmware or the
+  /// scenario's own), one line each.
+  std::function<void(const std::string&)> on_firmware_note;
   /// Where reports may put files of this run (wire log); empty: nowhere.
   std::string work_dir;
   /// Room for real time in every expectation (check() in
@@ -59,7 +74,10 @@ struct RunOptions {
 /// options, and its verdict would judge a client set up otherwise. With
 /// RunOptions::replay, a scenario of another car or profile than the
 /// capture's is skipped: its client would speak to a car it was not
-/// written for.
+/// written for. With RunOptions::firmware, so is a scenario of another car
+/// than the Arduino one, one that plays a capture, and one that arms a
+/// behaviour or sets a reply latency the emulated board cannot act on: it
+/// would pass or fail for the wrong reason.
 std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options);
 
 /// Never throws for a scenario's own failures; they are in the outcome. A

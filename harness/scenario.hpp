@@ -203,6 +203,11 @@ struct Scenario {
   /// (mocks/replay.hpp) instead of its mock firmware; the capture is read
   /// when the scenario loads.
   std::optional<mocks::ReplaySpec> replay;
+  /// `car: {kind: arduino, firmware: {sketch: FILE}}` (or `{elf: FILE}`):
+  /// the Arduino car runs this firmware on the emulated board
+  /// (mocks/avr/avr_firmware.hpp) instead of the behavioural mock; the
+  /// sketch is built (or found in the cache) when the scenario loads.
+  std::optional<mocks::AvrConfig> firmware;
   /// The car's profile (protocol/common/car_profile.hpp), mock and
   /// reference client alike; empty: the car's default.
   std::string profile;

@@ -6,8 +6,10 @@
 #include <utility>
 
 #include "base/enum_names.hpp"
+#include "harness/emulated_car.hpp"
 #include "harness/scenario_parts.hpp"
 #include "link/capture/probe_capture.hpp"
+#include "mocks/avr/firmware_source.hpp"
 #include "protocol/common/car_profile.hpp"
 
 namespace hil::harness {
@@ -42,7 +44,8 @@ const Keys kTopKeys = {"name",          "description", "tags",     "car",     "p
                        "at_end",        "variables",   "faults",   "client",  "setup",
                        "steps",         "teardown",    "schedule", "expect"};
 
-const Keys kCarKeys = {"kind", "replay", "unmatched"};
+const Keys kCarKeys = {"kind", "replay", "unmatched", "firmware"};
+const Keys kFirmwareKeys = {"sketch", "elf", "pins", "startup"};
 
 constexpr auto kAtEndNames = base::enum_names<AtEnd>(
     {AtEnd::at_rest, "at_rest"}, {AtEnd::moving, "moving"}, {AtEnd::any, "any"});
@@ -80,6 +83,10 @@ class ScenarioReader : public config::Reader {
       scenario.teardown = read_steps(facts_, n, "teardown", "teardown step ");
     if (auto n = root["schedule"]) scenario.schedule = read_schedule(facts_, n);
     if (auto n = root["expect"]) scenario.expectations = read_expectations(facts_, n);
+    if (firmware_source_) {
+      check_emulated_board(root, scenario);
+      scenario.firmware = resolve_firmware();
+    }
     return scenario;
   }
 
@@ -96,7 +103,8 @@ class ScenarioReader : public config::Reader {
         scenario.tags.push_back(scalar(t, "a tag"));
     }
     const auto car_node = required(root, "car", "the scenario");
-    // `car: logi`, or `car: {kind: logi, replay: FILE, unmatched: silent}`.
+    // `car: logi`, or `car: {kind: logi, replay: FILE, unmatched: silent}`,
+    // or `car: {kind: arduino, firmware: {sketch: FILE}}`.
     if (car_node.IsMap()) check_keys(car_node, kCarKeys, "'car'");
     const auto car = car_node.IsMap() ? required(car_node, "kind", "'car'") : car_node;
     const std::string car_text = scalar(car, "'car'");
@@ -113,7 +121,10 @@ class ScenarioReader : public config::Reader {
         fail(n, "'profile': " + problem);
       }
     }
-    if (car_node.IsMap()) read_replay(root, car_node, scenario);
+    if (car_node.IsMap()) {
+      read_firmware(car_node, scenario);
+      read_replay(root, car_node, scenario);
+    }
     if (auto n = root["world"]) scenario.world = read_existing_file(facts_, n, "world file");
     if (auto n = root["seed"]) scenario.seed = whole(n, "'seed'", 0);
     if (auto n = root["timeout"]) {
@@ -166,6 +177,99 @@ class ScenarioReader : public config::Reader {
     scenario.replay = std::move(replay);
   }
 
+  /// `firmware: {sketch: FILE, pins: FILE}` (or `elf:`) in a `car:` map:
+  /// the files found; the sketch is built at the end of the load, once the
+  /// rest of the file has been checked.
+  void read_firmware(const YAML::Node& car, const Scenario& scenario) {
+    const auto n = car["firmware"];
+    if (!n) return;
+    if (scenario.car != mocks::CarKind::arduino) {
+      fail(n, "'firmware' runs on the emulated Arduino board, and this scenario's car is " +
+                  car_title(scenario.car) + " (docs/firmware.md)");
+    }
+    if (car["replay"]) {
+      fail(n,
+           "'firmware' and 'replay' do not go together: the car either runs the firmware or "
+           "plays the capture");
+    }
+    const std::string usage =
+        "'firmware' is a map: {sketch: FILE.ino} or {elf: FILE.elf}, with an optional pins: FILE";
+    if (!n.IsMap()) fail(n, usage);
+    check_keys(n, kFirmwareKeys, "'firmware'");
+    const std::string image = one_key(n, {"sketch", "elf"}, [](const auto&, const auto&) {
+      return std::string("'firmware' takes 'sketch' or 'elf', not both");
+    });
+    if (image.empty()) fail(n, usage);
+    mocks::avr::FirmwareSource source;
+    if (image == "sketch") {
+      source.sketch = read_existing_file(facts_, n["sketch"], "sketch");
+    } else {
+      source.elf = read_existing_file(facts_, n["elf"], "firmware image");
+    }
+    if (auto pins = n["pins"]) source.pins = read_existing_file(facts_, pins, "pin map file");
+    if (auto startup = n["startup"]) {
+      source.startup_delay = duration(startup, "'startup'");
+      if (*source.startup_delay > std::chrono::seconds(10))
+        fail(startup, "'startup' is at most 10s (the time from the port opening to the sketch)");
+    }
+    firmware_.emplace(n);
+    firmware_source_ = std::move(source);
+  }
+
+  /// With `firmware:`, what the emulated board cannot do is an error where
+  /// the scenario asks for it: a behaviour that changes the firmware's own
+  /// answers, or a reply latency.
+  void check_emulated_board(const YAML::Node& root, const Scenario& scenario) const {
+    const std::string why =
+        ", and the firmware (car: firmware:) runs on the emulated board as it is: only send and "
+        "close act on it (docs/firmware.md)";
+    const auto check_steps = [&](const char* key, const std::vector<Step>& steps,
+                                 const std::string& prefix) {
+      const YAML::Node list = root[key];
+      if (!list || !list.IsSequence() || list.size() != steps.size()) return;
+      for (std::size_t i = 0; i < steps.size(); ++i) {
+        const auto* car = std::get_if<CarStep>(&steps[i].action);
+        if (car == nullptr || acts_on_emulated_board(car->behaviour.action)) continue;
+        const YAML::Node item = list[i];
+        fail(item.IsMap() && item["car"] ? item["car"] : item,
+             prefix + std::to_string(i + 1) + ": " + behaviour_phrase(car->behaviour.action) +
+                 " needs the behavioural mock" + why);
+      }
+    };
+    check_steps("setup", scenario.setup, "setup step ");
+    check_steps("steps", scenario.steps, "step ");
+    check_steps("teardown", scenario.teardown, "teardown step ");
+    std::vector<Step> scheduled;
+    for (const auto& s : scenario.schedule)
+      scheduled.push_back(s.step);
+    check_steps("schedule", scheduled, "schedule ");
+    if (auto n = root["reply_latency"]) {
+      fail(n,
+           "'reply_latency' has no effect on the firmware (car: firmware:): the emulated "
+           "board's answers take the chip's own time");
+    }
+  }
+
+  /// The firmware read by read_firmware(), built and checked.
+  mocks::AvrConfig resolve_firmware() const {
+    const mocks::avr::FirmwareSource& source = *firmware_source_;
+    const YAML::Node& firmware = *firmware_;
+    const YAML::Node image = firmware[source.sketch.empty() ? "elf" : "sketch"];
+    try {
+      return mocks::avr::resolve_firmware(source);
+    } catch (const mocks::avr::SketchBuildError& e) {
+      fail(image, source.sketch.empty() ? std::string("the firmware image: ") + e.what()
+                                        : std::string("the sketch does not build: ") + e.what());
+    } catch (const config::ConfigError& e) {
+      // A pin map file's own error is at its own line; one without a
+      // position (a file that cannot be read) is at `pins:`.
+      if (e.line() > 0) throw;
+      fail(firmware["pins"] ? firmware["pins"] : image, "the pin map: " + e.message());
+    } catch (const std::invalid_argument& e) {
+      fail(image, std::string("the firmware cannot run on the emulated board: ") + e.what());
+    }
+  }
+
   /// `at_end: moving`: how the car must be once the client has stopped.
   AtEnd at_end(const YAML::Node& n) const {
     const std::string word = scalar(n, "'at_end'");
@@ -191,6 +295,8 @@ class ScenarioReader : public config::Reader {
 
   std::map<std::string, std::string> overrides_;
   ScenarioFacts facts_;
+  std::optional<YAML::Node> firmware_;  // the `firmware:` map, when the car has one
+  std::optional<mocks::avr::FirmwareSource> firmware_source_;
 };
 
 }  // namespace

@@ -384,6 +384,10 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "--elf", args->car.elf,
       "Arduino: run this firmware image (an ELF for the ATmega328P) on the emulated board");
   sketch_option->excludes(elf_option);
+  cmd->add_option("--board-startup", args->car.board_startup,
+                  "With --sketch or --elf: the time from the port opening to the sketch's first "
+                  "instruction (default 66ms: the ATmega328P's own start-up; the Uno's bootloader "
+                  "is not emulated)");
   cmd->add_option("--pins", args->car.pins,
                   "With --sketch or --elf: the pin map (YAML; default: pins.yaml beside the "
                   "sketch, else the protocol document's wiring, docs/firmware.md)");

@@ -158,6 +158,8 @@ void load_replay(const MockCarArgs& args, MockPlan& plan) {
 void load_firmware(const MockCarArgs& args, MockPlan& plan) {
   if (args.sketch.empty() && args.elf.empty()) {
     if (!args.pins.empty()) throw MockStartError{"--pins needs --sketch or --elf", 2};
+    if (!args.board_startup.empty())
+      throw MockStartError{"--board-startup needs --sketch or --elf", 2};
     return;
   }
   if (args.kind != "arduino") {
@@ -171,6 +173,16 @@ void load_firmware(const MockCarArgs& args, MockPlan& plan) {
   source.sketch = args.sketch;
   source.elf = args.elf;
   source.pins = args.pins;
+  if (!args.board_startup.empty()) {
+    const auto startup = parse_duration(args.board_startup);
+    if (!startup || *startup > std::chrono::seconds(10)) {
+      throw MockStartError{
+          "--board-startup takes a duration of at most 10s (e.g. 0ms, 66ms), got \"" +
+              args.board_startup + "\"",
+          2};
+    }
+    source.startup_delay = *startup;
+  }
   try {
     plan.base.configs.avr = mocks::avr::resolve_firmware(source);
   } catch (const mocks::avr::SketchBuildError& e) {

@@ -31,6 +31,7 @@ struct MockCarArgs {
   std::string sketch;              ///< Arduino: a sketch to build and run on the emulated board
   std::string elf;                 ///< Arduino: a firmware image to run on the emulated board
   std::string pins;                ///< with sketch or elf: the pin map file
+  std::string board_startup;       ///< with sketch or elf: the board's start-up; empty: 66 ms
 };
 
 // Where car N listens.

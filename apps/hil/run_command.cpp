@@ -26,6 +26,7 @@
 #include "harness/scenario_yaml.hpp"
 #include "link/capture/probe_capture.hpp"
 #include "link/faults/profile_yaml.hpp"
+#include "mocks/avr/firmware_source.hpp"
 
 namespace hil::apps {
 namespace {
@@ -44,9 +45,13 @@ struct RunArgs {
   std::vector<std::string> tags;
   std::vector<std::string> exclude_tags;
   std::optional<std::string> client_exec;
-  std::string replay;     ///< a probe capture every scenario's car plays; empty: none
-  std::string unmatched;  ///< with replay: mock or silent
-  std::string slack;      ///< as written ("100ms"); empty: the runner's default
+  std::string replay;         ///< a probe capture every scenario's car plays; empty: none
+  std::string unmatched;      ///< with replay: mock or silent
+  std::string sketch;         ///< a sketch every Arduino scenario's car runs; empty: none
+  std::string elf;            ///< or a firmware image
+  std::string pins;           ///< with sketch or elf: the pin map file
+  std::string board_startup;  ///< with sketch or elf: the board's start-up ("0ms"); empty: 66 ms
+  std::string slack;          ///< as written ("100ms"); empty: the runner's default
   std::vector<std::string> sets;
   int jobs = 0;
   bool list = false;
@@ -85,6 +90,11 @@ std::string shell_quote(const std::string& word) {
   return out + "'";
 }
 
+// "--sketch robot.ino", "--elf robot.elf": how the firmware was given.
+std::string firmware_given(const RunArgs& args) {
+  return args.sketch.empty() ? "--elf " + args.elf : "--sketch " + args.sketch;
+}
+
 std::string repro_command(const RunArgs& args, const std::string& file,
                           std::optional<std::uint64_t> seed) {
   std::string out = "hil run " + shell_quote(file);
@@ -94,6 +104,10 @@ std::string repro_command(const RunArgs& args, const std::string& file,
   if (args.client_exec) out += " --client-exec " + shell_quote(*args.client_exec);
   if (!args.replay.empty()) out += " --replay " + shell_quote(args.replay);
   if (!args.unmatched.empty()) out += " --unmatched " + args.unmatched;
+  if (!args.sketch.empty()) out += " --sketch " + shell_quote(args.sketch);
+  if (!args.elf.empty()) out += " --elf " + shell_quote(args.elf);
+  if (!args.pins.empty()) out += " --pins " + shell_quote(args.pins);
+  if (!args.board_startup.empty()) out += " --board-startup " + shell_quote(args.board_startup);
   if (args.allow_outside_paths) out += " --allow-outside-paths";
   if (!args.slack.empty()) out += " --slack " + shell_quote(args.slack);
   return out;
@@ -277,8 +291,12 @@ Batch make_batch(const RunArgs& args, const std::vector<Planned>& plan) {
 class BatchRunner {
  public:
   BatchRunner(const RunArgs& args, const std::vector<Planned>& plan, Batch& batch,
-              std::optional<mocks::ReplaySpec> replay)
-      : args_(args), plan_(plan), batch_(batch), replay_(std::move(replay)) {}
+              std::optional<mocks::ReplaySpec> replay, std::optional<mocks::AvrConfig> firmware)
+      : args_(args),
+        plan_(plan),
+        batch_(batch),
+        replay_(std::move(replay)),
+        firmware_(std::move(firmware)) {}
 
   void run() {
     const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
@@ -322,6 +340,15 @@ class BatchRunner {
     options.seed = task.seed;
     options.client_exec = args_.client_exec;
     options.replay = replay_;
+    options.firmware = firmware_;
+    options.firmware_given = firmware_given(args_);
+    // The emulated board's warnings (a firmware that never turns its UART
+    // on, a simavr error), once each per scenario file.
+    options.on_firmware_note = [this, file = p.file](const std::string& note) {
+      const std::lock_guard lock(progress_);
+      if (!shown_notes_.insert(file + '\n' + note).second) return;
+      std::cerr << "hil run: " << file << ": firmware: " << note << '\n';
+    };
     // A scenario may start one program, its declared client: print the
     // exact command line before it starts (once per scenario file).
     options.on_client_command = [this, file = p.file](const std::string& command) {
@@ -356,10 +383,12 @@ class BatchRunner {
   const std::vector<Planned>& plan_;
   Batch& batch_;
   std::optional<mocks::ReplaySpec> replay_;
+  std::optional<mocks::AvrConfig> firmware_;
   std::atomic<std::size_t> next_{0};
   std::atomic<std::size_t> done_{0};
   std::mutex progress_;
   std::set<std::string> shown_commands_;  // files whose client command was printed
+  std::set<std::string> shown_notes_;     // file and firmware warning, printed
 };
 
 // The table on stdout, then JUnit XML and the report folder when asked
@@ -415,12 +444,49 @@ std::optional<mocks::ReplaySpec> load_replay(const RunArgs& args) {
   return replay;
 }
 
+// --sketch or --elf (and --pins): the firmware built (or found in the
+// cache) and checked once for every run; nullopt without them. Throws
+// std::runtime_error naming the option: a sketch that does not compile
+// carries the compiler's error lines.
+std::optional<mocks::AvrConfig> load_firmware(const RunArgs& args) {
+  if (args.sketch.empty() && args.elf.empty()) {
+    if (!args.pins.empty()) throw std::runtime_error("--pins needs --sketch or --elf");
+    if (!args.board_startup.empty())
+      throw std::runtime_error("--board-startup needs --sketch or --elf");
+    return std::nullopt;
+  }
+  mocks::avr::FirmwareSource source;
+  source.sketch = args.sketch;
+  source.elf = args.elf;
+  source.pins = args.pins;
+  if (!args.board_startup.empty()) source.startup_delay = parse_duration(args.board_startup);
+  try {
+    return mocks::avr::resolve_firmware(source);
+  } catch (const config::ConfigError& e) {
+    // A pin map file: the error names it, with the line.
+    throw std::runtime_error(std::string(args.pins.empty() ? "the sketch's pin map" : "--pins") +
+                             ": " + e.what());
+  } catch (const std::exception& e) {
+    // The build's or the image's error names the file.
+    throw std::runtime_error(std::string(args.sketch.empty() ? "--elf: " : "--sketch: ") +
+                             e.what());
+  }
+}
+
 int run_scenarios(const RunArgs& args) {
   const auto overrides = variable_overrides(args);
   if (!overrides) return 2;
   std::optional<mocks::ReplaySpec> replay;
+  std::optional<mocks::AvrConfig> firmware;
   try {
+    if (!args.replay.empty() && !(args.sketch.empty() && args.elf.empty())) {
+      throw std::runtime_error(std::string("--replay and ") +
+                               (args.sketch.empty() ? "--elf" : "--sketch") +
+                               " do not go together: the car either plays the capture or runs "
+                               "the firmware");
+    }
     replay = load_replay(args);
+    firmware = load_firmware(args);
   } catch (const std::exception& e) {
     std::cerr << "hil run: " << e.what() << '\n';
     return 2;
@@ -440,7 +506,7 @@ int run_scenarios(const RunArgs& args) {
   }
   if (args.list) return list_plan(args, plan);
   Batch batch = make_batch(args, plan);
-  BatchRunner(args, plan, batch, std::move(replay)).run();
+  BatchRunner(args, plan, batch, std::move(replay), std::move(firmware)).run();
   return report_results(args, batch.entries);
 }
 
@@ -486,6 +552,31 @@ void register_run(CLI::App& app, std::function<int()>& run) {
                   "With --replay: a request the capture has no answer for gets the mock's answer "
                   "(mock, the default) or none (silent)")
       ->check(CLI::IsMember({"mock", "silent"}));
+  auto* sketch =
+      cmd->add_option("--sketch", args->sketch,
+                      "Run every Arduino scenario's car as this sketch on the emulated ATmega328P "
+                      "(built once, and cached); scenarios of other cars, and those that need the "
+                      "behavioural mock, are skipped")
+          ->type_name("FILE.ino");
+  auto* elf = cmd->add_option("--elf", args->elf, "The same with a firmware image built already")
+                  ->type_name("FILE.elf");
+  sketch->excludes(elf);
+  elf->excludes(sketch);
+  cmd->add_option("--pins", args->pins,
+                  "With --sketch or --elf: the pin map file (default: pins.yaml beside the "
+                  "sketch, else the default wiring; docs/firmware.md)")
+      ->type_name("FILE");
+  cmd->add_option("--board-startup", args->board_startup,
+                  "With --sketch or --elf: the time from the port opening to the sketch's first "
+                  "instruction (default 66ms, the chip's own; the behavioural mock answers at "
+                  "once, so scenarios written for it run on the board with 0ms)")
+      ->type_name("D")
+      ->check([](const std::string& text) {
+        const auto d = parse_duration(text);
+        return d && *d <= std::chrono::seconds(10)
+                   ? std::string()
+                   : "'" + text + "' is not a duration of at most 10s (e.g. 0ms, 66ms)";
+      });
   cmd->add_option("--slack", args->slack,
                   "Room for real time: windows where something must happen grow by D, windows "
                   "where it must not shrink by D (default 100ms in real time, 0 in virtual time)")
@@ -516,7 +607,8 @@ void register_run(CLI::App& app, std::function<int()>& run) {
       "  hil run scenarios/ --repeat 20 -j 4             # hunt flaky scenarios\n"
       "Every failure prints the command that repeats it.\n"
       "A scenario that sets hil's reference client's settings is skipped (SKIP) under\n"
-      "--client-exec: the program is not given those settings.\n"
+      "--client-exec: the program is not given those settings. Under --sketch or --elf, a\n"
+      "scenario of another car, or one that needs the behavioural mock, is skipped too.\n"
       "Exit status: 0 every scenario passed or was skipped; 1 any failed (or was flaky, or\n"
       "did not load);\n"
       "2 a malformed command line, a path that does not exist, or no scenario to run.");

@@ -58,6 +58,25 @@ WRONG = {
     "an unmatched policy misspelt": (
         "name: t\ncar: {kind: logi, replay: car.ndjson, unmatched: mocked}\nsteps: [connect]\n"
     ),
+    "firmware on another car": (
+        "name: t\ncar: {kind: logi, firmware: {elf: a.elf}}\nsteps: [connect]\n"
+    ),
+    "firmware with a replay": (
+        "name: t\ncar: {kind: arduino, replay: c.ndjson, firmware: {elf: a.elf}}\nsteps: [PING]\n"
+    ),
+    "firmware as both a sketch and an image": (
+        "name: t\ncar: {kind: arduino, firmware: {sketch: a/a.ino, elf: a.elf}}\nsteps: [PING]\n"
+    ),
+    "firmware without a sketch or an image": (
+        "name: t\ncar: {kind: arduino, firmware: {pins: pins.yaml}}\nsteps: [PING]\n"
+    ),
+    "a firmware key misspelt": (
+        "name: t\ncar: {kind: arduino, firmware: {skecth: a/a.ino}}\nsteps: [PING]\n"
+    ),
+    "firmware with a reply latency": (
+        "name: t\ncar: {kind: arduino, firmware: {elf: a.elf}}\nreply_latency: 20ms\n"
+        "steps: [PING]\n"
+    ),
     "another car's profile with a replay": (
         "name: t\ncar: {kind: logi, replay: car.ndjson}\nprofile: readme\nsteps: [connect]\n"
     ),
@@ -78,6 +97,14 @@ RIGHT = {
     "a replayed car": (
         "name: t\ncar: {kind: logi, replay: ../captures/car.ndjson, unmatched: silent}\n"
         "steps: [connect]\n"
+    ),
+    "a sketch on the emulated board": (
+        "name: t\ncar: {kind: arduino, firmware: {sketch: ../firmware/robot/robot.ino}}\n"
+        "steps: [PING]\n"
+    ),
+    "an image and its pin map": (
+        "name: t\ncar: {kind: arduino, firmware: {elf: robot.elf, pins: pins.yaml}}\n"
+        "steps: [PING]\n"
     ),
     "an exec client": (
         "name: t\ncar: wr8\nclient: {exec: 'c {host} {port}', startup_timeout: 5s}\n"
