@@ -1,13 +1,16 @@
 // The Arduino client in the `firmware` dialect against the mock playing the
-// real sketch (andrii-mazurchuk/arduino_robot_steering- at 8dcfab0), on
-// mem:// in virtual time: the frames it sends are the real client's, the
-// board's replies come back as the same typed results as in `readme`, and
-// a raw token reaches the board as typed.
+// real sketch (andrii-mazurchuk/arduino_robot_steering- at 8dcfab0) and
+// against hil's test sketch on the emulated ATmega328P
+// (tests/client/arduino_board.hpp), on mem:// in virtual time: the frames
+// it sends are the real client's, the board's replies come back as the
+// same typed results as in `readme` (the mock's other profile), and a raw
+// token reaches the board as typed.
 
 #include <gtest/gtest.h>
 
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -18,6 +21,7 @@
 #include "mocks/server.hpp"
 #include "protocol/arduino/reply.hpp"
 #include "sim/presets.hpp"
+#include "tests/client/arduino_board.hpp"
 #include "tests/client/client_test_support.hpp"
 
 namespace hil::client::arduino {
@@ -26,17 +30,30 @@ namespace {
 namespace proto = protocol::arduino;
 using link::seconds;
 
-struct ArduinoDialects : ::testing::TestWithParam<proto::Dialect> {
+/// A board and the dialect it speaks (the emulated board runs hil's
+/// sketch, which speaks `firmware` only).
+struct BoardProfile {
+  test::Board board = test::Board::mock;
+  proto::Dialect dialect = proto::Dialect::firmware;
+};
+
+void PrintTo(const BoardProfile& p, std::ostream* os) {
+  *os << test::board_name(p.board) << " " << proto::to_string(p.dialect);
+}
+
+struct ArduinoDialects : ::testing::TestWithParam<BoardProfile> {
   ArduinoDialects() {
     mocks::ArduinoConfig board;
-    board.dialect = GetParam();
-    car.start_car(sim::arduino_robot(), test::on_mem("arduino", {}), board);
+    board.dialect = GetParam().dialect;
+    car.start_board(GetParam().board, test::on_mem("arduino", {}), board);
     ClientConfig config;
-    config.dialect = GetParam();
+    config.dialect = GetParam().dialect;
     config.health_check_interval = Duration::zero();
     session = std::make_unique<ArduinoSession>(car.context, link::MemEndpoint{"arduino"}, config);
     session->open();
     car.executor.run_for(Duration::zero());
+    // The emulated board resets as the port opens; the requests wait for it.
+    EXPECT_TRUE(car.wait_until_listening()) << "the sketch never turned its UART on";
   }
 
   Result run(const std::function<RequestId(ArduinoSession&, ArduinoSession::Callback)>& f) {
@@ -64,7 +81,7 @@ struct ArduinoDialects : ::testing::TestWithParam<proto::Dialect> {
     return out;
   }
 
-  test::VirtualCar<mocks::ArduinoFirmware> car;
+  test::BoardCar car;
   std::unique_ptr<ArduinoSession> session;
 };
 
@@ -107,7 +124,8 @@ TEST_P(ArduinoDialects, EveryCommandComesBackAsTheSameTypedReply) {
                                              "R",    "S",    "B",      "I"};
   const std::vector<std::string> readme_list{"PING", "STATUS", "V", "M",   "R",
                                              "S",    "B",      "I", "HELP"};
-  EXPECT_EQ(help.commands, GetParam() == proto::Dialect::firmware ? sketch_list : readme_list);
+  EXPECT_EQ(help.commands,
+            GetParam().dialect == proto::Dialect::firmware ? sketch_list : readme_list);
 }
 
 TEST_P(ArduinoDialects, ARawTokenOutOfRangeReachesTheBoardAndItsNackIsTheResult) {
@@ -132,11 +150,14 @@ TEST_P(ArduinoDialects, ATokenThatCannotBeFramedIsRefusedBeforeTheWire) {
   EXPECT_TRUE(sent().empty());
 }
 
-INSTANTIATE_TEST_SUITE_P(Profiles, ArduinoDialects,
-                         ::testing::Values(proto::Dialect::firmware, proto::Dialect::readme),
-                         [](const ::testing::TestParamInfo<proto::Dialect>& p) {
-                           return std::string(proto::to_string(p.param));
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Profiles, ArduinoDialects,
+    ::testing::Values(BoardProfile{test::Board::mock, proto::Dialect::firmware},
+                      BoardProfile{test::Board::mock, proto::Dialect::readme},
+                      BoardProfile{test::Board::sketch, proto::Dialect::firmware}),
+    [](const ::testing::TestParamInfo<BoardProfile>& p) {
+      return test::board_name(p.param.board) + "_" + std::string(proto::to_string(p.param.dialect));
+    });
 
 // The real client's own frames (robot_client.py at 8dcfab0): an
 // argument-less command carries one space, which the sketch needs.

@@ -1,6 +1,8 @@
 // The Arduino operator language (every command, every error with its column,
 // scripts with file:line:col) and the runner that carries commands out on a
-// session against the mock robot on mem:// in virtual time, with exact times.
+// session against the robot on mem:// in virtual time, with exact times, on
+// both boards (the behavioural mock and hil's test sketch on the emulated
+// ATmega328P, tests/client/arduino_board.hpp).
 
 #include <unistd.h>
 
@@ -22,6 +24,7 @@
 #include "mocks/server.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/arduino_board.hpp"
 #include "tests/client/client_test_support.hpp"
 #include "tests/client/operator_test_support.hpp"
 
@@ -239,10 +242,15 @@ TEST(ArduinoOperatorDescribe, ResultsReadAsAPersonWouldSayThem) {
   EXPECT_EQ(describe_outcome(outcome), "V 160 -> ACK 160");
 }
 
-// ---- the runner, against the mock robot in virtual time ----
+// ---- the runner, against the robot in virtual time ----
 
-struct ArduinoOperatorRunner : ::testing::Test, test::VirtualCar<mocks::ArduinoFirmware> {
-  /// The robot on mem://arduino; `bytes_per_second` paces both directions.
+using test::Board;
+
+struct ArduinoOperatorRunner : ::testing::TestWithParam<Board>, test::BoardCar {
+  /// The robot (the board of the test's parameter) on mem://arduino, once it
+  /// listens (the emulated board resets as the port opens,
+  /// test::BoardCar::wait_until_listening()); `bytes_per_second` paces both
+  /// directions.
   void start(std::optional<std::uint64_t> bytes_per_second = std::nullopt,
              OperatorRunner::Options options = {}) {
     mocks::ServerOptions server_options = test::on_mem("arduino");
@@ -251,8 +259,9 @@ struct ArduinoOperatorRunner : ::testing::Test, test::VirtualCar<mocks::ArduinoF
       rule.action = link::Bandwidth{*bytes_per_second};
       server_options.faults.rules.push_back(rule);
     }
-    start_car(sim::arduino_robot(), std::move(server_options));
+    start_board(GetParam(), std::move(server_options));
     connect("arduino", options);
+    ASSERT_TRUE(wait_until_listening()) << "the sketch never turned its UART on";
   }
 
   void connect(const std::string& name, OperatorRunner::Options options = {}) {
@@ -296,7 +305,10 @@ struct ArduinoOperatorRunner : ::testing::Test, test::VirtualCar<mocks::ArduinoF
   int idle_calls = 0;
 };
 
-TEST_F(ArduinoOperatorRunner, PingWaitStatusEndsAtTheTimeTheLinePacingGives) {
+/// The same, for the tests that need a behaviour only the mock honours.
+struct ArduinoMockOperatorRunner : ArduinoOperatorRunner {};
+
+TEST_P(ArduinoOperatorRunner, PingWaitStatusEndsAtTheTimeTheLinePacingGives) {
   // 1000 bytes per second: every byte is 1 ms on the line, each way.
   start(1000);
   const Time t0 = executor.now();
@@ -305,22 +317,41 @@ TEST_F(ArduinoOperatorRunner, PingWaitStatusEndsAtTheTimeTheLinePacingGives) {
   // The real sketch's dialect: "^00|PING| *30$" is 14 bytes out,
   // "^00|ACK|PONG*5F$" 16 bytes back.
   EXPECT_EQ(outcomes[0].text, "ACK PONG");
-  EXPECT_EQ(outcomes[0].finished - t0, milliseconds(30));
-  EXPECT_EQ(outcomes[1].started - t0, milliseconds(30));
-  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(1030));
-  // "^01|STATUS| *..$" is 16 bytes, so the robot reads it at 1046 ms; the
-  // answer is the text plus 12 bytes of frame.
   const auto& status = outcomes[2];
   ASSERT_TRUE(status.ok) << status.text;
   const std::string info = status.result->info;
   EXPECT_EQ(info, "STATUS:V=140,DIR=stop,MOT:IDLE");
-  EXPECT_EQ(status.finished - t0, milliseconds(1046 + static_cast<int>(info.size()) + 12));
+  // "^01|STATUS| *..$" is 16 bytes; the answer is the text plus 12 bytes
+  // of frame.
+  const std::size_t status_out = 16, status_back = info.size() + 12;
+  if (GetParam() == Board::mock) {
+    EXPECT_EQ(outcomes[0].finished - t0, milliseconds(30));
+    EXPECT_EQ(outcomes[1].started - t0, milliseconds(30));
+    EXPECT_EQ(outcomes[1].finished - t0, milliseconds(1030));
+    // The robot reads STATUS at 1046 ms and answers at once.
+    EXPECT_EQ(status.finished - t0, milliseconds(1030) + milliseconds(status_out + status_back));
+  } else {
+    // The link paces each whole frame (1 ms a byte), and the board's UART
+    // takes its own 9,600-baud time to read the request and to write the
+    // answer: both, one after the other.
+    const auto exchange = [](std::size_t out, std::size_t back) {
+      return milliseconds(out + back) + test::sketch_uart_time(out + back);
+    };
+    const Duration ping = outcomes[0].finished - t0;
+    EXPECT_GE(ping, exchange(14, 16));
+    EXPECT_LE(ping, exchange(14, 16) + test::kSketchSlack);
+    EXPECT_EQ(outcomes[1].started - t0, ping);
+    EXPECT_EQ(outcomes[1].finished - t0, ping + seconds(1));
+    const Duration answered = status.finished - outcomes[1].finished;
+    EXPECT_GE(answered, exchange(status_out, status_back));
+    EXPECT_LE(answered, exchange(status_out, status_back) + test::kSketchSlack);
+  }
   EXPECT_EQ(runner->failures(), 0u);
   EXPECT_EQ(runner->completed(), 3u);
   EXPECT_GE(idle_calls, 1);
 }
 
-TEST_F(ArduinoOperatorRunner, EveryRequestIsCarriedOutAndAnswered) {
+TEST_P(ArduinoOperatorRunner, EveryRequestIsCarriedOutAndAnswered) {
   start();
   run_script("PING\nV 160\nM 20\nstatus\nS\nR -90\nB\nI\nHELP\n");
   const auto out = lines();
@@ -335,20 +366,40 @@ TEST_F(ArduinoOperatorRunner, EveryRequestIsCarriedOutAndAnswered) {
   EXPECT_EQ(out[6].rfind("B -> ACK B:", 0), 0u) << out[6];
   EXPECT_EQ(out[7].rfind("I -> ACK I:AL=", 0), 0u) << out[7];
   EXPECT_EQ(out[8], "HELP -> ACK CMDS:PING,HELP,STATUS,V,M,R,S,B,I");
-  EXPECT_EQ(firmware->state().pwm, 160);
+  if (auto* m = mock()) EXPECT_EQ(m->state().pwm, 160);
 }
 
-TEST_F(ArduinoOperatorRunner, AMoveScriptDrivesTheRobotForItsTimedDuration) {
+TEST_P(ArduinoOperatorRunner, AMoveScriptDrivesTheRobotForItsTimedDuration) {
   start();
-  // M 50 runs 900 ms: polled at 899 ms it still moves, at 900 ms it is idle.
-  run_script("M 50\nwait 899ms\nSTATUS\nwait 1ms\nSTATUS\n");
-  ASSERT_EQ(outcomes.size(), 5u);
-  EXPECT_EQ(outcomes[2].result->info.rfind("STATUS:V=140,DIR=fwd,MOT:MOVE,tleft:", 0), 0u)
-      << outcomes[2].result->info;
-  EXPECT_EQ(outcomes[4].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE");
+  if (GetParam() == Board::mock) {
+    // M 50 runs 900 ms: polled at 899 ms it still moves, at 900 ms it is idle.
+    run_script("M 50\nwait 899ms\nSTATUS\nwait 1ms\nSTATUS\n");
+    ASSERT_EQ(outcomes.size(), 5u);
+    EXPECT_EQ(outcomes[2].result->info.rfind("STATUS:V=140,DIR=fwd,MOT:MOVE,tleft:", 0), 0u)
+        << outcomes[2].result->info;
+    EXPECT_EQ(outcomes[4].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE");
+    return;
+  }
+  // The sketch times the 900 ms from the moment it read M, which the client
+  // hears of only after the ACK's 20 bytes at 9,600 baud; the STATUS it is
+  // polled with takes its 16 bytes to reach it. So polled 840 ms after the
+  // ACK it has run 840 ms plus those 36 bytes' time, and says how much is
+  // left; polled after that answer it is idle.
+  run_script("M 50\nwait 840ms\nSTATUS\nSTATUS\n");
+  ASSERT_EQ(outcomes.size(), 4u);
+  const std::string moving = outcomes[2].result->info;
+  const std::string prefix = "STATUS:V=140,DIR=fwd,MOT:MOVE,tleft:";
+  ASSERT_EQ(moving.rfind(prefix, 0), 0u) << moving;
+  const Duration ran = milliseconds(840) + test::sketch_uart_time(20 + 16);
+  const Duration left = milliseconds(std::stoi(moving.substr(prefix.size())));
+  EXPECT_LE(left, milliseconds(900) - ran) << moving;
+  EXPECT_GE(left, milliseconds(900) - ran - test::kSketchSlack) << moving;
+  EXPECT_EQ(outcomes[3].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE");
 }
 
-TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
+// Mock only: the sketch never refuses a V it can take (a scripted Reject
+// does not act on the emulated board).
+TEST_P(ArduinoMockOperatorRunner, TheRunStopsAtTheFirstFailure) {
   start();
   firmware->arm(test::reject_next("V"));
   run_script("ping\nV 160\nstatus\n");
@@ -362,7 +413,8 @@ TEST_F(ArduinoOperatorRunner, TheRunStopsAtTheFirstFailure) {
   EXPECT_EQ(session->log().size(), 4u) << "a halted runner takes no more";
 }
 
-TEST_F(ArduinoOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
+// Mock only: a scripted Reject, which does not act on the emulated board.
+TEST_P(ArduinoMockOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
   start(std::nullopt, {.keep_going = true});
   firmware->arm(test::reject_next("V"));
   run_script("V 160\nV 170\nstatus\n");
@@ -372,7 +424,7 @@ TEST_F(ArduinoOperatorRunner, KeepGoingRunsEveryCommandAndCountsTheFailures) {
   EXPECT_FALSE(runner->halted());
 }
 
-TEST_F(ArduinoOperatorRunner, HistoryAndSaveLogShowTheFramesSoFar) {
+TEST_P(ArduinoOperatorRunner, HistoryAndSaveLogShowTheFramesSoFar) {
   start();
   const auto dir = std::filesystem::temp_directory_path() /
                    ("hil-arduino-operator-" + std::to_string(::getpid()));
@@ -396,9 +448,9 @@ TEST_F(ArduinoOperatorRunner, HistoryAndSaveLogShowTheFramesSoFar) {
   std::filesystem::remove_all(dir);
 }
 
-TEST_F(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
+TEST_P(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
   start();
-  const auto boots = firmware->state().boots;
+  const auto boots_before = boots();
   run_script("V 200\nreconnect\nstatus\n");
   ASSERT_EQ(outcomes.size(), 3u);
   EXPECT_TRUE(outcomes[1].ok);
@@ -407,23 +459,25 @@ TEST_F(ArduinoOperatorRunner, ReconnectReopensThePortAndTheRobotBootsAgain) {
       << "closed for the session's reconnect_base_delay";
   EXPECT_EQ(outcomes[2].result->info, "STATUS:V=140,DIR=stop,MOT:IDLE")
       << "the board reset when the port opened: " << outcomes[2].result->info;
-  EXPECT_EQ(firmware->state().boots, boots + 1);
+  EXPECT_EQ(boots(), boots_before + 1);
   ASSERT_GE(changes.size(), 2u);
   EXPECT_EQ(changes[changes.size() - 2].to, ConnectionState::connecting);
   EXPECT_EQ(changes.back().to, ConnectionState::connected);
 }
 
-TEST_F(ArduinoOperatorRunner, QuitDropsWhatComesAfterIt) {
+TEST_P(ArduinoOperatorRunner, QuitDropsWhatComesAfterIt) {
   start();
   run_script("ping\nquit\nV 100\n");
   ASSERT_EQ(outcomes.size(), 2u);
   EXPECT_TRUE(runner->quit_requested());
   EXPECT_TRUE(runner->halted());
   EXPECT_EQ(runner->failures(), 0u);
-  EXPECT_EQ(firmware->state().pwm, 140);
+  EXPECT_EQ(session->log().size(), 2u) << "V 100 never went out";
+  if (auto* m = mock()) EXPECT_EQ(m->state().pwm, 140);
 }
 
-TEST_F(ArduinoOperatorRunner, APortThatDoesNotOpenFailsTheRequestAndReconnect) {
+// No board answers here: run once, on the mock's fixture.
+TEST_P(ArduinoMockOperatorRunner, APortThatDoesNotOpenFailsTheRequestAndReconnect) {
   connect("nobody-listens");
   EXPECT_EQ(session->state(), ConnectionState::down);
   runner->add(RobotRequest{proto::Ping{}});
@@ -433,7 +487,7 @@ TEST_F(ArduinoOperatorRunner, APortThatDoesNotOpenFailsTheRequestAndReconnect) {
   EXPECT_EQ(outcomes[0].text.rfind("LINK DOWN (", 0), 0u) << outcomes[0].text;
 }
 
-TEST_F(ArduinoOperatorRunner, ARequestQueuedWhileAWaitRunsGoesOutAfterIt) {
+TEST_P(ArduinoOperatorRunner, ARequestQueuedWhileAWaitRunsGoesOutAfterIt) {
   start();
   runner->add(WaitCommand{milliseconds(300)});
   const Time t0 = executor.now();
@@ -443,8 +497,21 @@ TEST_F(ArduinoOperatorRunner, ARequestQueuedWhileAWaitRunsGoesOutAfterIt) {
   run_to_idle();
   ASSERT_EQ(outcomes.size(), 2u);
   EXPECT_EQ(outcomes[1].started - t0, milliseconds(300));
-  EXPECT_EQ(outcomes[1].finished - t0, milliseconds(300));
+  if (GetParam() == Board::mock) {
+    EXPECT_EQ(outcomes[1].finished - t0, milliseconds(300));
+  } else {
+    // The board reads the 16-byte STATUS and writes its 43-byte answer at
+    // 9,600 baud.
+    const Duration took = outcomes[1].finished - outcomes[1].started;
+    EXPECT_GE(took, test::sketch_uart_time(16 + 43));
+    EXPECT_LE(took, test::sketch_uart_time(16 + 43) + test::kSketchSlack);
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(Boards, ArduinoOperatorRunner, test::both_boards(),
+                         test::board_param_name);
+INSTANTIATE_TEST_SUITE_P(Boards, ArduinoMockOperatorRunner, ::testing::Values(Board::mock),
+                         test::board_param_name);
 
 }  // namespace
 }  // namespace hil::client::arduino

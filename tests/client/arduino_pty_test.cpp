@@ -1,5 +1,7 @@
-// The Arduino client session over a real pty at 9600 baud against the mock
-// robot, under the real-time driver. Waits are bounded and generous.
+// The Arduino client session over a real pty at 9600 baud under the
+// real-time driver, against both boards: the behavioural mock and hil's
+// test sketch on the emulated ATmega328P (tests/client/arduino_board.hpp).
+// Waits are bounded and generous.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +14,8 @@
 #include "client/arduino/session.hpp"
 #include "link/endpoint.hpp"
 #include "mocks/arduino.hpp"
+#include "mocks/avr/avr_firmware.hpp"
+#include "tests/client/arduino_board.hpp"
 #include "tests/link/transports/real_time.hpp"
 #include "tests/mocks/real_time_car.hpp"
 
@@ -20,8 +24,33 @@ namespace {
 
 namespace proto = protocol::arduino;
 
-TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) {
-  mocks::test::PtyCar<mocks::ArduinoFirmware> car("arduino0", "?baud=9600", sim::arduino_robot());
+// The board, by its firmware's type, and how to make it.
+struct OnMock {
+  using Firmware = mocks::ArduinoFirmware;
+  static constexpr test::Board kBoard = test::Board::mock;
+  static mocks::ArduinoConfig config() { return {}; }
+};
+struct OnSketch {
+  using Firmware = mocks::AvrFirmware;
+  static constexpr test::Board kBoard = test::Board::sketch;
+  static mocks::AvrConfig config() { return test::sketch_config(); }
+};
+
+struct BoardNames {
+  template <class T>
+  static std::string GetName(int) {
+    return test::board_name(T::kBoard);
+  }
+};
+
+template <class Board>
+struct ArduinoSessionOverPty : ::testing::Test {};
+using Boards = ::testing::Types<OnMock, OnSketch>;
+TYPED_TEST_SUITE(ArduinoSessionOverPty, Boards, BoardNames);
+
+TYPED_TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) {
+  mocks::test::PtyCar<typename TypeParam::Firmware> car("arduino0", "?baud=9600",
+                                                        sim::arduino_robot(), TypeParam::config());
   asio::io_context& io = car.io;
 
   ArduinoSession session(car.context, link::parse_endpoint(car.uri));
@@ -29,6 +58,16 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   ASSERT_TRUE(link::test::run_until(io, [&] {
     return session.state() == ConnectionState::connected;
   })) << "the port never opened";
+  if constexpr (TypeParam::kBoard == test::Board::sketch) {
+    // The emulated board resets as the port opens (about 66 ms); the
+    // requests wait until its sketch has turned the UART on after that
+    // reset (its second boot, power-on being the first).
+    ASSERT_TRUE(link::test::run_until(io, [&] {
+      return car.firmware.state().boots >= 2 &&
+             car.firmware.state().phase == mocks::ChipPhase::running &&
+             car.firmware.state().uart_baud != 0;
+    })) << "the sketch never turned its UART on";
+  }
 
   auto run = [&](auto submit) {
     std::optional<Result> result;
@@ -50,7 +89,7 @@ TEST(ArduinoSessionOverPty, ASessionAt9600BaudGetsEveryAnswerAndLogsEveryFrame) 
   EXPECT_EQ(bad.nack, (proto::Nack{proto::NackCode::bad_v}));
   auto turn = run([](auto& s, auto cb) { return s.raw("R:-90", cb); });
   EXPECT_EQ(turn.info, "ACCEPTED");
-  EXPECT_EQ(car.firmware.state().pwm, 180);
+  if constexpr (TypeParam::kBoard == test::Board::mock) EXPECT_EQ(car.firmware.state().pwm, 180);
 
   const auto entries = session.log().entries();
   ASSERT_GE(entries.size(), 8u);

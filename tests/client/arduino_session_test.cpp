@@ -1,6 +1,8 @@
-// The Arduino client session against the mock Arduino robot on mem:// in
-// virtual time: every helper, and each timing rule seen on the wire through
-// the session's frame log (stamped with the virtual clock).
+// The Arduino client session against the Arduino robot on mem:// in
+// virtual time, on both boards (the behavioural mock and hil's test sketch
+// on the emulated ATmega328P, tests/client/arduino_board.hpp): every
+// helper, and each timing rule seen on the wire through the session's
+// frame log (stamped with the virtual clock).
 
 #include <gtest/gtest.h>
 
@@ -17,6 +19,7 @@
 #include "protocol/arduino/codec.hpp"
 #include "sim/presets.hpp"
 #include "sim/world.hpp"
+#include "tests/client/arduino_board.hpp"
 #include "tests/client/client_test_support.hpp"
 
 namespace hil::client::arduino {
@@ -26,10 +29,21 @@ namespace proto = protocol::arduino;
 using link::milliseconds;
 using link::seconds;
 
-/// The mock robot behind mem://arduino and a session to it, in virtual time.
-struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFirmware> {
+using test::Board;
+
+/// The robot (the board of the test's parameter) behind mem://arduino and a
+/// session to it, in virtual time.
+struct ArduinoSessionOnMem : ::testing::TestWithParam<Board>, test::BoardCar {
+  /// Opens the port and waits until the board listens (the emulated board
+  /// resets as the port opens, test::BoardCar::wait_until_listening()).
   void start(ClientConfig config = {}, mocks::ServerOptions options = {}) {
-    start_car(sim::arduino_robot(), test::on_mem("arduino", std::move(options)));
+    open(config, std::move(options));
+    ASSERT_TRUE(wait_until_listening()) << "the sketch never turned its UART on";
+  }
+
+  /// Opens the port and leaves the board to itself.
+  void open(ClientConfig config = {}, mocks::ServerOptions options = {}) {
+    start_board(GetParam(), test::on_mem("arduino", std::move(options)));
     session = std::make_unique<ArduinoSession>(context, link::MemEndpoint{"arduino"}, config);
     // Log times are the virtual clock in microseconds, so the log shows
     // exactly when each frame went out.
@@ -59,8 +73,17 @@ struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFir
   std::vector<Time> tx_times() const {
     std::vector<Time> out;
     for (auto& e : session->log().entries()) {
-      if (e.kind == LogKind::tx) out.push_back(milliseconds(e.utc_us / 1000));
+      if (e.kind == LogKind::tx) out.push_back(link::microseconds(e.utc_us));
     }
+    return out;
+  }
+
+  /// The frame log, one line per frame with its time in microseconds, for
+  /// a failure's message.
+  std::string wire() const {
+    std::string out;
+    for (const auto& e : session->log().entries())
+      out += std::to_string(e.utc_us) + (e.kind == LogKind::tx ? " TX " : " RX ") + e.raw + "\n";
     return out;
   }
 
@@ -68,6 +91,9 @@ struct ArduinoSessionOnMem : ::testing::Test, test::VirtualCar<mocks::ArduinoFir
   std::vector<LinkChanged> changes;
   Time done_at{0};
 };
+
+/// The same, for the tests that need a behaviour only the mock honours.
+struct ArduinoMockSessionOnMem : ArduinoSessionOnMem {};
 
 /// Server options whose link corrupts the checksum of each of the first
 /// `count` frames going `direction`.
@@ -81,13 +107,25 @@ mocks::ServerOptions checksum_corrupted(link::DirectionFilter direction, std::ui
   return options;
 }
 
+/// Server options whose link loses every frame to the robot until `until`
+/// (for ever when not given): a deaf robot on either board.
+mocks::ServerOptions requests_lost(std::optional<Time> until = std::nullopt) {
+  mocks::ServerOptions options;
+  link::FaultRule rule;
+  rule.direction = link::DirectionFilter::to_car;
+  rule.window.to = until;
+  rule.action = link::Drop{};
+  options.faults.rules.push_back(rule);
+  return options;
+}
+
 ClientConfig quiet() {
   ClientConfig c;
   c.health_check_interval = Duration::zero();
   return c;
 }
 
-TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
+TEST_P(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   start(quiet());
   auto ok = [](const std::optional<Result>& r) {
     EXPECT_TRUE(r.has_value());
@@ -112,17 +150,20 @@ TEST_F(ArduinoSessionOnMem, EveryHelperGetsTheRobotsAnswer) {
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.ir(cb); })).rfind("I:AL=", 0), 0u);
   EXPECT_EQ(ok(run([](auto& s, auto cb) { return s.help(cb); })),
             mocks::ArduinoFirmware::help_text(proto::Dialect::firmware));
-  EXPECT_EQ(firmware->state().last_seq, std::optional<std::uint8_t>(0x09));
+  // The mock also keeps the last SEQ it took (the sketch keeps none).
+  if (auto* m = mock()) EXPECT_EQ(m->state().last_seq, std::optional<std::uint8_t>(0x09));
   // Every frame in the log, both ways, with its SEQ.
   const auto entries = session->log().entries();
-  ASSERT_EQ(entries.size(), 20u);
+  ASSERT_EQ(entries.size(), 20u) << wire();
   EXPECT_EQ(entries[0].raw, "^00|PING| *30$");
   EXPECT_EQ(entries[1].raw, "^00|ACK|PONG*5F$");
   EXPECT_EQ(entries[1].kind, LogKind::rx);
   EXPECT_EQ(entries[1].seq, std::optional<std::uint8_t>(0x00));
 }
 
-TEST_F(ArduinoSessionOnMem, ARejectedMoveComesBackAsItsNack) {
+// Mock only: the sketch never refuses a move (a scripted Reject does not
+// act on the emulated board).
+TEST_P(ArduinoMockSessionOnMem, ARejectedMoveComesBackAsItsNack) {
   start(quiet());
   firmware->arm(test::reject_next("M"));
   auto r = run([](auto& s, auto cb) { return s.move_cm(20, cb); });
@@ -132,13 +173,13 @@ TEST_F(ArduinoSessionOnMem, ARejectedMoveComesBackAsItsNack) {
   EXPECT_EQ(r->attempts, 1);
 }
 
-TEST_F(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
+TEST_P(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms) {
   start(quiet(), checksum_corrupted(link::DirectionFilter::to_client, 2));
   const Time t0 = executor.now();
   auto r = run([](auto& s, auto cb) { return s.ping(cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::ok);
-  EXPECT_EQ(r->attempts, 3);
+  EXPECT_EQ(r->attempts, 3) << wire();
   EXPECT_EQ(session->core().parse_errors(), 2u);
   const auto tx = tx_times();
   ASSERT_EQ(tx.size(), 3u);
@@ -147,13 +188,13 @@ TEST_F(ArduinoSessionOnMem, CorruptedAnswersAreRetriedAfterExactly600Then1200Ms)
   EXPECT_EQ(tx[2] - tx[1], milliseconds(1200));
 }
 
-TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
+TEST_P(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
   start(quiet(), checksum_corrupted(link::DirectionFilter::to_car, 1));
   auto r = run([](auto& s, auto cb) { return s.set_v(200, cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::ok);
   EXPECT_EQ(r->info, "OK");
-  EXPECT_EQ(r->attempts, 1);
+  EXPECT_EQ(r->attempts, 1) << wire();
   EXPECT_EQ(r->bad_cs_resends, 1);
   const auto entries = session->log().entries();
   ASSERT_EQ(entries.size(), 4u);
@@ -161,10 +202,15 @@ TEST_F(ArduinoSessionOnMem, ANackBadCsIsResentAtOnce) {
   EXPECT_EQ(entries[2].kind, LogKind::tx);
   EXPECT_EQ(entries[2].raw, entries[0].raw);
   EXPECT_EQ(entries[2].utc_us, entries[1].utc_us) << "resent the moment the NACK arrived";
-  EXPECT_EQ(firmware->state().pwm, 200);
+  // The resent V took effect.
+  auto status = run([](auto& s, auto cb) { return s.status(cb); });
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->info, "STATUS:V=200,DIR=stop,MOT:IDLE");
 }
 
-TEST_F(ArduinoSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
+// Mock only: the sketch answers every frame it hears (a scripted Ignore
+// does not act on the emulated board).
+TEST_P(ArduinoMockSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
   start(quiet());
   firmware->arm({.name = "", .when = {}, .action = mocks::Ignore{}});
   const Time t0 = executor.now();
@@ -180,7 +226,9 @@ TEST_F(ArduinoSessionOnMem, ARobotThatIgnoresEverythingGivesTimeoutAfter9s) {
   EXPECT_EQ(tx[3] - t0, milliseconds(4200));
 }
 
-TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
+// Mock only: it needs the board to ignore a request (Ignore does not act on
+// the emulated board).
+TEST_P(ArduinoMockSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   start(quiet());
   firmware->arm(
       {.name = "", .when = {}, .action = mocks::Ignore{.match = "B", .count = 1, .duration = {}}});
@@ -199,7 +247,9 @@ TEST_F(ArduinoSessionOnMem, AStaleAnswerWithAnotherSeqIsIgnored) {
   EXPECT_EQ(session->core().stale_frames(), 1u);
 }
 
-TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
+// Mock only: the robot goes deaf by a scripted Ignore, which does not act on
+// the emulated board.
+TEST_P(ArduinoMockSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack) {
   start();  // health check after 5 s of quiet
   // The robot hears nothing for 10 s, then recovers.
   firmware->arm({.name = "",
@@ -218,13 +268,15 @@ TEST_F(ArduinoSessionOnMem, TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRo
     EXPECT_EQ(changes[i].at, expected[i].second) << i;
   }
   EXPECT_EQ(server->clients_served(), 2u);
-  EXPECT_EQ(firmware->state().boots, 3u) << "power-on and a reset per port opening";
+  EXPECT_EQ(boots(), 3u) << "power-on and a reset per port opening";
   auto r = run([](auto& s, auto cb) { return s.ping(cb); });
   ASSERT_TRUE(r);
   EXPECT_EQ(r->code, ResultCode::ok);
 }
 
-TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
+// Mock only: silence by a scripted Ignore, which does not act on the
+// emulated board.
+TEST_P(ArduinoMockSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
   ClientConfig config = quiet();
   config.max_reconnect_attempts = 2;
   start(config);
@@ -239,7 +291,7 @@ TEST_F(ArduinoSessionOnMem, ARobotThatStaysSilentTakesTheLinkDown) {
   EXPECT_EQ(changes.back().at, milliseconds(9000 + 500 + 4200 + 1000 + 4200));
 }
 
-TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueuedRequestsGoOut) {
+TEST_P(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueuedRequestsGoOut) {
   start(quiet());
   mocks::When at_1s;
   at_1s.at = seconds(1);
@@ -254,13 +306,119 @@ TEST_F(ArduinoSessionOnMem, ARobotThatHangsUpIsReopenedHalfASecondLaterAndQueued
   });
   executor.run_until(seconds(3));
   EXPECT_EQ(session->state(), ConnectionState::connected);
-  EXPECT_EQ(changes.back().at, milliseconds(1500));
   ASSERT_TRUE(queued.has_value());
   EXPECT_EQ(queued->code, ResultCode::ok);
-  EXPECT_EQ(done_at, milliseconds(1500)) << "sent right after the reconnect PING's ACK";
   // The reconnect PING took the next SEQ, the queued request the one after.
   EXPECT_EQ(queued->seq, std::optional<std::uint8_t>(0x01));
+  // After the hang-up: the reconnect PING (SEQ 00), OPEN the instant its
+  // ACK came in, and the queued sonar (SEQ 01) sent in that same instant.
+  const auto entries = session->log().entries();
+  ASSERT_GE(entries.size(), 4u);
+  const auto us = [](Time t) { return t.count() / 1000; };
+  std::vector<std::int64_t> ping_tx;
+  std::optional<std::int64_t> ping_ack, sonar_tx, sonar_rx;
+  for (const auto& e : entries) {
+    if (e.kind == LogKind::tx && e.raw == "^00|PING| *30$") ping_tx.push_back(e.utc_us);
+    if (e.kind == LogKind::rx && e.raw == "^00|ACK|PONG*5F$") ping_ack = e.utc_us;
+    if (e.kind == LogKind::tx && e.seq == std::optional<std::uint8_t>(0x01)) sonar_tx = e.utc_us;
+    if (e.kind == LogKind::rx && e.seq == std::optional<std::uint8_t>(0x01)) sonar_rx = e.utc_us;
+  }
+  ASSERT_TRUE(ping_ack && sonar_tx && sonar_rx);
+  EXPECT_EQ(us(changes.back().at), *ping_ack);
+  EXPECT_EQ(*sonar_tx, *ping_ack) << "sent right after the reconnect PING's ACK";
+  EXPECT_EQ(us(done_at), *sonar_rx);
+  if (GetParam() == Board::mock) {
+    // The mock hears the PING sent as the port opens: OPEN at 1.5 s.
+    EXPECT_EQ(ping_tx, (std::vector<std::int64_t>{1'500'000}));
+    EXPECT_EQ(changes.back().at, milliseconds(1500));
+    EXPECT_EQ(done_at, milliseconds(1500));
+  } else {
+    // The emulated board resets as the port opens and is deaf while it
+    // does (about 66 ms): the PING sent at once is lost, and its first
+    // retry, 600 ms later, proves the port.
+    EXPECT_EQ(ping_tx, (std::vector<std::int64_t>{1'500'000, 2'100'000}));
+    EXPECT_GT(changes.back().at, milliseconds(2100));
+    EXPECT_LT(changes.back().at, milliseconds(2200));
+  }
 }
+
+// The robot's deafness comes from the link here (every request lost for
+// 10 s), so both boards take part; the mock's scripted Ignore does the same
+// in TheLinkGoesDegradedThenReconnectingThenOpenWhenTheRobotComesBack.
+TEST_P(ArduinoSessionOnMem, ALinkThatLosesEveryRequestFor10sDegradesAndReconnects) {
+  start({}, requests_lost(seconds(10)));  // health check after 5 s of quiet
+  executor.run_until(seconds(20));
+  ASSERT_EQ(changes.size(), 5u) << wire();
+  const std::vector<std::pair<ConnectionState, Time>> expected = {
+      {ConnectionState::connecting, seconds(0)},
+      {ConnectionState::connected, seconds(0)},
+      {ConnectionState::degraded, seconds(14)},  // PING at 5 s, 9 s of attempts
+      {ConnectionState::reconnecting, milliseconds(14500)}};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(changes[i].to, expected[i].first) << i;
+    EXPECT_EQ(changes[i].at, expected[i].second) << i;
+  }
+  EXPECT_EQ(changes[4].to, ConnectionState::connected);
+  if (GetParam() == Board::mock) {
+    EXPECT_EQ(changes[4].at, milliseconds(14500));
+  } else {
+    // The reopened port resets the emulated board: the proving PING sent
+    // at 14.5 s is lost in the reset, its retry at 15.1 s is answered.
+    const Duration exchange = test::sketch_uart_time(14 + 16);
+    EXPECT_GE(changes[4].at, milliseconds(15100) + exchange) << wire();
+    EXPECT_LE(changes[4].at, milliseconds(15100) + exchange + test::kSketchSlack) << wire();
+  }
+  EXPECT_EQ(server->clients_served(), 2u);
+  EXPECT_EQ(boots(), 3u) << "power-on and a reset per port opening";
+}
+
+// A link that loses every request: the same timeline on both boards, since
+// neither hears anything.
+TEST_P(ArduinoSessionOnMem, ALinkThatLosesEveryRequestTakesTheLinkDown) {
+  ClientConfig config = quiet();
+  config.max_reconnect_attempts = 2;
+  start(config, requests_lost());
+  auto r = run([](auto& s, auto cb) { return s.ping(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::timeout);
+  // Sent once the board listens (at once on the mock).
+  const auto entries = session->log().entries();
+  ASSERT_FALSE(entries.empty());
+  const Time sent = link::microseconds(entries[0].utc_us);
+  executor.run_until(sent + seconds(20));
+  ASSERT_FALSE(changes.empty());
+  EXPECT_EQ(changes.back().to, ConnectionState::down);
+  // 9 s, +0.5 s, +4.2 s of reconnect PING, +1 s, +4.2 s.
+  EXPECT_EQ(changes.back().at - sent, milliseconds(9000 + 500 + 4200 + 1000 + 4200));
+}
+
+// The client sends its first request the instant the port is open; it
+// does not wait for the board. The mock answers it; the emulated board,
+// like a real Uno, is resetting then (AvrConfig::startup_delay, about 66
+// ms) and hears nothing, so the request is answered at its first retry.
+TEST_P(ArduinoSessionOnMem, ARequestSentAsThePortOpensMeetsTheBoardsReset) {
+  open(quiet());
+  auto r = run([](auto& s, auto cb) { return s.ping(cb); });
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->code, ResultCode::ok);
+  EXPECT_EQ(r->info, "PONG");
+  const auto tx = tx_times();
+  if (GetParam() == Board::mock) {
+    EXPECT_EQ(r->attempts, 1);
+    EXPECT_EQ(tx, (std::vector<Time>{milliseconds(0)}));
+    EXPECT_EQ(done_at, milliseconds(0));
+  } else {
+    EXPECT_EQ(r->attempts, 2);
+    EXPECT_EQ(tx, (std::vector<Time>{milliseconds(0), milliseconds(600)}));
+    // 14 bytes in and 16 out at 9,600 baud: about 31 ms after the retry.
+    EXPECT_GT(done_at, milliseconds(600 + 25));
+    EXPECT_LT(done_at, milliseconds(600 + 50));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Boards, ArduinoSessionOnMem, test::both_boards(), test::board_param_name);
+INSTANTIATE_TEST_SUITE_P(Boards, ArduinoMockSessionOnMem, ::testing::Values(Board::mock),
+                         test::board_param_name);
 
 }  // namespace
 }  // namespace hil::client::arduino

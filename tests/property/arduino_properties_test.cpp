@@ -25,6 +25,10 @@
 //     first attempt and the link never leaving OPEN.
 // Every session property also holds each frame to its time and each port
 // the client reopened to its PING (check_attempt_times, which they share).
+// ArduinoClientPropertiesOnTheSketch runs the session properties against
+// hil's test sketch on the emulated ATmega328P as well, with fewer cases
+// (kSketchCasesPercent); there each planted bug below was caught too,
+// within 10 to 23 sessions from kPlantedSeed.
 //
 // They have teeth. ArduinoPlantedBugs (at the end) plants each bug of
 // tests/property/arduino_planted_bug.hpp in the client as built and shows
@@ -46,8 +50,10 @@
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
+#include <rapidcheck/detail/Configuration.h>
 #include <rapidcheck/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <ostream>
@@ -294,9 +300,10 @@ RC_GTEST_PROP(ArduinoClientProperties, RequestsAreServedOneAtATimeInOrderAndEach
   after_a_random_session(check_serving_order);
 }
 
-RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAndTheLinkStaysOpen,
-              ()) {
-  ArduinoRig rig(link::FaultProfile{});
+/// With nothing lost on the link, against `board`: every request is
+/// answered at its first attempt and the link never leaves OPEN.
+void on_a_clean_link(Board board) {
+  ArduinoRig rig(link::FaultProfile{}, PlantedBug::none, board);
   const auto requests = *rc::gen::container<std::vector<proto::Body>>(gen_request());
   for (const auto& body : requests) {
     const RequestId id = rig.session->request(body);
@@ -304,7 +311,7 @@ RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAnd
     if (is_valid_request(body)) rig.queued.push_back(id);
     rig.car.executor.run_for(milliseconds(*rc::gen::inRange(0, 300)));
   }
-  rig.car.executor.run_for(seconds(20));
+  finish(rig, seconds(20));
   const auto wire = wire_of(rig);
   RC_LOG() << dump(rig, wire);
   const auto exchanges = check_attempt_times(rig, wire);
@@ -322,6 +329,70 @@ RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAnd
   // OPENING and OPEN, nothing else: with nothing lost, nothing degrades.
   RC_ASSERT(rig.links.size() == 2u);
   RC_ASSERT(rig.session->state() == ConnectionState::connected);
+}
+
+RC_GTEST_PROP(ArduinoClientProperties, OnACleanLinkEveryRequestIsAnsweredOnceAndTheLinkStaysOpen,
+              ()) {
+  on_a_clean_link(Board::mock);
+}
+
+// ---- the same properties against hil's test sketch on the emulated board ----
+// The sketch runs as built: the robot misbehaves only as the driver can make
+// it (hanging up, resetting the connection), and the link's faults act.
+
+/// The emulated board costs CPU: it runs about ten to twelve times faster
+/// than real time, and a random session lasts tens of virtual seconds
+/// (about 2 s of CPU each, measured), so each property runs this share of
+/// the cases RC_PARAMS asks for (100 by default: 5 sessions, about 8 to 12
+/// s a property; the sanitizer trees' 25: 1; the soak's 5,000: 250), at
+/// least one.
+constexpr int kSketchCasesPercent = 5;
+
+/// Checks `property` (a callable that checks one random case) as
+/// RC_GTEST_PROP does, with kSketchCasesPercent of the configured cases.
+template <class Property>
+void check_on_the_sketch(const std::string& name, Property property) {
+  rc::detail::TestParams params = rc::detail::configuration().testParams;
+  params.maxSuccess = std::max(1, params.maxSuccess * kSketchCasesPercent / 100);
+  rc::detail::TestMetadata metadata;
+  metadata.id = "ArduinoClientPropertiesOnTheSketch/" + name;
+  metadata.description = name;
+  const rc::detail::TestResult result =
+      rc::detail::checkTestable(std::move(property), metadata, params);
+  EXPECT_TRUE(result.is<rc::detail::SuccessResult>()) << name << ":\n"
+                                                      << logi::prop::result_message(result);
+}
+
+TEST(ArduinoClientPropertiesOnTheSketch,
+     AnAnswerIsTakenOnlyForTheRequestWithItsSeqAndSaysWhatTheRobotSaid) {
+  check_on_the_sketch("AnAnswerIsTakenOnlyForTheRequestWithItsSeq", [] {
+    after_a_random_session(check_answers, PlantedBug::none, Board::sketch);
+  });
+}
+
+TEST(ArduinoClientPropertiesOnTheSketch,
+     EveryRetryComesOnItsDoubledTimeoutEveryBadCsResendAtOnceAndATimeoutAtTheSum) {
+  check_on_the_sketch("EveryRetryComesOnItsDoubledTimeout", [] {
+    after_a_random_session(check_attempts, PlantedBug::none, Board::sketch);
+  });
+}
+
+TEST(ArduinoClientPropertiesOnTheSketch,
+     TheLinkMovesAlongItsStateMachineOnTimeAndAReopenedPortGetsOnlyItsProvingPing) {
+  check_on_the_sketch("TheLinkMovesAlongItsStateMachine", [] {
+    after_a_random_session(check_link_states, PlantedBug::none, Board::sketch);
+  });
+}
+
+TEST(ArduinoClientPropertiesOnTheSketch, RequestsAreServedOneAtATimeInOrderAndEachEndsExactlyOnce) {
+  check_on_the_sketch("RequestsAreServedOneAtATime", [] {
+    after_a_random_session(check_serving_order, PlantedBug::none, Board::sketch);
+  });
+}
+
+TEST(ArduinoClientPropertiesOnTheSketch,
+     OnACleanLinkEveryRequestIsAnsweredOnceAndTheLinkStaysOpen) {
+  check_on_the_sketch("OnACleanLink", [] { on_a_clean_link(Board::sketch); });
 }
 
 // ---- the properties have teeth ----

@@ -67,11 +67,11 @@ bool is_valid_request(const proto::Body& body) {
   return v == nullptr || (v->pwm >= 0 && v->pwm <= 255);
 }
 
-ArduinoRig::ArduinoRig(link::FaultProfile faults, PlantedBug bug) {
+ArduinoRig::ArduinoRig(link::FaultProfile faults, PlantedBug bug, Board board) {
   mocks::ServerOptions options = test::on_mem("arduino");
   options.faults = std::move(faults);
   options.observers.push_back(std::make_shared<Closes>(closes, car_opens));
-  car.start_car(sim::arduino_robot(), std::move(options));
+  car.start_board(board, std::move(options));
   session = std::make_unique<ArduinoSession>(car.context, link::MemEndpoint{"arduino"},
                                              std::make_unique<PlantedBugCore>(bug, ClientConfig{}));
   // The log's clock is the virtual one in nanoseconds (not the microseconds
@@ -84,12 +84,16 @@ ArduinoRig::ArduinoRig(link::FaultProfile faults, PlantedBug bug) {
       turned_away.push_back(car.server->turned_away());
     } else if (const auto* d = std::get_if<RequestDone>(&e)) {
       auto& chassis = dynamic_cast<sim::DifferentialChassis&>(car.firmware->vehicle().chassis());
-      done.push_back({car.executor.now(), d->id, d->result, car.firmware->moving(),
-                      chassis.left_pwm(), chassis.right_pwm()});
+      const bool moving = car.mock() != nullptr ? car.mock()->moving()
+                                                : car.sketch()->state().left_pwm != 0 ||
+                                                      car.sketch()->state().right_pwm != 0;
+      done.push_back(
+          {car.executor.now(), d->id, d->result, moving, chassis.left_pwm(), chassis.right_pwm()});
     }
   });
   session->open();
   car.executor.run_for(Duration::zero());
+  RC_ASSERT(car.wait_until_listening());
 }
 
 std::vector<WireFrame> wire_of(const ArduinoRig& rig) {
@@ -127,12 +131,29 @@ std::string dump(const ArduinoRig& rig, const std::vector<WireFrame>& wire) {
   return out;
 }
 
+void finish(ArduinoRig& rig, Duration limit) {
+  if (rig.car.board == Board::mock) {
+    rig.car.executor.run_for(limit);
+    return;
+  }
+  const auto settled = [&rig] {
+    const ArduinoClientCore& core = rig.session->core();
+    const ConnectionState s = core.state();
+    return !core.busy() && core.queued() == 0 &&
+           (s == ConnectionState::connected || s == ConnectionState::disconnected ||
+            s == ConnectionState::down);
+  };
+  test::run_until_done(rig.car.executor, settled, limit);
+}
+
 // ---- the random session: the operator, the robot's misbehaviour, time ----
 
 namespace {
 
 struct OperatorModel {
   bool closed = false;  ///< the operator closed the port and has not opened it again
+  /// The robot is the emulated board: only the driver's misbehaviours act.
+  bool emulated = false;
 };
 
 using ArduinoCommand = rc::state::Command<OperatorModel, ArduinoRig>;
@@ -164,7 +185,11 @@ struct Submit : ArduinoCommand {
 using Advance = hil::test::AdvanceTime<ArduinoCommand, OperatorModel, ArduinoRig, 4000>;
 
 struct CarMisbehaves : ArduinoCommand {
-  int kind = *rc::gen::inRange(0, 4);
+  // The first two kinds change the firmware's own answers, which the
+  // emulated board does not let a script do.
+  explicit CarMisbehaves(const OperatorModel& model)
+      : kind(*rc::gen::inRange(model.emulated ? 2 : 0, 4)) {}
+  int kind;
   int ms = *rc::gen::inRange(100, 30'000);
   void apply(OperatorModel&) const override {}
   using Kind = hil::test::Misbehaviour;
@@ -219,12 +244,12 @@ struct OperatorToggles : ArduinoCommand {
 
 }  // namespace
 
-void after_a_random_session(SessionCheck check, PlantedBug bug) {
-  ArduinoRig rig(*gen_faults(), bug);
-  rc::state::check(OperatorModel{}, rig,
+void after_a_random_session(SessionCheck check, PlantedBug bug, Board board) {
+  ArduinoRig rig(*gen_faults(), bug, board);
+  rc::state::check(OperatorModel{.closed = false, .emulated = board == Board::sketch}, rig,
                    rc::state::gen::execOneOfWithArgs<Submit, Submit, Submit, Advance, Advance,
                                                      Advance, CarMisbehaves, OperatorToggles>());
-  rig.car.executor.run_for(seconds(60));
+  finish(rig, seconds(60));
   const auto wire = wire_of(rig);
   RC_LOG() << dump(rig, wire);
   check(rig, wire);

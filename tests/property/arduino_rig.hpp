@@ -1,7 +1,9 @@
 #pragma once
 // The Arduino client's property bench: the session (with a planted bug if
-// asked, tests/property/arduino_planted_bug.hpp) against the mock robot on
-// mem:// under a random fault schedule, in virtual time, and a recorder of
+// asked, tests/property/arduino_planted_bug.hpp) against the robot on
+// mem:// (the behavioural mock, or hil's test sketch on the emulated
+// ATmega328P: tests/client/arduino_board.hpp) under a random fault
+// schedule, in virtual time, and a recorder of
 // everything it reported (arduino_rig.cpp); the random operator session
 // that drives it (arduino_rig.cpp); and one check per rule of
 // docs/clients/arduino.md, read from the frame log, the events and the
@@ -23,6 +25,7 @@
 #include "link/link.hpp"
 #include "mocks/arduino.hpp"
 #include "protocol/arduino/codec.hpp"
+#include "tests/client/arduino_board.hpp"
 #include "tests/client/client_test_support.hpp"
 #include "tests/property/arduino_planted_bug.hpp"
 
@@ -44,15 +47,19 @@ rc::Gen<proto::Body> gen_request();
 /// Whether the protocol can carry `body` (V only takes 0..255).
 bool is_valid_request(const proto::Body& body);
 
-/// The mock robot on mem://arduino, a session to it (its core with `bug`
-/// planted), and everything the session reported, stamped with the virtual
-/// clock.
+using test::Board;
+
+/// The robot (`board`) on mem://arduino, a session to it (its core with
+/// `bug` planted), and everything the session reported, stamped with the
+/// virtual clock. The session opens the port at 0 s; on the emulated board
+/// the rig then waits until the sketch listens after the reset that caused
+/// (test::BoardCar::wait_until_listening()).
 struct ArduinoRig {
   struct Done {
     Time at{0};
     RequestId id = 0;
     Result result;
-    bool robot_moving = false;
+    bool robot_moving = false;  ///< the mock's motion, or the emulated board's motor pins
     int left_pwm = 0;
     int right_pwm = 0;
   };
@@ -66,7 +73,8 @@ struct ArduinoRig {
     std::vector<Time>& opens_;
   };
 
-  explicit ArduinoRig(link::FaultProfile faults, PlantedBug bug = PlantedBug::none);
+  explicit ArduinoRig(link::FaultProfile faults, PlantedBug bug = PlantedBug::none,
+                      Board board = Board::mock);
 
   Time now() const { return car.executor.now(); }
 
@@ -86,9 +94,16 @@ struct ArduinoRig {
   /// port, one per entry of operator_opens: orders that open against frames
   /// of the same instant.
   std::vector<std::size_t> logged_at_operator_open{0};
-  test::VirtualCar<mocks::ArduinoFirmware> car;
+  test::BoardCar car;
   std::unique_ptr<ArduinoSession> session;
 };
+
+/// Lets the run play out for `limit`. The emulated board's minute costs
+/// seconds of CPU, so on it the run ends as soon as it has settled
+/// (nothing queued or in flight, the link OPEN, CLOSED or DOWN), within
+/// `limit`: what happened until then is what the checks read, and the rest
+/// would only add health checks.
+void finish(ArduinoRig& rig, Duration limit);
 
 /// One frame of the session's log.
 struct WireFrame {
@@ -153,11 +168,14 @@ void check_order(const ArduinoRig& rig);
 /// What a session property checks of a whole run.
 using SessionCheck = void (*)(const ArduinoRig&, const std::vector<WireFrame>&);
 
-/// A random session with `bug` planted in the client: a random fault
-/// schedule, then random operator requests, waits, robot misbehaviour,
-/// closes and opens (each command checks what the operator sees at once),
-/// then a minute for every retry, reconnect and timeout to play out;
-/// `check` reads the whole run.
-void after_a_random_session(SessionCheck check, PlantedBug bug = PlantedBug::none);
+/// A random session with `bug` planted in the client, against `board`: a
+/// random fault schedule, then random operator requests, waits, robot
+/// misbehaviour, closes and opens (each command checks what the operator
+/// sees at once), then a minute for every retry, reconnect and timeout to
+/// play out; `check` reads the whole run. The emulated board misbehaves
+/// only as the driver can make it (hanging up, resetting the connection):
+/// scripted silence and refusals do not act on the sketch.
+void after_a_random_session(SessionCheck check, PlantedBug bug = PlantedBug::none,
+                            Board board = Board::mock);
 
 }  // namespace hil::client::arduino::prop
