@@ -124,6 +124,7 @@ if [ "$default_only" = 0 ] && [ "${HIL_SKIP_ASAN:-0}" != 1 ]; then
   cmake --build --preset asan
   stage "asan+ubsan: tests"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    LSAN_OPTIONS=suppressions=$PWD/ci/lsan-suppressions.txt:print_suppressions=0 \
     ctest --preset asan | tee "$log"
   passed=$((passed + $(ran)))
 fi

@@ -29,11 +29,17 @@ endif()
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(SIMAVR REQUIRED simavr)
 pkg_check_modules(LIBELF REQUIRED IMPORTED_TARGET libelf)
-# Linked statically: calls into the emulator's core from hil's run loop
-# (one per instruction) are about 15 % faster than through the shared
-# library's PLT (docs/performance.md, "Real firmware").
-find_library(HIL_SIMAVR_STATIC NAMES libsimavr.a REQUIRED)
+# Linked statically where hil's own libraries are static: calls into the
+# emulator's core from hil's run loop (one per instruction) are about 15 %
+# faster than through the shared library's PLT (docs/performance.md, "Real
+# firmware"). Debian's libsimavr.a is not position-independent, so a tree of
+# shared libraries (the sanitizer preset) links the shared one.
+if(BUILD_SHARED_LIBS)
+  find_library(HIL_SIMAVR_LIBRARY NAMES simavr REQUIRED)
+else()
+  find_library(HIL_SIMAVR_LIBRARY NAMES libsimavr.a REQUIRED)
+endif()
 add_library(hil_simavr INTERFACE)
 target_include_directories(hil_simavr SYSTEM INTERFACE ${SIMAVR_INCLUDE_DIRS})
-target_link_libraries(hil_simavr INTERFACE ${HIL_SIMAVR_STATIC} PkgConfig::LIBELF)
+target_link_libraries(hil_simavr INTERFACE ${HIL_SIMAVR_LIBRARY} PkgConfig::LIBELF)
 add_library(hil::simavr ALIAS hil_simavr)

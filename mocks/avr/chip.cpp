@@ -242,8 +242,12 @@ void on_pin(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
 
 void on_adc_trigger(avr_irq_t* /*irq*/, std::uint32_t value, void* param) {
   auto* impl = static_cast<Chip::Impl*>(param);
+  // simavr raises the mux description (a bit-field struct) as its first
+  // 32 bits; the struct itself may be wider.
+  static_assert(sizeof(avr_adc_mux_t) <= sizeof(std::uint64_t));
+  const std::uint64_t bits = value;
   avr_adc_mux_t mux{};
-  std::memcpy(&mux, &value, sizeof mux);
+  std::memcpy(&mux, &bits, sizeof mux);
   if (impl->on_conversion && mux.kind == ADC_MUX_SINGLE) impl->on_conversion(mux.src);
 }
 
