@@ -1,5 +1,7 @@
 #include "mocks/avr/chip.hpp"
 
+#include "mocks/avr/sketch_build.hpp"
+
 extern "C" {
 #include <avr_adc.h>
 #include <avr_extint.h>
@@ -18,7 +20,6 @@ extern "C" {
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <stdexcept>
 
@@ -64,7 +65,6 @@ constexpr std::uint8_t kComB1 = 1 << 5;
 // ELF32 header fields (System V ABI): the AVR machine number, and the
 // avr-gcc architecture number in the low bits of e_flags.
 constexpr std::uint16_t kEmAvr = 83;
-constexpr std::uint32_t kEfAvrMachMask = 0x7F;
 constexpr std::uint32_t kAvr5 = 5;
 
 void quiet_logger(avr_t* avr, int level, const char* format, va_list ap);
@@ -255,34 +255,26 @@ void sleep_nowhere(avr_t* /*avr*/, avr_cycle_count_t /*cycles*/) {
   // Virtual time: the clock jumps over a sleep; nothing waits.
 }
 
-std::uint32_t read_u32(const std::vector<unsigned char>& b, std::size_t at) {
-  std::uint32_t v = 0;
-  for (std::size_t i = 0; i < 4; ++i)
-    v |= static_cast<std::uint32_t>(b[at + i]) << (8 * i);
-  return v;
-}
-
 }  // namespace
 
 ElfInfo check_elf(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(name + ": cannot read the firmware file");
-  std::vector<unsigned char> head(52);
-  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  if (in.gcount() < 52 || head[0] != 0x7F || head[1] != 'E' || head[2] != 'L' || head[3] != 'F')
-    throw std::invalid_argument(name +
-                                ": not an ELF file (build the sketch with `hil firmware "
-                                "build SKETCH.ino`, or give its .elf)");
-  if (head[4] != 1 || head[5] != 1)
-    throw std::invalid_argument(name + ": a 64-bit or big-endian ELF file, not AVR firmware");
-  const std::uint16_t machine = static_cast<std::uint16_t>(head[18] | (head[19] << 8));
-  if (machine != kEmAvr)
+  if (!std::filesystem::is_regular_file(path))
+    throw std::invalid_argument(name + ": cannot read the firmware file");
+  AvrElfInfo header;
+  try {
+    header = read_avr_elf(path);
+  } catch (const SketchBuildError& e) {
+    throw std::invalid_argument(std::string(e.what()) +
+                                " (build the sketch with `hil firmware build SKETCH.ino`, or give "
+                                "its .elf)");
+  }
+  if (header.machine != kEmAvr)
     throw std::invalid_argument(name + ": built for another processor (ELF machine " +
-                                std::to_string(machine) + "), not an AVR");
-  const std::uint32_t mach = read_u32(head, 36) & kEfAvrMachMask;
-  if (mach != kAvr5)
-    throw std::invalid_argument(name + ": built for the AVR family " + elf_family(mach) +
+                                std::to_string(header.machine) + "), not an AVR");
+  if (header.architecture != kAvr5)
+    throw std::invalid_argument(name + ": built for the AVR family " +
+                                elf_family(header.architecture) +
                                 "; hil emulates the ATmega328P (avr5)");
 
   install_logger();

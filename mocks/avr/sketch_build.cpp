@@ -628,6 +628,7 @@ AvrElfInfo read_elf(const fs::path& elf) {
   if (bytes[4] != 1 || bytes[5] != 1) throw fail("not a 32-bit little-endian ELF file");
   AvrElfInfo info;
   info.machine = static_cast<std::uint16_t>(u16(18));
+  info.architecture = u32(36) & 0x7FU;
   const std::size_t shoff = u32(32);
   const std::size_t shentsize = u16(46);
   const std::size_t shnum = u16(48);

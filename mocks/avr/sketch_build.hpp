@@ -95,7 +95,10 @@ std::string sha256_hex(std::string_view bytes);
 
 /// What an AVR ELF file says about itself.
 struct AvrElfInfo {
-  std::uint16_t machine = 0;      ///< e_machine: 83 (EM_AVR) for AVR code
+  std::uint16_t machine = 0;  ///< e_machine: 83 (EM_AVR) for AVR code
+  /// avr-gcc's architecture number, e_flags' low 7 bits: 5 for avr5 (the
+  /// ATmega328P), 6 for avr6 (the ATmega2560), ...
+  std::uint32_t architecture = 0;
   std::uint32_t flash_bytes = 0;  ///< .text + .data: what the board's flash holds
   std::uint32_t ram_bytes = 0;    ///< .data + .bss + .noinit: static RAM before the stack
 };
