@@ -2,7 +2,7 @@
 # Runs the decoder, proxy, simulation, mock-car, random-session and
 # whole-stack benchmarks and times the scenario suite on a RelWithDebInfo
 # build, and rewrites their sections of docs/performance.md with the results.
-# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [session] [stack] [suite]
+# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [firmware] [session] [stack] [suite]
 #   With no section named, runs them all. Each section is rewritten only when
 #   its benchmark ran to the end, so one section can be refreshed alone
 #   (bench/run.sh mock). Run on an otherwise idle machine.
@@ -12,12 +12,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 sections=("$@")
-[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock session stack suite)
+[ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock firmware session stack suite)
 for section in "${sections[@]}"; do
   case $section in
-    decoder | proxy | sim | mock | session | stack | suite) ;;
+    decoder | proxy | sim | mock | firmware | session | stack | suite) ;;
     *)
-      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, session, stack, suite)" >&2
+      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, firmware, session, stack, suite)" >&2
       exit 2
       ;;
   esac
@@ -103,6 +103,20 @@ run_mock() {
   run_benchmark mock mock_bench "bench/run.sh mock" \
     "best of 5 interleaved repetitions of at least 0.5 s, CPU time" \
     --benchmark_min_time=0.5 --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
+}
+
+# The emulated board in virtual time, then behind a pty in real time; both
+# tables go to the firmware-bench section.
+run_firmware() {
+  cmake --build "$build" --target firmware_bench firmware_pty_bench
+  "$build/bench/firmware_bench" --benchmark_min_time=0.5 --benchmark_repetitions=5 \
+    --benchmark_enable_random_interleaving=true --hil_markdown="$work/firmware.md"
+  "$build/bench/firmware_pty_bench" --elf "$build/firmware/hil_arduino.elf" --requests 300 \
+    --markdown "$work/firmware-pty.md"
+  { cat "$work/firmware.md"; echo; cat "$work/firmware-pty.md"; } >"$work/firmware-both.md"
+  write_section firmware "bench/run.sh firmware" \
+    "virtual time: best of 5 interleaved repetitions of at least 0.5 s, CPU time; real time: 300 PINGs one at a time" \
+    "$work/firmware-both.md"
 }
 
 run_session() {
