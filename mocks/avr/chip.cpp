@@ -257,6 +257,33 @@ void sleep_nowhere(avr_t* /*avr*/, avr_cycle_count_t /*cycles*/) {
 
 }  // namespace
 
+namespace {
+
+// An ELF file's sections as simavr reads them, freed when it goes.
+struct Image {
+  explicit Image(const std::filesystem::path& path) {
+    install_logger();
+    if (elf_read_firmware(path.string().c_str(), &fw) != 0)
+      throw std::invalid_argument(path.string() + ": cannot load the ELF file's sections");
+  }
+  ~Image() {
+    std::free(fw.flash);
+    std::free(fw.eeprom);
+    std::free(fw.fuse);
+    std::free(fw.lockbits);
+#if ELF_SYMBOLS
+    for (std::uint32_t i = 0; i < fw.symbolcount; ++i)
+      std::free(fw.symbol[i]);
+    std::free(fw.symbol);
+#endif
+  }
+  Image(const Image&) = delete;
+  Image& operator=(const Image&) = delete;
+  elf_firmware_t fw{};
+};
+
+}  // namespace
+
 ElfInfo check_elf(const std::filesystem::path& path) {
   const std::string name = path.string();
   if (!std::filesystem::is_regular_file(path))
@@ -277,20 +304,8 @@ ElfInfo check_elf(const std::filesystem::path& path) {
                                 elf_family(header.architecture) +
                                 "; hil emulates the ATmega328P (avr5)");
 
-  install_logger();
-  elf_firmware_t fw{};
-  if (elf_read_firmware(name.c_str(), &fw) != 0)
-    throw std::invalid_argument(name + ": cannot load the ELF file's sections");
-  ElfInfo info{path, fw.flashsize, fw.mmcu};
-  std::free(fw.flash);
-  std::free(fw.eeprom);
-  std::free(fw.fuse);
-  std::free(fw.lockbits);
-#if ELF_SYMBOLS
-  for (std::uint32_t i = 0; i < fw.symbolcount; ++i)
-    std::free(fw.symbol[i]);
-  std::free(fw.symbol);
-#endif
+  const Image image(path);
+  ElfInfo info{path, image.fw.flashsize, image.fw.mmcu};
   if (!info.mmcu.empty() && info.mmcu != "atmega328p" && info.mmcu != "atmega328")
     throw std::invalid_argument(name + ": built for the " + info.mmcu +
                                 "; hil emulates the ATmega328P");
@@ -303,9 +318,7 @@ ElfInfo check_elf(const std::filesystem::path& path) {
 Chip::Chip(const std::filesystem::path& elf)
     : elf_(check_elf(elf)), impl_(std::make_unique<Impl>()) {
   impl_->chip = this;
-  elf_firmware_t fw{};
-  if (elf_read_firmware(elf.string().c_str(), &fw) != 0)
-    throw std::invalid_argument(elf.string() + ": cannot load the ELF file's sections");
+  Image image(elf);
   avr_t* avr = avr_make_mcu_by_name("atmega328p");
   if (avr == nullptr) throw std::runtime_error("simavr has no ATmega328P core");
   impl_->avr = avr;
@@ -315,18 +328,9 @@ Chip::Chip(const std::filesystem::path& elf)
   avr->frequency = kFrequencyHz;
   avr->vcc = avr->avcc = avr->aref = 5000;
   avr->sleep = &sleep_nowhere;
-  fw.tracecount = 0;  // a VCD trace request in the image writes no file
-  avr_load_firmware(avr, &fw);
+  image.fw.tracecount = 0;  // a VCD trace request in the image writes no file
+  avr_load_firmware(avr, &image.fw);
   avr->frequency = kFrequencyHz;
-  std::free(fw.flash);
-  std::free(fw.eeprom);
-  std::free(fw.fuse);
-  std::free(fw.lockbits);
-#if ELF_SYMBOLS
-  for (std::uint32_t i = 0; i < fw.symbolcount; ++i)
-    std::free(fw.symbol[i]);
-  std::free(fw.symbol);
-#endif
   impl_->quiet_uart();
   impl_->datasheet_reset_values();
   for (avr_io_t* io = avr->io_port; io != nullptr; io = io->next) {
