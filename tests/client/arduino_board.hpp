@@ -75,21 +75,26 @@ inline std::unique_ptr<mocks::Firmware> make_board(Board board, sim::World& worl
 }
 
 /// How long `bytes` take through the emulated board's UART at the sketch's
-/// 9,600 baud (ten bits a byte: start, eight data, stop). The mock answers
-/// in the instant a frame reaches it; the emulated board reads a request
-/// at this pace, then writes its answer at this pace.
+/// 9,600 baud (ten bits a byte: start, eight data, stop).
 inline link::Duration sketch_uart_time(std::size_t bytes) {
   return link::Duration(static_cast<std::int64_t>(bytes) * 10 * 1'000'000'000 / 9600);
 }
 
-/// What the emulated board adds on top of its UART's time: the sketch's own
-/// work between a request's '$' and its answer's first byte, the 1 ms
+/// The emulated board's own time for a request of `out` bytes that reaches
+/// it whole and its answer of `back` bytes (at least 2). The mock answers
+/// in the instant a frame reaches it; the board's UART hands the request's
+/// first byte to the sketch at once and each next one a byte time later,
+/// and takes the answer's first two bytes at once (its data register and
+/// its shift register) and each next one as the line frees a place.
+inline link::Duration sketch_frames_time(std::size_t out, std::size_t back) {
+  return sketch_uart_time(out - 1) + sketch_uart_time(back - 2);
+}
+
+/// What the emulated board adds on top of that: the sketch's own work
+/// between a request's '$' and its answer's first byte, and the 250 us
 /// slices it runs in (AvrConfig::step; its output is handed over at a
-/// slice's end, a frame's last byte included), and the 1.024 ms steps of
-/// its millis(). Times taken on it are held to [model, model + this]; a
-/// request and its answer measured 4 to 7 ms above the UART's and the
-/// link's time.
-inline constexpr link::Duration kSketchSlack = link::milliseconds(8);
+/// slice's end). Times taken on it are held to [model, model + this].
+inline constexpr link::Duration kSketchSlack = link::milliseconds(2);
 
 /// An Arduino car in virtual time whose firmware is either board: the
 /// Arduino robot preset in a world of `world_def`, the board behind a mock

@@ -364,7 +364,7 @@ TEST_P(ArduinoSessionOnMem, ALinkThatLosesEveryRequestFor10sDegradesAndReconnect
   } else {
     // The reopened port resets the emulated board: the proving PING sent
     // at 14.5 s is lost in the reset, its retry at 15.1 s is answered.
-    const Duration exchange = test::sketch_uart_time(14 + 16);
+    const Duration exchange = test::sketch_frames_time(14, 16);
     EXPECT_GE(changes[4].at, milliseconds(15100) + exchange) << wire();
     EXPECT_LE(changes[4].at, milliseconds(15100) + exchange + test::kSketchSlack) << wire();
   }
