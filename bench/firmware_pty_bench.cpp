@@ -11,9 +11,7 @@
 // 99th percentile of the reply time less its 1st percentile; the worst
 // and best are printed too. With --max-jitter-ms, exit 1 above it.
 
-#include <fcntl.h>
 #include <poll.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -37,6 +36,7 @@
 #include "mocks/server.hpp"
 #include "protocol/arduino/sketch.hpp"
 #include "sim/presets.hpp"
+#include "tests/mocks/serial_support.hpp"
 
 namespace {
 
@@ -76,18 +76,6 @@ Args parse(int argc, char** argv) {
     std::exit(2);
   }
   return args;
-}
-
-int open_port(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
-  if (fd < 0) return -1;
-  termios tio{};
-  ::tcgetattr(fd, &tio);
-  ::cfmakeraw(&tio);
-  ::cfsetispeed(&tio, B9600);
-  ::cfsetospeed(&tio, B9600);
-  ::tcsetattr(fd, TCSANOW, &tio);
-  return fd;
 }
 
 // Reads until a frame's end marker; false after 2 s without one.
@@ -133,11 +121,15 @@ int main(int argc, char** argv) {
   auto guard = asio::make_work_guard(io);
   std::thread driver([&io] { io.run(); });
 
-  const int fd = open_port(path);
+  int fd = -1;
+  try {
+    fd = hil::mocks::test::open_serial_port(path, B9600);
+  } catch (const std::system_error& e) {
+    std::fprintf(stderr, "firmware_pty_bench: %s\n", e.what());
+  }
   int status = 0;
   std::vector<double> ms;
   if (fd < 0) {
-    std::fprintf(stderr, "firmware_pty_bench: cannot open %s\n", path.c_str());
     status = 1;
   } else {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the reset and setup()

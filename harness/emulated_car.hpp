@@ -8,6 +8,7 @@
 // the wrong reason. Sending bytes and closing the connection act on the
 // link in front of the board and work with it (docs/firmware.md).
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
@@ -20,6 +21,18 @@ bool acts_on_emulated_board(const mocks::Action& action);
 
 /// "a `reject` behaviour", "an `ignore` behaviour": the action's kind in a sentence.
 std::string behaviour_phrase(const mocks::Action& action);
+
+/// A step that arms a behaviour the emulated board cannot act on.
+struct UnplayableStep {
+  const char* list;    ///< the scenario's key: "setup", "steps", "teardown" or "schedule"
+  const char* prefix;  ///< how messages name one of its steps: "setup step ", "step ", ...
+  std::size_t index;   ///< in that list, from 0
+  const Step* step;
+  const mocks::Action* action;
+};
+
+/// The first such step, in the order setup, steps, teardown, schedule.
+std::optional<UnplayableStep> first_unplayable_step(const Scenario& scenario);
 
 /// Why the emulated board cannot play `scenario`'s car, or nullopt: it can.
 /// The first of its armed behaviours that needs the behavioural mock ("it

@@ -223,26 +223,17 @@ class ScenarioReader : public config::Reader {
     const std::string why =
         ", and the firmware (car: firmware:) runs on the emulated board as it is: only send and "
         "close act on it (docs/firmware.md)";
-    const auto check_steps = [&](const char* key, const std::vector<Step>& steps,
-                                 const std::string& prefix) {
-      const YAML::Node list = root[key];
-      if (!list || !list.IsSequence() || list.size() != steps.size()) return;
-      for (std::size_t i = 0; i < steps.size(); ++i) {
-        const auto* car = std::get_if<CarStep>(&steps[i].action);
-        if (car == nullptr || acts_on_emulated_board(car->behaviour.action)) continue;
-        const YAML::Node item = list[i];
-        fail(item.IsMap() && item["car"] ? item["car"] : item,
-             prefix + std::to_string(i + 1) + ": " + behaviour_phrase(car->behaviour.action) +
-                 " needs the behavioural mock" + why);
+    if (const auto u = first_unplayable_step(scenario)) {
+      // At the step's `car:` where the file has it, else at its list.
+      const YAML::Node list = root[u->list];
+      YAML::Node at = list;
+      if (list && list.IsSequence() && u->index < list.size()) {
+        const YAML::Node item = list[u->index];
+        at = item.IsMap() && item["car"] ? item["car"] : item;
       }
-    };
-    check_steps("setup", scenario.setup, "setup step ");
-    check_steps("steps", scenario.steps, "step ");
-    check_steps("teardown", scenario.teardown, "teardown step ");
-    std::vector<Step> scheduled;
-    for (const auto& s : scenario.schedule)
-      scheduled.push_back(s.step);
-    check_steps("schedule", scheduled, "schedule ");
+      fail(at ? at : root, u->prefix + std::to_string(u->index + 1) + ": " +
+                               behaviour_phrase(*u->action) + " needs the behavioural mock" + why);
+    }
     if (auto n = root["reply_latency"]) {
       fail(n,
            "'reply_latency' has no effect on the firmware (car: firmware:): the emulated "

@@ -69,7 +69,8 @@ AvrFirmware::AvrFirmware(sim::World& world, sim::Vehicle& vehicle, AvrConfig con
       chassis_(differential_chassis_of(vehicle, "the emulated Arduino board",
                                        "use the arduino vehicle preset")),
       chip_(std::make_unique<avr::Chip>(config_.elf)),
-      adapter_(link::protocol_adapter(protocol(), profile())) {
+      adapter_(link::protocol_adapter(protocol(), profile())),
+      link_baud_(protocol::find_car_profile("arduino", profile()).baud) {
   chip_->on_uart_transmit([this](std::uint8_t byte, std::uint64_t) { tx_.push_back(byte); });
   const avr::PinMap& pins = config_.pins;
   if (pins.sonar_trigger && pins.sonar_echo)
@@ -269,7 +270,7 @@ void AvrFirmware::check_health(Time now) {
   }
   if (chip_->uart_enabled()) {
     state_.uart_baud = chip_->uart_baud();
-    const std::uint32_t link_baud = protocol::find_car_profile("arduino", profile()).baud;
+    const std::uint32_t link_baud = link_baud_;
     // UART framing survives about 2 % of clock difference between the ends.
     if (!warned_baud_ && link_baud != 0 &&
         std::abs(static_cast<double>(state_.uart_baud) - link_baud) > 0.03 * link_baud) {

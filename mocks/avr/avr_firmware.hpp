@@ -105,6 +105,7 @@ class AvrFirmware final : public FirmwareWith<AvrConfig, AvrState> {
   sim::DifferentialChassis& chassis_;
   std::unique_ptr<avr::Chip> chip_;
   std::shared_ptr<const link::ProtocolAdapter> adapter_;
+  std::uint32_t link_baud_;  // the car profile's line rate, which the firmware's UART should match
   std::unique_ptr<link::FrameSplitter> from_client_;
   std::unique_ptr<link::FrameSplitter> to_client_;
   Bytes tx_;                       // what the firmware wrote in the slice being run

@@ -167,11 +167,17 @@ struct Chip::Impl {
   // bytes take 11 bit times where the 8N1 line takes 10: each byte would
   // come 10 % late. The byte time is set again from the frame format the
   // firmware chose (UCSR0C, UCSR0B's UCSZ02) whenever it changes.
+  // Cycles a bit takes at the baud rate UBRR0 and U2X0 set.
+  std::uint32_t bit_cycles() const {
+    const std::uint8_t* d = avr->data;
+    const std::uint32_t ubrr = (static_cast<std::uint32_t>(d[kUbrr0h] & 0x0F) << 8) | d[kUbrr0l];
+    return (ubrr + 1) * ((d[kUcsr0a] & kU2x0) != 0 ? 8U : 16U);
+  }
+
   void fix_byte_time() {
     const std::uint8_t* d = avr->data;
     if ((d[kUcsr0b] & (kRxen0 | kTxen0)) == 0) return;
-    const std::uint32_t ubrr = (static_cast<std::uint32_t>(d[kUbrr0h] & 0x0F) << 8) | d[kUbrr0l];
-    const std::uint32_t per_bit = (ubrr + 1) * ((d[kUcsr0a] & kU2x0) != 0 ? 8U : 16U);
+    const std::uint32_t per_bit = bit_cycles();
     const std::uint8_t c = d[kUcsr0c];
     const std::uint32_t size = ((c >> 1) & 0x3U) | ((d[kUcsr0b] & 0x04U) != 0 ? 4U : 0U);
     const std::uint32_t data_bits = size <= 3 ? 5 + size : size == 7 ? 9 : 8;
@@ -432,11 +438,7 @@ bool Chip::uart_enabled() const {
 }
 
 std::uint32_t Chip::uart_baud() const {
-  const std::uint8_t* d = impl_->avr->data;
-  if (!uart_enabled()) return 0;
-  const std::uint32_t ubrr = (static_cast<std::uint32_t>(d[kUbrr0h] & 0x0F) << 8) | d[kUbrr0l];
-  const std::uint32_t divisor = (d[kUcsr0a] & kU2x0) != 0 ? 8 : 16;
-  return kFrequencyHz / (divisor * (ubrr + 1));
+  return uart_enabled() ? kFrequencyHz / impl_->bit_cycles() : 0;
 }
 
 bool Chip::output_level(const BoardPin& pin) const {

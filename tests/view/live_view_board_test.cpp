@@ -3,8 +3,6 @@
 // board's pty drives it: the pose follows the moves the sketch makes, and
 // the page's wire holds the frames both ways.
 
-#include <fcntl.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -15,6 +13,7 @@
 #include <thread>
 
 #include "protocol/arduino/sketch.hpp"
+#include "tests/mocks/serial_support.hpp"
 #include "tests/view/view_test_support.hpp"
 
 namespace hil::view::test {
@@ -22,23 +21,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
-int open_port(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
-  if (fd < 0) return -1;
-  termios tio{};
-  ::tcgetattr(fd, &tio);
-  ::cfmakeraw(&tio);
-  ::cfsetispeed(&tio, B9600);
-  ::cfsetospeed(&tio, B9600);
-  ::tcsetattr(fd, TCSANOW, &tio);
-  return fd;
-}
-
 // What comes back within `limit`, read until a frame's end marker.
 std::string answer(int fd, std::chrono::milliseconds limit) {
   std::string got;
   const auto until = std::chrono::steady_clock::now() + limit;
-  ::fcntl(fd, F_SETFL, O_NONBLOCK);
   while (std::chrono::steady_clock::now() < until && got.find('$') == std::string::npos) {
     char buffer[64];
     const ssize_t n = ::read(fd, buffer, sizeof buffer);
@@ -69,8 +55,7 @@ TEST(LiveViewBoard, ThePoseFollowsWhatTheSketchDoes) {
   const json before = state();
   ASSERT_FALSE(before.is_null());
 
-  const int fd = open_port(port);
-  ASSERT_GE(fd, 0) << port;
+  const int fd = mocks::test::open_serial_port(port, B9600);
   std::this_thread::sleep_for(300ms);  // the board's reset and setup()
   const std::string move = protocol::arduino::sketch_frame("01", "M", "50");
   ASSERT_EQ(::write(fd, move.data(), move.size()), static_cast<ssize_t>(move.size()));
