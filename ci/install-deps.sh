@@ -24,6 +24,10 @@ packages=(
   arduino-core-avr arduino-mk  # the Arduino Uno core and the Makefile that builds a sketch with it
   simavr                     # the emulator's command-line tool (run a sketch's ELF by hand)
   libsimavr-dev libelf-dev   # the emulated ATmega328P that hil::mocks links (mocks/avr/)
+  libtelnet-dev              # the Telnet layer of the serial cars' RFC 2217 listener (link/)
+  python3-serial             # pySerial's rfc2217:// client, unmodified, drives it in the tests
+  libpugixml-dev             # hil report merge reads the shards' JUnit XML
+  help2man                   # the Debian package's man pages, made from each program's --help
 )
 
 if [ "$(id -u)" -ne 0 ]; then

@@ -43,3 +43,12 @@ add_library(hil_simavr INTERFACE)
 target_include_directories(hil_simavr SYSTEM INTERFACE ${SIMAVR_INCLUDE_DIRS})
 target_link_libraries(hil_simavr INTERFACE ${HIL_SIMAVR_LIBRARY} PkgConfig::LIBELF)
 add_library(hil::simavr ALIAS hil_simavr)
+
+# libtelnet (libtelnet-dev) is the Telnet layer under the RFC 2217 listener
+# of the serial cars (link/rfc2217*): option negotiation and
+# subnegotiation framing; the COM-PORT-OPTION commands are hil's own.
+pkg_check_modules(LIBTELNET REQUIRED IMPORTED_TARGET libtelnet)
+
+# pugixml (libpugixml-dev) reads the JUnit XML of the shards that
+# `hil report merge` joins.
+find_package(pugixml REQUIRED)
