@@ -12,6 +12,7 @@
 
 #include "apps/common/log_file.hpp"
 #include "apps/common/stdin_lines.hpp"
+#include "apps/common/version.hpp"
 #include "client/arduino/session.hpp"
 #include "protocol/arduino/codec.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -112,6 +113,7 @@ std::string link_change_text(const arduino::LinkChanged& change, const std::stri
 ParsedArguments parse_arguments(int argc, const char* const* argv) {
   AppOptions o;
   CLI::App app{"arduino-client: steer the Arduino serial robot (raw tokens, a script, or a REPL)"};
+  app.set_version_flag("--version", version_line("arduino-client"));
   add_serial_options(app, o.port, o.baud,
                      "Serial device (/dev/ttyUSB0, /tmp/hil-arduino0) or a hil endpoint "
                      "(pty://..., tcp://HOST:PORT)",

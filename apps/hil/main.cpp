@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "apps/common/program.hpp"
+#include "apps/common/version.hpp"
 #include "apps/hil/cli_common.hpp"
 
 int main(int argc, char** argv) {
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
   hil::apps::unblock_signals({SIGINT, SIGTERM});
   CLI::App app{"hil: test harness and mock cars for robot-car client software"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "hil 0.1.0");
+  app.set_version_flag("--version", hil::apps::version_line("hil"));
   app.footer(
       "Protocols: logi (TCP, ASCII), wr8 (TCP, binary), arduino (serial, ASCII), leka (serial, "
       "binary).\n"

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "apps/common/log_file.hpp"
+#include "apps/common/version.hpp"
 #include "client/leka/session.hpp"
 #include "protocol/common/bytes.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -54,6 +55,7 @@ std::string plural(std::size_t n, const char* one, const char* many) {
 ParsedArguments parse_arguments(int argc, const char* const* argv) {
   AppOptions o;
   CLI::App app{"leka-client: send command groups to the Leka robot, one line per group"};
+  app.set_version_flag("--version", version_line("leka-client"));
   add_serial_options(app, o.port, o.baud,
                      "Serial device of the robot (/dev/ttyUSB0, /tmp/hil-leka0) or a hil "
                      "endpoint (pty://PATH, tcp://HOST:PORT); not needed with --dry-run",

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/common/program.hpp"
+#include "apps/common/version.hpp"
 #include "apps/logi-client/batch.hpp"
 #include "apps/logi-client/stdin_actions.hpp"
 #include "apps/logi-client/tui.hpp"
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   namespace lc = hil::apps::logi_client;
   CLI::App app{
       "logi-client: upper computer for the LOGI logistics car (batch mode and terminal UI)"};
-  app.set_version_flag("--version", "logi-client 0.1.0");
+  app.set_version_flag("--version", hil::apps::version_line("logi-client"));
   lc::BatchOptions options;
   std::string script;
   std::string connect_timeout = "10s";

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "apps/common/stdin_lines.hpp"
+#include "apps/common/version.hpp"
 #include "apps/wr8-client/console.hpp"
 #include "link/endpoint.hpp"
 #include "protocol/common/car_profile.hpp"
@@ -124,6 +125,7 @@ int run_with(const AppOptions& options, Config config, std::vector<typename Kit:
 ParsedArguments parse_arguments(int argc, const char* const* argv) {
   AppOptions o;
   CLI::App app{"wr8-client: drive the WR8 vehicle over TCP (actions, a script, or interactively)"};
+  app.set_version_flag("--version", version_line("wr8-client"));
   app.add_option("--host", o.host, "The vehicle's address (default 127.0.0.1)");
   app.add_option("--port", o.port,
                  "The vehicle's TCP port (default 9100 for profile document, 5556 for "
