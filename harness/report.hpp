@@ -4,6 +4,7 @@
 // folder of HTML pages, NDJSON timelines and SVG trajectories.
 
 #include <cstddef>
+#include <cstdint>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -76,17 +77,58 @@ std::string format_seconds(Duration d);
 /// A JUnit XML document: one <testsuite name="hil">, one <testcase> per run.
 std::string junit_xml(const std::vector<ReportEntry>& entries);
 
+/// A <testcase>'s classname: the scenario file's folder with dots
+/// ("scenarios.logi"), else its first tag, else "hil".
+std::string junit_classname(const std::string& file, const std::vector<std::string>& tags);
+
 /// Fills each entry's empty `folder`: the scenario's name made safe for a
 /// file name, "-<repeat>" (from 1) when it ran more than once, and "-2",
 /// "-3"... when two scenarios share a name.
 void report_folders(std::vector<ReportEntry>& entries);
 
-/// Writes DIR/index.html (every run, with links) and, per run,
+/// Writes DIR/index.html (every run, with links), DIR/results.json (every
+/// run's verdict, for tools) and, per run,
 /// DIR/<folder>/{index.html, timeline.ndjson, trajectory.svg}. Creates the
 /// folders; throws std::runtime_error naming the path that cannot be written.
 void write_report_dir(const std::string& dir, std::vector<ReportEntry> entries);
 
 /// The page of one run (what DIR/<folder>/index.html holds).
 std::string run_page_html(const ReportEntry& entry);
+
+/// One run as DIR/results.json keeps it, for tools that read a finished
+/// report folder (`hil report merge` joins the folders of CI shards).
+struct RunResult {
+  std::string file;  ///< the scenario file as the run named it
+  std::string name;
+  std::vector<std::string> tags;
+  int repeat = 0;  ///< 0-based
+  int repeats = 1;
+  std::uint64_t seed = 0;
+  Verdict verdict = Verdict::pass;  ///< pass, fail or skip (a run is never flaky)
+  double run_time_s = 0;            ///< simulated (or real) time the run covered
+  double wall_seconds = 0;
+  bool real_time = false;
+  std::string folder;         ///< the run's folder under the report directory; "" none
+  std::string first_failure;  ///< or why it was skipped
+  std::string failure_text;   ///< failure_text() of a failed run
+  std::string repro_command;
+  friend bool operator==(const RunResult&, const RunResult&) = default;
+};
+
+/// The run as results.json keeps it.
+RunResult run_result(const ReportEntry& entry);
+
+/// DIR/results.json: {"format": "hil-results", "version": 1, "runs": [...]},
+/// one object per run with the fields of RunResult ("verdict": "pass",
+/// "fail" or "skip").
+std::string results_json(const std::vector<RunResult>& runs);
+
+/// The runs of a results.json text. Throws std::runtime_error saying what
+/// is wrong (not JSON, not hil's results, a run without its file...).
+std::vector<RunResult> parse_results_json(const std::string& text);
+
+/// DIR/index.html: `heading`, then a row per run linking its folder (a run
+/// without a folder has no link).
+std::string index_html(const std::vector<RunResult>& runs, const std::string& heading);
 
 }  // namespace hil::harness

@@ -493,6 +493,35 @@ std::string run_page_html(const ReportEntry& entry) {
   return out;
 }
 
+std::string index_html(const std::vector<RunResult>& runs, const std::string& heading) {
+  std::string index = page_head("hil run: " + heading);
+  index += "<body>\n<h1>" + esc(heading) + "</h1>\n";
+  index +=
+      "<table><thead><tr><th>result</th><th>scenario</th><th>file</th><th>seed</th>"
+      "<th>run time</th><th>wall</th><th>first failure</th></tr></thead><tbody>\n";
+  for (const auto& r : runs) {
+    const bool passed = r.verdict != Verdict::fail;
+    std::string name = r.name.empty() ? r.file : r.name;
+    if (r.repeats > 1) name += " #" + std::to_string(r.repeat + 1);
+    const std::string link =
+        r.folder.empty() ? esc(name)
+                         : "<a href=\"" + esc(r.folder) + "/index.html\">" + esc(name) + "</a>";
+    char wall[32];
+    std::snprintf(wall, sizeof wall, "%.3f s", r.wall_seconds);
+    const char* result = r.verdict == Verdict::skip ? "skip\">SKIP"
+                         : passed                   ? "pass\">PASS"
+                                                    : "fail\">FAIL";
+    index += std::string("<tr") + (passed ? "" : " class=\"fail\"") + "><td class=\"" + result +
+             "</td><td>" + link + "</td><td class=\"mono\">" + esc(r.file) + "</td><td>" +
+             std::to_string(r.seed) + "</td><td>" +
+             format_seconds(std::chrono::duration_cast<Duration>(
+                 std::chrono::duration<double>(r.run_time_s))) +
+             "</td><td>" + wall + "</td><td>" + esc(r.first_failure) + "</td></tr>\n";
+  }
+  index += "</tbody></table>\n</body></html>\n";
+  return index;
+}
+
 void write_report_dir(const std::string& dir, std::vector<ReportEntry> entries) {
   report_folders(entries);
   const fs::path root(dir);
@@ -500,11 +529,7 @@ void write_report_dir(const std::string& dir, std::vector<ReportEntry> entries) 
   fs::create_directories(root, ec);
   if (ec) throw std::runtime_error("cannot create " + root.string() + ": " + ec.message());
 
-  std::string index = page_head("hil run: " + summary_line(entries));
-  index += "<body>\n<h1>" + esc(summary_line(entries)) + "</h1>\n";
-  index +=
-      "<table><thead><tr><th>result</th><th>scenario</th><th>file</th><th>seed</th>"
-      "<th>run time</th><th>wall</th><th>first failure</th></tr></thead><tbody>\n";
+  std::vector<RunResult> runs;
   for (const auto& e : entries) {
     const auto& o = e.outcome;
     const fs::path folder = root / e.folder;
@@ -515,21 +540,10 @@ void write_report_dir(const std::string& dir, std::vector<ReportEntry> entries) 
     svg.title = o.name;
     write_file(folder / "trajectory.svg", sim::render_svg(o.arena, o.trajectories, svg));
     write_file(folder / "index.html", run_page_html(e));
-
-    const bool passed = o.passed();
-    std::string name = o.name.empty() ? o.file : o.name;
-    if (e.repeats > 1) name += " #" + std::to_string(e.repeat + 1);
-    char wall[32];
-    std::snprintf(wall, sizeof wall, "%.3f s", o.wall_seconds);
-    const char* result = o.was_skipped() ? "skip\">SKIP" : passed ? "pass\">PASS" : "fail\">FAIL";
-    index += std::string("<tr") + (passed ? "" : " class=\"fail\"") + "><td class=\"" + result +
-             "</td><td><a href=\"" + esc(e.folder) + "/index.html\">" + esc(name) +
-             "</a></td><td class=\"mono\">" + esc(o.file) + "</td><td>" + std::to_string(o.seed) +
-             "</td><td>" + format_seconds(o.run_time) + "</td><td>" + wall + "</td><td>" +
-             esc(o.was_skipped() ? o.skipped : o.first_failure()) + "</td></tr>\n";
+    runs.push_back(run_result(e));
   }
-  index += "</tbody></table>\n</body></html>\n";
-  write_file(root / "index.html", index);
+  write_file(root / "results.json", results_json(runs));
+  write_file(root / "index.html", index_html(runs, summary_line(entries)));
 }
 
 }  // namespace hil::harness

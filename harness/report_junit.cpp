@@ -9,20 +9,6 @@
 namespace hil::harness {
 namespace {
 
-std::string classname(const ScenarioOutcome& o) {
-  std::string folder;
-  if (const auto slash = o.file.rfind('/'); slash != std::string::npos)
-    folder = o.file.substr(0, slash);
-  while (folder.rfind("./", 0) == 0)
-    folder.erase(0, 2);
-  while (!folder.empty() && folder.front() == '/')
-    folder.erase(0, 1);
-  if (folder.empty() || folder == ".") return o.tags.empty() ? "hil" : o.tags.front();
-  for (char& c : folder)
-    if (c == '/') c = '.';
-  return folder;
-}
-
 std::string junit_seconds(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3f", s);
@@ -49,6 +35,20 @@ std::string step_list(const ScenarioOutcome& o) {
 
 }  // namespace
 
+std::string junit_classname(const std::string& file, const std::vector<std::string>& tags) {
+  std::string folder;
+  if (const auto slash = file.rfind('/'); slash != std::string::npos)
+    folder = file.substr(0, slash);
+  while (folder.rfind("./", 0) == 0)
+    folder.erase(0, 2);
+  while (!folder.empty() && folder.front() == '/')
+    folder.erase(0, 1);
+  if (folder.empty() || folder == ".") return tags.empty() ? "hil" : tags.front();
+  for (char& c : folder)
+    if (c == '/') c = '.';
+  return folder;
+}
+
 std::string junit_xml(const std::vector<ReportEntry>& entries) {
   std::size_t failures = 0;
   std::size_t skipped = 0;
@@ -67,8 +67,8 @@ std::string junit_xml(const std::vector<ReportEntry>& entries) {
     std::string name = o.name.empty() ? o.file : o.name;
     if (e.repeats > 1)
       name += " #" + std::to_string(e.repeat + 1) + " (seed " + std::to_string(o.seed) + ")";
-    out += "  <testcase classname=\"" + xml_escape(classname(o)) + "\" name=\"" + xml_escape(name) +
-           "\" time=\"" + junit_seconds(o.wall_seconds) + "\"";
+    out += "  <testcase classname=\"" + xml_escape(junit_classname(o.file, o.tags)) + "\" name=\"" +
+           xml_escape(name) + "\" time=\"" + junit_seconds(o.wall_seconds) + "\"";
     if (!o.file.empty()) out += " file=\"" + xml_escape(o.file) + "\"";
     out += ">\n";
     if (o.was_skipped()) out += "    <skipped message=\"" + xml_escape(o.skipped) + "\"/>\n";

@@ -402,6 +402,10 @@ std::optional<std::string> skip_reason(const Scenario& scenario, const RunOption
          "scenario without the settings (docs/scenarios.md, \"Skipped scenarios\")";
 }
 
+bool runs_in_real_time(const Scenario& scenario, const RunOptions& options) {
+  return external_client(scenario, options) || std::get<ReferenceClient>(scenario.client).real_time;
+}
+
 ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   ScenarioOutcome out;
@@ -417,7 +421,7 @@ ScenarioOutcome run_scenario(const Scenario& scenario, const RunOptions& options
     return out;
   }
   const bool exec = external_client(scenario, options);
-  out.real_time = exec || std::get<ReferenceClient>(scenario.client).real_time;
+  out.real_time = runs_in_real_time(scenario, options);
   // A program that closes its stdin early must not end hil with SIGPIPE;
   // the write fails with EPIPE instead.
   if (exec) std::signal(SIGPIPE, SIG_IGN);

@@ -4,6 +4,7 @@
 // external program in real time), plays the steps and the schedule,
 // records the timeline, and checks the expectations.
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -26,6 +27,12 @@ inline constexpr Duration kRealTimeSlack = std::chrono::milliseconds(100);
 /// frames up to about a millisecond after the behavioural mock's, which
 /// answers in the instant the request's last byte is in (docs/firmware.md).
 inline constexpr Duration kEmulatedBoardSlack = std::chrono::milliseconds(2);
+
+/// `hil run -j auto`: runs in real time at once per core. Such a run mostly
+/// waits (its car's clock, its client's answers), so on 2 cores 32 of the
+/// LOGI library's runs with an external client go at once and every one
+/// keeps its timing (docs/performance.md, "The gate's width").
+inline constexpr std::size_t kRealTimeRunsPerCore = 16;
 
 struct RunOptions {
   /// Overrides the scenario's seed (and a random choice when it has none).
@@ -79,6 +86,13 @@ struct RunOptions {
 /// behaviour or sets a reply latency the emulated board cannot act on: it
 /// would pass or fail for the wrong reason.
 std::optional<std::string> skip_reason(const Scenario& scenario, const RunOptions& options);
+
+/// Whether a run of `scenario` with `options` is in real time: its client
+/// is an external program (a scenario's `client: exec:` or
+/// RunOptions::client_exec) or the reference client asked for real sockets
+/// (`real_time: true`). Such a run mostly waits, on its clock and on the
+/// client; one in virtual time keeps a core busy from start to end.
+bool runs_in_real_time(const Scenario& scenario, const RunOptions& options);
 
 /// Never throws for a scenario's own failures; they are in the outcome. A
 /// scenario skip_reason() skips is not run: its outcome says why.

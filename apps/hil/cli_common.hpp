@@ -118,5 +118,7 @@ void register_conform(CLI::App& app, std::function<int()>& run);
 void register_profiles(CLI::App& app, std::function<int()>& run);
 /// `hil firmware build`: an Arduino sketch into the emulated Uno's ELF (firmware_command.cpp).
 void register_firmware(CLI::App& app, std::function<int()>& run);
+/// `hil report merge`: the results of CI shards joined into one (report_command.cpp).
+void register_report(CLI::App& app, std::function<int()>& run);
 
 }  // namespace hil::apps

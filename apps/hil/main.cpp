@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
       "  hil world check scenarios/worlds/*.yaml\n"
       "  hil world render scenarios/worlds/corridor.yaml -o corridor.svg\n"
       "  hil run scenarios/ --junit hil.xml --report-dir hil-report\n"
+      "  hil report merge --junit hil.xml shard-1.xml shard-2.xml  join CI shards' results\n"
       "  hil profiles                                each car's dialects and their sources\n"
       "  hil conform probe arduino --target pty:///dev/ttyUSB0 -o car.ndjson\n"
       "  hil conform check car.ndjson --all-profiles  which profile the car plays\n"
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
   hil::apps::register_profiles(app, run);
   hil::apps::register_conform(app, run);
   hil::apps::register_firmware(app, run);
+  hil::apps::register_report(app, run);
 
   // CLI11 would only say "A subcommand is required"; name the protocols instead.
   if (argc >= 3 &&

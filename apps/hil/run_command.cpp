@@ -7,11 +7,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <set>
 #include <thread>
@@ -23,7 +25,9 @@
 #include "harness/exec_client.hpp"
 #include "harness/report.hpp"
 #include "harness/runner.hpp"
+#include "harness/scenario_search.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "harness/shard.hpp"
 #include "link/capture/probe_capture.hpp"
 #include "link/faults/profile_yaml.hpp"
 #include "mocks/avr/firmware_source.hpp"
@@ -53,29 +57,12 @@ struct RunArgs {
   std::string board_startup;  ///< with sketch or elf: the board's start-up ("0ms"); empty: 66 ms
   std::string slack;          ///< as written ("100ms"); empty: the runner's default
   std::vector<std::string> sets;
-  int jobs = 0;
+  std::string jobs = "auto";  ///< -j as written: N, or auto (parse_jobs())
   bool list = false;
   bool verbose = false;
   bool allow_outside_paths = false;
+  std::string shard;  ///< --shard K/N as written; empty: every selected scenario
 };
-
-// A scenario file is a YAML map with top-level `car:` and `steps:`. Read as
-// text so a file with a YAML mistake is still found (and its error shown).
-bool looks_like_scenario(const fs::path& path) {
-  std::ifstream in(path);
-  bool car = false;
-  bool steps = false;
-  for (std::string line; std::getline(in, line) && !(car && steps);) {
-    car = car || line.rfind("car:", 0) == 0;
-    steps = steps || line.rfind("steps:", 0) == 0;
-  }
-  return car && steps;
-}
-
-bool is_yaml(const fs::path& path) {
-  const auto ext = path.extension().string();
-  return ext == ".yaml" || ext == ".yml";
-}
 
 // For the repro command: a word the shell passes through unchanged.
 std::string shell_quote(const std::string& word) {
@@ -119,12 +106,6 @@ struct Planned {
   std::string error;  ///< why it did not load
 };
 
-bool has_any(const std::vector<std::string>& have, const std::vector<std::string>& wanted) {
-  return std::any_of(wanted.begin(), wanted.end(), [&](const std::string& t) {
-    return std::find(have.begin(), have.end(), t) != have.end();
-  });
-}
-
 std::string joined(const std::vector<std::string>& words, const char* separator = ", ") {
   std::string out;
   for (const auto& w : words)
@@ -135,39 +116,18 @@ std::string joined(const std::vector<std::string>& words, const char* separator 
 // The scenario files named by the arguments, sorted; nullopt (and a message
 // on stderr) for a path that does not exist.
 std::optional<std::vector<std::string>> find_files(const RunArgs& args) {
-  std::set<std::string> files;
-  for (const auto& arg : args.paths) {
-    const fs::path path(arg);
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) {
-      std::vector<fs::path> found;
-      for (auto it = fs::recursive_directory_iterator(
-               path, fs::directory_options::skip_permission_denied, ec);
-           !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-        if (it->is_regular_file(ec) && is_yaml(it->path())) found.push_back(it->path());
-      }
-      if (ec) {
-        std::cerr << "hil run: cannot read folder " << arg << ": " << ec.message() << '\n';
-        return std::nullopt;
-      }
-      for (const auto& f : found) {
-        if (looks_like_scenario(f)) {
-          files.insert(f.lexically_normal().string());
-        } else if (args.verbose) {
-          std::cerr << "hil run: skipped " << f.lexically_normal().string()
-                    << " (no top-level car: and steps:, not a scenario)\n";
-        }
-      }
-    } else if (fs::exists(path, ec)) {
-      // A file named on the command line is a scenario: if it is not one,
-      // loading it says why.
-      files.insert(path.lexically_normal().string());
-    } else {
-      std::cerr << "hil run: " << arg << ": no such file or folder\n";
-      return std::nullopt;
+  try {
+    auto found = harness::find_scenario_files(args.paths);
+    if (args.verbose) {
+      for (const auto& f : found.not_scenarios)
+        std::cerr << "hil run: skipped " << f
+                  << " (no top-level car: and steps:, not a scenario)\n";
     }
+    return std::move(found.files);
+  } catch (const harness::ScenarioSearchError& e) {
+    std::cerr << "hil run: " << e.what() << '\n';
+    return std::nullopt;
   }
-  return std::vector<std::string>(files.begin(), files.end());
 }
 
 // The command an external client of this scenario runs, as written (the
@@ -216,14 +176,30 @@ std::vector<Planned> load_plan(const RunArgs& args, const std::vector<std::strin
       p.error = file + ": " + e.what();
     }
     if (p.scenario) {
-      if (!args.tags.empty() && !has_any(p.scenario->tags, args.tags)) continue;
-      if (has_any(p.scenario->tags, args.exclude_tags)) continue;
+      if (!args.tags.empty() && !harness::has_any_tag(p.scenario->tags, args.tags)) continue;
+      if (harness::has_any_tag(p.scenario->tags, args.exclude_tags)) continue;
     }
     // A file that does not load stays in, whatever the tags: a gate must not
     // pass because a broken file was silently left out.
     plan.push_back(std::move(p));
   }
   return plan;
+}
+
+// --shard K/N: the planned files of shard K, each weighed by its expected
+// time (harness/shard.hpp); a file that did not load has a nominal weight.
+std::vector<Planned> shard_plan(const RunArgs& args, std::vector<Planned> plan) {
+  std::vector<harness::ShardItem> items;
+  for (const auto& p : plan) {
+    const double weight_s =
+        p.scenario ? std::chrono::duration<double>(harness::expected_duration(*p.scenario)).count()
+                   : harness::kShardNominalWeightS;
+    items.push_back({harness::shard_key(p.file, args.paths), p.file, weight_s});
+  }
+  std::vector<Planned> out;
+  for (const std::size_t i : harness::shard_members(items, *harness::parse_shard(args.shard)))
+    out.push_back(std::move(plan[i]));
+  return out;
 }
 
 // --list: each scenario with its tags and any program it would start.
@@ -286,8 +262,38 @@ Batch make_batch(const RunArgs& args, const std::vector<Planned>& plan) {
   return batch;
 }
 
+// How many runs go at once. `-j N`: N, of whatever kind. `-j auto` (the
+// default): a run in virtual time keeps a core busy, so at most one per
+// core; a run in real time mostly waits on its clock and its client, so
+// harness::kRealTimeRunsPerCore per core, virtual-time ones among them.
+struct JobLimits {
+  std::size_t total = 1;
+  std::size_t virtual_time = 1;
+};
+
+// -j's value: "auto", or N >= 1; nullopt for anything else.
+std::optional<std::size_t> parse_jobs(const std::string& text) {
+  if (text == "auto") return std::size_t{0};
+  std::size_t used = 0;
+  try {
+    const long n = std::stol(text, &used);
+    if (used == text.size() && n >= 1 && n <= 1024) return static_cast<std::size_t>(n);
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+JobLimits job_limits(const std::string& jobs, bool any_real_time) {
+  const std::size_t cores = std::max(1U, std::thread::hardware_concurrency());
+  if (const std::size_t n = parse_jobs(jobs).value_or(0); n > 0) return {n, n};
+  return {any_real_time ? cores * harness::kRealTimeRunsPerCore : cores, cores};
+}
+
 // Runs a batch on worker threads, printing what the runs start and, with
-// -v, each run as it finishes.
+// -v, each run as it finishes. Runs start longest first (by their
+// scenarios' expected durations, harness::expected_duration()), so the
+// batch does not end waiting on one long run started last; the table keeps
+// the files' order.
 class BatchRunner {
  public:
   BatchRunner(const RunArgs& args, const std::vector<Planned>& plan, Batch& batch,
@@ -299,11 +305,10 @@ class BatchRunner {
         firmware_(std::move(firmware)) {}
 
   void run() {
-    const unsigned cores = std::max(1U, std::thread::hardware_concurrency());
-    const std::size_t jobs = std::min<std::size_t>(
-        args_.jobs > 0 ? static_cast<std::size_t>(args_.jobs) : cores, batch_.tasks.size());
+    plan_queue();
+    const std::size_t threads_wanted = std::min(limits_.total, batch_.tasks.size());
     std::vector<std::thread> threads;
-    for (std::size_t t = 1; t < jobs; ++t)
+    for (std::size_t t = 1; t < threads_wanted; ++t)
       threads.emplace_back([this] { work(); });
     work();
     for (auto& t : threads)
@@ -311,13 +316,64 @@ class BatchRunner {
   }
 
  private:
-  void work() {
-    for (std::size_t k = next_++; k < batch_.tasks.size(); k = next_++) {
+  // The tasks in the order they start, each marked real time or not, and
+  // the limits -j sets for them.
+  void plan_queue() {
+    harness::RunOptions kind;
+    kind.client_exec = args_.client_exec;
+    std::vector<double> expected_s(batch_.tasks.size(), 0.0);
+    real_time_.assign(batch_.tasks.size(), false);
+    for (std::size_t k = 0; k < batch_.tasks.size(); ++k) {
       const auto& p = plan_[batch_.tasks[k].plan_index];
-      auto& entry = batch_.entries[k];
-      if (p.scenario) entry.outcome = run_one(p, batch_.tasks[k], entry);
-      const std::size_t finished = ++done_;
-      if (args_.verbose) show_progress(finished, p, entry);
+      if (!p.scenario) continue;
+      real_time_[k] = harness::runs_in_real_time(*p.scenario, kind);
+      expected_s[k] =
+          std::chrono::duration<double>(harness::expected_duration(*p.scenario)).count();
+    }
+    queue_.resize(batch_.tasks.size());
+    std::iota(queue_.begin(), queue_.end(), std::size_t{0});
+    std::stable_sort(queue_.begin(), queue_.end(),
+                     [&](std::size_t a, std::size_t b) { return expected_s[a] > expected_s[b]; });
+    limits_ = job_limits(args_.jobs,
+                         std::find(real_time_.begin(), real_time_.end(), true) != real_time_.end());
+  }
+
+  // The next task this worker may start, longest first: a virtual-time run
+  // only while fewer than limits_.virtual_time run. Waits while only such
+  // runs are left and none may start; nullopt when none is left.
+  std::optional<std::size_t> take() {
+    std::unique_lock lock(queue_mutex_);
+    for (;;) {
+      const auto it = std::find_if(queue_.begin(), queue_.end(), [&](std::size_t k) {
+        return real_time_[k] || running_virtual_ < limits_.virtual_time;
+      });
+      if (it != queue_.end()) {
+        const std::size_t k = *it;
+        queue_.erase(it);
+        if (!real_time_[k]) ++running_virtual_;
+        return k;
+      }
+      if (queue_.empty()) return std::nullopt;
+      slot_freed_.wait(lock);
+    }
+  }
+
+  void finished(std::size_t k) {
+    {
+      const std::lock_guard lock(queue_mutex_);
+      if (!real_time_[k]) --running_virtual_;
+    }
+    slot_freed_.notify_all();
+  }
+
+  void work() {
+    while (const auto k = take()) {
+      const auto& p = plan_[batch_.tasks[*k].plan_index];
+      auto& entry = batch_.entries[*k];
+      if (p.scenario) entry.outcome = run_one(p, batch_.tasks[*k], entry);
+      finished(*k);
+      const std::size_t done = ++done_;
+      if (args_.verbose) show_progress(done, p, entry);
     }
   }
 
@@ -384,7 +440,12 @@ class BatchRunner {
   Batch& batch_;
   std::optional<mocks::ReplaySpec> replay_;
   std::optional<mocks::AvrConfig> firmware_;
-  std::atomic<std::size_t> next_{0};
+  JobLimits limits_;
+  std::vector<bool> real_time_;      // per task: runs in real time
+  std::vector<std::size_t> queue_;   // tasks not started yet, in start order
+  std::size_t running_virtual_ = 0;  // virtual-time runs under way
+  std::mutex queue_mutex_;
+  std::condition_variable slot_freed_;
   std::atomic<std::size_t> done_{0};
   std::mutex progress_;
   std::set<std::string> shown_commands_;  // files whose client command was printed
@@ -498,11 +559,19 @@ int run_scenarios(const RunArgs& args) {
               << joined(args.paths, " ") << '\n';
     return 2;
   }
-  const std::vector<Planned> plan = load_plan(args, *files, *overrides);
+  std::vector<Planned> plan = load_plan(args, *files, *overrides);
   if (plan.empty()) {
     std::cerr << "hil run: no scenario has the tags " << joined(args.tags)
               << (args.exclude_tags.empty() ? "" : " without " + joined(args.exclude_tags)) << '\n';
     return 2;
+  }
+  if (!args.shard.empty()) {
+    plan = shard_plan(args, std::move(plan));
+    if (plan.empty()) {
+      std::cerr << "hil run: shard " << args.shard << " has no scenarios (fewer scenarios than "
+                << "shards); nothing to run\n";
+      if (args.list) return 0;
+    }
   }
   if (args.list) return list_plan(args, plan);
   Batch batch = make_batch(args, plan);
@@ -588,9 +657,26 @@ void register_run(CLI::App& app, std::function<int()>& run) {
   cmd->add_option("--set", args->sets, "Set a scenario variable: name=value (repeatable)")
       ->type_name("NAME=VALUE")
       ->allow_extra_args(false);
-  cmd->add_option("-j,--jobs", args->jobs, "Runs at a time (default: the number of cores)")
-      ->type_name("N")
-      ->check(CLI::Range(1, 1024));
+  cmd->add_option("-j,--jobs", args->jobs,
+                  "Runs at a time: N, or auto (the default): one per core for runs in virtual "
+                  "time, " +
+                      std::to_string(harness::kRealTimeRunsPerCore) +
+                      " per core for runs in real time (an external client)")
+      ->type_name("N|auto")
+      ->check([](const std::string& text) {
+        return parse_jobs(text)
+                   ? std::string()
+                   : "expected a number of runs from 1 to 1024, or auto; got '" + text + "'";
+      });
+  cmd->add_option("--shard", args->shard,
+                  "Run shard K of N: a share of the selected scenarios, balanced by their "
+                  "expected time and stable as files are added, so N CI jobs together run each "
+                  "scenario once (join their results with hil report merge)")
+      ->type_name("K/N")
+      ->check([](const std::string& text) {
+        std::string error;
+        return harness::parse_shard(text, &error) ? std::string() : error;
+      });
   cmd->add_flag("--list", args->list,
                 "Print the scenarios that would run, with their tags and the command line of "
                 "any external client");
@@ -605,6 +691,7 @@ void register_run(CLI::App& app, std::function<int()>& run) {
       "  hil run scenarios/ --tags smoke --junit hil.xml --report-dir hil-report\n"
       "  hil run scenarios/logi/release.yaml --seed 42   # repeat one run exactly\n"
       "  hil run scenarios/ --repeat 20 -j 4             # hunt flaky scenarios\n"
+      "  hil run scenarios/ --shard 2/4 --junit hil-2.xml  # CI job 2 of 4\n"
       "Every failure prints the command that repeats it.\n"
       "A scenario that sets hil's reference client's settings is skipped (SKIP) under\n"
       "--client-exec: the program is not given those settings. Under --sketch or --elf, a\n"
