@@ -2,8 +2,9 @@
 # Runs the decoder, proxy, simulation, mock-car, random-session and
 # whole-stack benchmarks and times the scenario suite on a RelWithDebInfo
 # build, and rewrites their sections of docs/performance.md with the results.
-# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [firmware] [session] [stack] [suite]
-#   With no section named, runs them all. Each section is rewritten only when
+# Usage: bench/run.sh [decoder] [proxy] [sim] [mock] [firmware] [session] [stack] [suite] [gate]
+#   With no section named, runs them all but gate (the LOGI gate in real time
+#   at several widths, 20 runs each: about 90 minutes; name it to run it). Each section is rewritten only when
 #   its benchmark ran to the end, so one section can be refreshed alone
 #   (bench/run.sh mock). Run on an otherwise idle machine.
 #   HIL_BUILD_DIR=DIR builds and runs in an already configured build tree
@@ -15,9 +16,9 @@ sections=("$@")
 [ ${#sections[@]} -gt 0 ] || sections=(decoder proxy sim mock firmware session stack suite)
 for section in "${sections[@]}"; do
   case $section in
-    decoder | proxy | sim | mock | firmware | session | stack | suite) ;;
+    decoder | proxy | sim | mock | firmware | session | stack | suite | gate) ;;
     *)
-      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, firmware, session, stack, suite)" >&2
+      echo "bench/run.sh: unknown section '$section' (decoder, proxy, sim, mock, firmware, session, stack, suite, gate)" >&2
       exit 2
       ;;
   esac
@@ -140,6 +141,19 @@ run_suite() {
   [ -s "$work/suite.md" ] || exit 1
   write_section suite "bench/run.sh suite" \
     '`hil run -j 2`, wall time of one run of the library' "$work/suite.md"
+}
+
+# The LOGI gate with each correct external client at several widths, 20
+# whole runs each (bench/gate_time.sh). A flake fails the section's run but
+# still writes the table, which says which scenarios failed.
+run_gate() {
+  cmake --build "$build" --target hil logi-client
+  bench/gate_time.sh --hil "$build"/apps/hil/hil --jobs "${HIL_GATE_JOBS:-8 16 32 54}" \
+    --repeats "${HIL_GATE_REPEATS:-20}" --markdown "$work/gate.md" ||
+    echo "bench/run.sh: a gate run failed; the gate section says which scenarios" >&2
+  [ -s "$work/gate.md" ] || exit 1
+  write_section gate "bench/run.sh gate" \
+    'wall time of whole gate runs one after another, each client alone' "$work/gate.md"
 }
 
 # Load average when the figures were taken: CPU times and in-run ratios are

@@ -27,7 +27,8 @@ options:
   --report-dir DIR   write the report folder here (default: client-gate/report)
   --tags a,b         run only the scenarios with one of these tags
   --repeat N         run each scenario N times (flakiness hunting)
-  -j N, --jobs N     scenarios at a time (default: hil's, the number of cores)
+  -j N, --jobs N     scenarios at a time (default: hil's -j auto, 16 per core for
+                     an external client)
   --hil PATH         the hil program (default: $HIL, else hil on PATH, else
                      build/apps/hil/hil next to this script)
   -h, --help         this text

@@ -6,6 +6,8 @@
 # warehouse) to build/worlds/*.svg, and ends by running the scenario suite
 # (scenarios/) against the reference clients: the table on the console,
 # JUnit XML in build/hil-junit.xml and the report in build/hil-report/.
+# Last, it packs hil, the four client programs and the scenario library
+# into the Debian package build/hil_<version>_<arch>.deb (docs/install.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -44,4 +46,9 @@ echo "== scenarios"
 if ! "$hil" run scenarios/ --junit build/hil-junit.xml --report-dir build/hil-report; then
   status=1
 fi
+
+echo "== package"
+cmake --build --preset default --target logi-client wr8-client arduino-client leka-client \
+  hil_man_pages
+if ! (cd build && cpack -G DEB); then status=1; fi
 exit "$status"
