@@ -3,6 +3,7 @@
 //   tcp://127.0.0.1:9000
 //   pty:///tmp/hil-arduino0?baud=9600&reset_ms=200
 //   mem://car0?baud=9600
+//   rfc2217://127.0.0.1:4000?baud=9600&reset_ms=200
 
 #include <cstdint>
 #include <stdexcept>
@@ -39,7 +40,22 @@ struct MemEndpoint {
   friend bool operator==(const MemEndpoint&, const MemEndpoint&) = default;
 };
 
-using Endpoint = std::variant<TcpEndpoint, PtyEndpoint, MemEndpoint>;
+/// A serial car behind an RFC 2217 (Telnet COM-PORT-OPTION) server on TCP,
+/// the way a serial port is shared over a network (ser2net, a COM port
+/// redirector on Windows). Listen-only.
+struct Rfc2217Endpoint {
+  std::string host = "127.0.0.1";  ///< numeric address or name to listen on
+  std::uint16_t port = 0;          ///< 0: a free port (the listener's address() tells)
+  /// The car's line rate (8N1): what paces the line until the client sets
+  /// another; 0 = unpaced whatever the client sets.
+  unsigned baud = 0;
+  /// Data bytes the client sends this long after connecting are lost, as
+  /// on a pty (an Arduino resets when the port opens); 0 = off.
+  Duration reset_on_open{0};
+  friend bool operator==(const Rfc2217Endpoint&, const Rfc2217Endpoint&) = default;
+};
+
+using Endpoint = std::variant<TcpEndpoint, PtyEndpoint, MemEndpoint, Rfc2217Endpoint>;
 
 /// A URI that cannot be used; what() says what was wrong and what was expected.
 class EndpointError : public std::invalid_argument {

@@ -1,6 +1,7 @@
 #include "link/transport.hpp"
 
 #include "link/pty.hpp"
+#include "link/rfc2217_listener.hpp"
 #include "link/tcp.hpp"
 #include "protocol/common/overloaded.hpp"
 
@@ -28,18 +29,25 @@ MemNetwork& mem_network(TransportContext& context) {
 }  // namespace
 
 std::unique_ptr<Listener> listen(TransportContext& context, const Endpoint& endpoint) {
-  return std::visit(protocol::Overloaded{[&](const TcpEndpoint& e) -> std::unique_ptr<Listener> {
-                                           return std::make_unique<TcpListener>(
-                                               real_time_io(context, "tcp"), e);
-                                         },
-                                         [&](const PtyEndpoint& e) -> std::unique_ptr<Listener> {
-                                           return std::make_unique<PtyListener>(
-                                               real_time_io(context, "pty"), context.executor, e);
-                                         },
-                                         [&](const MemEndpoint& e) -> std::unique_ptr<Listener> {
-                                           return mem_network(context).listen(e.name, e.baud);
-                                         }},
-                    endpoint);
+  return std::visit(
+      protocol::Overloaded{[&](const TcpEndpoint& e) -> std::unique_ptr<Listener> {
+                             return std::make_unique<TcpListener>(real_time_io(context, "tcp"), e);
+                           },
+                           [&](const PtyEndpoint& e) -> std::unique_ptr<Listener> {
+                             return std::make_unique<PtyListener>(real_time_io(context, "pty"),
+                                                                  context.executor, e);
+                           },
+                           [&](const MemEndpoint& e) -> std::unique_ptr<Listener> {
+                             return mem_network(context).listen(e.name, e.baud);
+                           },
+                           [&](const Rfc2217Endpoint& e) -> std::unique_ptr<Listener> {
+                             auto tcp = std::make_unique<TcpListener>(
+                                 real_time_io(context, "rfc2217"), TcpEndpoint{e.host, e.port});
+                             return std::make_unique<Rfc2217Listener>(
+                                 context.executor, std::move(tcp),
+                                 Rfc2217Options{e.baud, e.reset_on_open, context.log});
+                           }},
+      endpoint);
 }
 
 void connect(TransportContext& context, const Endpoint& endpoint, ConnectHandler handler) {
@@ -51,7 +59,13 @@ void connect(TransportContext& context, const Endpoint& endpoint, ConnectHandler
           [&](const PtyEndpoint& e) {
             pty_connect(real_time_io(context, "pty"), context.executor, e, std::move(handler));
           },
-          [&](const MemEndpoint& e) { mem_network(context).connect(e.name, std::move(handler)); }},
+          [&](const MemEndpoint& e) { mem_network(context).connect(e.name, std::move(handler)); },
+          [&](const Rfc2217Endpoint&) {
+            // hil serves RFC 2217 but has no client for it.
+            context.executor.post([handler = std::move(handler)] {
+              handler(std::make_error_code(std::errc::protocol_not_supported), nullptr);
+            });
+          }},
       endpoint);
 }
 

@@ -65,9 +65,8 @@ link::Duration local_time_of_day() {
                                        (wall - system_clock::from_time_t(seconds_now)));
 }
 
-link::Endpoint endpoint_for(const MockListenArgs& args, const std::string& profile,
-                            mocks::CarKind kind, std::size_t index) {
-  link::Endpoint e = mocks::default_endpoint(kind, index, profile);
+link::Endpoint endpoint_for(const MockListenArgs& args, const MockPlan& plan, std::size_t index) {
+  link::Endpoint e = mocks::default_endpoint(plan.kind, index, plan.profile);
   if (auto* tcp = std::get_if<link::TcpEndpoint>(&e)) {
     tcp->host = args.bind;
     if (args.port) {
@@ -77,6 +76,14 @@ link::Endpoint endpoint_for(const MockListenArgs& args, const std::string& profi
     if (!args.pty.empty()) pty->path = nth_path(args.pty, index);
     if (args.baud) pty->baud = *args.baud;
     pty->reset_on_open = link::milliseconds(args.reset_ms);
+    if (plan.rfc2217) {
+      // The same line, served by an RFC 2217 server instead of a pty.
+      link::Rfc2217Endpoint served = *plan.rfc2217;
+      if (served.port != 0) served.port = static_cast<std::uint16_t>(served.port + index);
+      served.baud = pty->baud;
+      served.reset_on_open = pty->reset_on_open;
+      return served;
+    }
   }
   return e;
 }
@@ -85,6 +92,13 @@ std::string how_to_connect(const link::Endpoint& listening, const std::string& a
   if (const auto* pty = std::get_if<link::PtyEndpoint>(&listening)) {
     std::string text = "open " + pty->path + " as a serial port";
     if (pty->baud != 0) text += " at " + std::to_string(pty->baud) + " baud";
+    return text;
+  }
+  if (const auto* served = std::get_if<link::Rfc2217Endpoint>(&listening)) {
+    // What a client opens: the URI without hil's options (pySerial takes
+    // rfc2217://HOST:PORT as it is).
+    std::string text = "connect an RFC 2217 client to " + address.substr(0, address.find('?'));
+    if (served->baud != 0) text += " (the line at " + std::to_string(served->baud) + " baud)";
     return text;
   }
   return "connect to " + address;
@@ -101,6 +115,9 @@ class MockDesk {
     constexpr link::Duration kDay = std::chrono::hours(24);
     plan_.base.configs.svgui.time_of_day_at_start =
         ((local_time_of_day() - executor_.now()) % kDay + kDay) % kDay;
+    // What a listener's clients cannot see (an RFC 2217 client's refused
+    // connection, its bad input, a line set unlike the car's).
+    if (!args.desk.quiet) context_.log = [this](const std::string& line) { log(line); };
   }
 
   void start_cars();
@@ -161,7 +178,7 @@ RunningCar MockDesk::start_car(std::size_t i) {
   for (const auto& b : plan_.behaviours)
     running.car->firmware().arm(b);
   mocks::ServerOptions server;
-  server.listen = endpoint_for(args_.listen, plan_.profile, plan_.kind, i);
+  server.listen = endpoint_for(args_.listen, plan_, i);
   server.faults = plan_.faults;
   server.seed = mocks::car_seed(plan_.seed, i);
   server.wire_log_path = args_.desk.wire_log;
@@ -173,13 +190,15 @@ RunningCar MockDesk::start_car(std::size_t i) {
   }
   running.server =
       std::make_unique<mocks::MockServer>(context_, running.car->firmware(), std::move(server));
-  const auto listening = endpoint_for(args_.listen, plan_.profile, plan_.kind, i);
+  const auto listening = endpoint_for(args_.listen, plan_, i);
   try {
     running.server->start();
   } catch (const std::exception& e) {
     std::string message = "cannot listen on " + link::to_uri(listening) + ": " + e.what();
     if (std::holds_alternative<link::TcpEndpoint>(listening))
       message += " (is another hil mock running? choose another --port)";
+    if (std::holds_alternative<link::Rfc2217Endpoint>(listening))
+      message += " (is another hil mock running? choose another --rfc2217 port)";
     throw MockStartError{message, 1};
   }
   list_car(i, running, listening);
@@ -213,8 +232,12 @@ void MockDesk::start_cars() {
     cars_.push_back(start_car(i));
   if (!args_.desk.ports_file.empty()) write_ports_file();
   const std::string& bind = args_.listen.bind;
-  if (bind != "127.0.0.1" && bind != "localhost" && bind != "::1" && !plan_.serial)
+  if (!is_loopback(bind) && !plan_.serial)
     std::cerr << "warning: listening on " << bind << ", reachable from other machines\n";
+  if (plan_.rfc2217 && !is_loopback(plan_.rfc2217->host)) {
+    std::cerr << "warning: RFC 2217 server listening on " << plan_.rfc2217->host
+              << ", reachable from other machines (anyone who connects drives the car)\n";
+  }
   const std::string& world = args_.car.world;
   std::cout << "world " << (world.empty() ? "built-in warehouse" : world) << ", "
             << plan_.faults.rules.size() << " fault rule(s), " << plan_.behaviours.size()
@@ -334,7 +357,8 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   auto args = std::make_shared<MockArgs>();
   auto* cmd = app.add_subcommand(
       "mock", "Run mock cars on this machine for a client or UI to talk to (real time)");
-  cmd->add_option("car", args->car.kind, "Which car: logi, wr8 (TCP), arduino, leka (pty)")
+  cmd->add_option("car", args->car.kind,
+                  "Which car: logi, wr8 (TCP), arduino, leka (pty, or --rfc2217)")
       ->required()
       ->check(CLI::IsMember({"logi", "wr8", "arduino", "leka"}));
   cmd->add_option("--profile", args->car.profile,
@@ -349,6 +373,12 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
   cmd->add_option(
       "--pty", args->listen.pty,
       "Serial cars: symlink to the first pty (default /tmp/hil-<car>0; car N counts up)");
+  cmd->add_option(
+      "--rfc2217", args->listen.rfc2217,
+      "Serial cars: serve the car's serial port over the network with RFC 2217 (Telnet "
+      "COM-PORT-OPTION) on [ADDR:]PORT instead of a pty, for Windows COM port redirectors and "
+      "pySerial's rfc2217:// (ADDR 127.0.0.1 by default; car N on PORT+N; 0 picks free ports; "
+      "one client at a time; docs/rfc2217.md)");
   cmd->add_option("--baud", args->listen.baud,
                   "Serial cars: line rate (default 9600 for arduino, 115200 for leka; 0 unpaced)");
   cmd->add_option("--reply-latency", args->car.reply_latency,
@@ -433,6 +463,9 @@ void register_mock(CLI::App& app, std::function<int()>& run) {
       "  hil mock wr8 --count 3 --port 9100            # three WR8 vehicles on 9100..9102\n"
       "  hil mock logi --count 1000 -q                 # a fleet of LOGI cars on 9000..9999\n"
       "  hil mock arduino --pty /tmp/robot0            # open /tmp/robot0 at 9600 baud\n"
+      "  hil mock arduino --rfc2217 4000               # rfc2217://127.0.0.1:4000 for COM port\n"
+      "                                                # redirectors and pySerial\n"
+      "  hil mock leka --rfc2217 0.0.0.0:4000          # the same, reachable from other machines\n"
       "  hil mock logi --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil mock logi --view                          # and watch it on http://127.0.0.1:8080/\n"
       "  hil mock logi --replay car.ndjson             # the car `hil conform probe` recorded\n"

@@ -194,6 +194,27 @@ void load_firmware(const MockCarArgs& args, MockPlan& plan) {
   }
 }
 
+// --rfc2217 for this kind of car, with --pty and --count.
+void plan_rfc2217(const MockArgs& args, MockPlan& plan) {
+  if (args.listen.rfc2217.empty()) return;
+  if (!plan.serial) {
+    throw MockStartError{"--rfc2217 serves a serial car (arduino, leka); a " + args.car.kind +
+                             " car listens on TCP (--bind, --port)",
+                         2};
+  }
+  if (!args.listen.pty.empty())
+    throw MockStartError{"--rfc2217 and --pty each give the car's serial port; choose one", 2};
+  const auto e = parse_rfc2217_option(args.listen.rfc2217);
+  if (e.port != 0 && e.port + args.count - 1 > 65535) {
+    throw MockStartError{"--rfc2217 port " + std::to_string(e.port) + " with --count " +
+                             std::to_string(args.count) +
+                             " runs past port 65535 (car N listens on PORT+N); choose a lower "
+                             "port or port 0",
+                         2};
+  }
+  plan.rfc2217 = e;
+}
+
 // --count and --port for this kind of car, and the open files they need.
 void check_fleet(const MockArgs& args, bool serial) {
   if (serial && args.count > kMaxSerialCars) {
@@ -216,6 +237,36 @@ void check_fleet(const MockArgs& args, bool serial) {
 
 }  // namespace
 
+link::Rfc2217Endpoint parse_rfc2217_option(const std::string& text) {
+  const auto bad = [&text]() {
+    return MockStartError{
+        "--rfc2217 takes [ADDR:]PORT, e.g. 4000, 127.0.0.1:4000 or "
+        "0.0.0.0:4000 (PORT 0..65535, 0 picks a free one), got \"" +
+            text + "\"",
+        2};
+  };
+  const std::size_t colon = text.rfind(':');
+  const bool bracketed = !text.empty() && text.front() == '[';
+  if (colon == std::string::npos && bracketed) throw bad();
+  std::string host = colon == std::string::npos ? "" : text.substr(0, colon);
+  const std::string port = colon == std::string::npos ? text : text.substr(colon + 1);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+    host = host.substr(1, host.size() - 2);
+  if (colon != std::string::npos && host.empty()) throw bad();
+  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos)
+    throw bad();
+  const unsigned long number = std::stoul(port);
+  if (number > 65535) throw bad();
+  link::Rfc2217Endpoint e;
+  if (!host.empty()) e.host = host;
+  e.port = static_cast<std::uint16_t>(number);
+  return e;
+}
+
+bool is_loopback(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "::1";
+}
+
 MockPlan plan_mock(const MockArgs& args) {
   MockPlan plan;
   plan.kind = *mocks::parse_car_kind(args.car.kind);
@@ -230,6 +281,7 @@ MockPlan plan_mock(const MockArgs& args) {
   configure_car(args.car, plan.profile, plan.base.configs, plan.kind);
   plan.serial = std::holds_alternative<link::PtyEndpoint>(
       mocks::default_endpoint(plan.kind, 0, plan.profile));
+  plan_rfc2217(args, plan);
   check_fleet(args, plan.serial);
   plan.seed = args.car.seed ? *args.car.seed : std::random_device{}();
   const auto view_port = parse_view_port(args.desk.view_port);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "link/endpoint.hpp"
 #include "link/faults/profile.hpp"
 #include "mocks/behaviour.hpp"
 #include "mocks/car.hpp"
@@ -41,6 +42,7 @@ struct MockListenArgs {
   std::string pty;
   std::optional<unsigned> baud;
   unsigned reset_ms = 0;
+  std::string rfc2217;  ///< serial cars: "[ADDR:]PORT" of an RFC 2217 server instead of a pty
 };
 
 // What the desk shows and takes.
@@ -91,10 +93,21 @@ struct MockPlan {
   std::string profile;
   link::FaultProfile faults;
   std::vector<mocks::Behaviour> behaviours;
-  bool serial = false;  ///< cars on ptys (else TCP)
+  bool serial = false;  ///< cars on ptys or RFC 2217 (else TCP)
+  /// --rfc2217: where car 0's RFC 2217 server listens (car N on PORT+N,
+  /// or free ports with port 0); the line's baud and reset come from the
+  /// pty options. Empty: the cars are on ptys.
+  std::optional<link::Rfc2217Endpoint> rfc2217;
   std::uint64_t seed = 0;
   std::uint16_t view_port = kDefaultViewPort;
 };
+
+/// "[ADDR:]PORT" ("4000", "0.0.0.0:4000", "[::1]:4000") as an RFC 2217
+/// endpoint, 127.0.0.1 when no address is given. Throws MockStartError.
+link::Rfc2217Endpoint parse_rfc2217_option(const std::string& text);
+
+/// Whether a listener on `host` is reachable from this machine only.
+bool is_loopback(const std::string& host);
 
 /// Loads the files the options name and checks the options against each
 /// other and the machine (raising the open-file limit for a big fleet).

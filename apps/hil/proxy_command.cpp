@@ -37,7 +37,9 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
                   "The car's profile the frames are judged by (hil profiles CAR lists them; "
                   "default: the car's default), e.g. arduino --profile readme");
   cmd->add_option("--listen", args->listen,
-                  "Where the client connects: tcp://127.0.0.1:PORT or pty:///PATH[?baud=9600]")
+                  "Where the client connects: tcp://127.0.0.1:PORT, pty:///PATH[?baud=9600], or "
+                  "rfc2217://ADDR:PORT[?baud=9600] for an RFC 2217 client (a Windows COM port "
+                  "redirector, pySerial; one client at a time)")
       ->required();
   cmd->add_option("--upstream", args->upstream,
                   "The car: tcp://HOST:PORT, or pty:///dev/ttyUSB0 for a serial device")
@@ -57,6 +59,8 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       "            --faults scenarios/faults/sticky-packets.yaml --log wire.ndjson\n"
       "  hil proxy --protocol arduino --listen 'pty:///tmp/hil-arduino0?baud=9600' --upstream "
       "pty:///dev/ttyUSB0\n"
+      "  hil proxy --protocol arduino --listen 'rfc2217://127.0.0.1:4000?baud=9600' \\\n"
+      "            --upstream pty:///dev/ttyACM0   (a real board, shared with RFC 2217 clients)\n"
       "  hil proxy --protocol wr8 --profile svgui-head --listen tcp://127.0.0.1:5557 \\\n"
       "            --upstream tcp://127.0.0.1:5556 --log wire.ndjson   (the real vehicle program; "
       "frames\n"
@@ -68,6 +72,13 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       try {
         options.listen = link::parse_endpoint(args->listen);
         options.upstream = link::parse_endpoint(args->upstream);
+        if (std::holds_alternative<link::Rfc2217Endpoint>(options.upstream)) {
+          std::cerr << "hil proxy: --upstream " << args->upstream
+                    << ": hil serves RFC 2217 (--listen rfc2217://...) but cannot connect to an "
+                       "RFC 2217 server; give the car's serial port (pty:///dev/ttyUSB0) or "
+                       "tcp://HOST:PORT\n";
+          return 1;
+        }
         if (!args->faults.empty()) options.faults = link::load_fault_profile(args->faults);
       } catch (const std::exception& e) {
         std::cerr << "hil proxy: " << e.what() << '\n';
@@ -88,6 +99,9 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
       asio::io_context io;
       link::AsioExecutor executor(io);
       link::TransportContext context{executor, &io};
+      // An rfc2217:// listener's refused connections and bad input are
+      // printed even with -q: the client cannot see them.
+      context.log = [](const std::string& line) { std::cout << line << std::endl; };
       link::Proxy proxy(context, options);
       // Caught before the start-up lines: a Ctrl-C right after them stops
       // cleanly instead of killing the process.
@@ -98,10 +112,11 @@ void register_proxy(CLI::App& app, std::function<int()>& run) {
         std::cerr << "hil proxy: cannot listen on " << args->listen << ": " << e.what() << '\n';
         return 1;
       }
-      if (const auto* tcp = std::get_if<link::TcpEndpoint>(&options.listen);
-          tcp != nullptr && tcp->host != "127.0.0.1" && tcp->host != "localhost" &&
-          tcp->host != "::1") {
-        std::cerr << "warning: listening on " << tcp->host << ", reachable from other machines\n";
+      const auto* tcp = std::get_if<link::TcpEndpoint>(&options.listen);
+      const auto* served = std::get_if<link::Rfc2217Endpoint>(&options.listen);
+      const std::string host = tcp != nullptr ? tcp->host : served != nullptr ? served->host : "";
+      if (!host.empty() && host != "127.0.0.1" && host != "localhost" && host != "::1") {
+        std::cerr << "warning: listening on " << host << ", reachable from other machines\n";
       }
       std::cout << "hil proxy: clients connect to " << proxy.address() << ", car at "
                 << link::to_uri(options.upstream) << ", protocol " << args->protocol
