@@ -7,12 +7,14 @@
 # fails in any run counts as a flake (both clients are correct). Target: the
 # gate in at most 60 s of wall time on 2 cores, with no flake in 20 runs.
 # Usage: bench/gate_time.sh [--hil PATH] [--jobs "8 16 32"] [--repeats R]
-#                           [--client logi|python|both] [--markdown FILE]
+#                           [--client logi|python|both] [--markdown FILE] [--keep DIR]
 #   --hil PATH       the hil binary (default: build/apps/hil/hil)
 #   --jobs LIST      the widths to time, -j values (default: "2 8 16 32 auto")
 #   --repeats R      gate runs per width and client (default 20)
 #   --client WHICH   which correct client (default: both)
 #   --markdown FILE  also writes the results as a Markdown table to FILE
+#   --keep DIR       keeps the report folder of every gate run that failed in
+#                    DIR/<client>-j<N>-<run> (timelines of every scenario)
 # Exits 1 when any run failed (the table says which scenarios).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +24,7 @@ jobs_list="2 8 16 32 auto"
 repeats=20
 which=both
 markdown=
+keep=
 while [ $# -gt 0 ]; do
   case $1 in
     --hil) hil=$2; shift 2 ;;
@@ -29,6 +32,7 @@ while [ $# -gt 0 ]; do
     --repeats) repeats=$2; shift 2 ;;
     --client) which=$2; shift 2 ;;
     --markdown) markdown=$2; shift 2 ;;
+    --keep) keep=$2; shift 2 ;;
     *) echo "bench/gate_time.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -63,13 +67,22 @@ for client in "${clients[@]}"; do
       out="$work/run.txt"
       t0=$(date +%s.%N)
       status=0
-      "$hil" run scenarios/logi -j "$jobs" --client-exec "$command" >"$out" 2>&1 || status=$?
+      report=()
+      [ -z "$keep" ] || report=(--report-dir "$work/report")
+      rm -rf "$work/report"
+      "$hil" run scenarios/logi -j "$jobs" --client-exec "$command" "${report[@]}" >"$out" 2>&1 ||
+        status=$?
       t1=$(date +%s.%N)
       walls+=("$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.1f", b - a }')")
       if [ $status -ne 0 ]; then
         bad_runs=$((bad_runs + 1))
         failed=1
         awk '$2 == "FAIL" || $2 == "FLAKY" { print $1 }' "$out" >>"$work/failures"
+        if [ -n "$keep" ]; then
+          kept="$keep/${name// /-}-j$jobs-$r"
+          mkdir -p "$keep" && rm -rf "$kept" && mv "$work/report" "$kept" && cp "$out" "$kept/output.txt"
+          echo "bench/gate_time.sh: its report: $kept" >&2
+        fi
         echo "bench/gate_time.sh: $name -j $jobs run $r failed:" >&2
         # Each failure's block: what was expected, what was seen, the repeat command.
         awk '/^(FAIL|FLAKY) / { show = 1 } show { print } /^  repeat: / { show = 0 }' "$out" >&2

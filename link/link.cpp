@@ -59,11 +59,14 @@ Link::~Link() {
 }
 
 void Link::start() {
+  start(executor_.now());
+}
+
+void Link::start(Time opened_at) {
   if (open_) return;
   open_ = true;
-  const Time now = executor_.now();
   for (const auto& o : observers_) {
-    o->on_open(now, pipes_[index(Direction::to_client)]->describe(),
+    o->on_open(opened_at, pipes_[index(Direction::to_client)]->describe(),
                pipes_[index(Direction::to_car)]->describe());
   }
   // Bytes the client sends travel to_car; bytes the car sends travel to_client.

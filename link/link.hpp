@@ -82,7 +82,13 @@ class Link : public std::enable_shared_from_this<Link> {
                                       LinkOptions options);
   ~Link();
 
+  /// Starts carrying bytes; the observers see the link open now.
   void start();
+  /// The same, the link opened at `opened_at` (the moment its connection
+  /// was accepted): a car that starts its clock at the accept and the
+  /// timeline's `open` then name one instant, however long setting up the
+  /// link took on a loaded machine.
+  void start(Time opened_at);
   /// Closes both sides.
   void close(CloseMode mode = CloseMode::graceful);
   bool is_open() const;

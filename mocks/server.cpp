@@ -16,8 +16,8 @@ class FaultLogger final : public link::LinkObserver {
   FaultLogger(std::string id, std::function<void(const std::string&)> log)
       : id_(std::move(id)), log_(std::move(log)) {}
   void on_fault(const link::FaultEvent& e) override {
-    log_(id_ + " " + link::format_ms(e.at) + " fault " + std::string(link::to_string(e.kind)) + " (" + e.rule + ", " +
-         std::string(link::to_string(e.direction)) + "): " + e.detail);
+    log_(id_ + " " + link::format_ms(e.at) + " fault " + std::string(link::to_string(e.kind)) +
+         " (" + e.rule + ", " + std::string(link::to_string(e.direction)) + "): " + e.detail);
   }
 
  private:
@@ -205,7 +205,10 @@ void MockServer::on_accept(link::BytePipePtr client) {
       }});
   link_ = link::Link::create(context_.executor, std::move(client), std::move(car_end),
                              std::move(link_options));
-  link_->start();
+  // One instant for the car's connection and the timeline's `open` (an
+  // external client's origin): the car's clock grid and the fault times
+  // moved to the origin then line up exactly.
+  link_->start(now);
   firmware_.connect(now);
   flush();
 }

@@ -22,6 +22,8 @@ struct End {
 struct Recorder final : LinkObserver {
   std::vector<FaultEvent> faults;
   std::optional<LinkClose> close;
+  std::optional<Time> opened_at;
+  void on_open(Time at, const std::string&, const std::string&) override { opened_at = at; }
   void on_fault(const FaultEvent& e) override { faults.push_back(e); }
   void on_close(Time, const LinkClose& c) override { close = c; }
 };
@@ -60,6 +62,22 @@ class LinkTest : public ::testing::Test {
                  }});
   }
 };
+
+TEST_F(LinkTest, OpensNowOrAtTheInstantItsConnectionWasAccepted) {
+  open();
+  EXPECT_EQ(recorder->opened_at, Time(0));
+  // Accepted at 5 ms, set up and started at 12 ms (a loaded machine): the
+  // observers see it open at 5 ms, the instant the car was connected.
+  ex.run_until(Time(std::chrono::milliseconds(12)));
+  auto [client_end, client_link_side] = make_mem_pipe(ex, "client2");
+  auto [car_link_side, car_end] = make_mem_pipe(ex, "car2");
+  LinkOptions o;
+  auto late = std::make_shared<Recorder>();
+  o.observers.push_back(late);
+  auto second = Link::create(ex, client_link_side, car_link_side, o);
+  second->start(Time(std::chrono::milliseconds(5)));
+  EXPECT_EQ(late->opened_at, Time(std::chrono::milliseconds(5)));
+}
 
 TEST_F(LinkTest, CarriesBothDirectionsUntouchedWithoutFaults) {
   open();
