@@ -1,5 +1,5 @@
 // Virtual-time speed of the whole stack: a LOGI auto tour through a faulty
-// link (scenarios/logi/logi-auto-tour-flaky.yaml: the reference client, the
+// link (bench/scenarios/logi-auto-tour-long.yaml: the reference client, the
 // mock car with its firmware and physics, the link with its faults, the
 // timeline and the expectations) run by the scenario runner exactly as
 // `hil run` runs it, against bare Box2D stepping the same bodies the same
@@ -170,7 +170,7 @@ class RecordingReporter : public hil::bench::BestRunReporter {
 int main(int argc, char** argv) {
   auto flags = hil::bench::take_hil_flags(argc, argv);
   std::string file = flags.text("scenario");
-  if (file.empty()) file = HIL_SOURCE_DIR "/scenarios/logi/logi-auto-tour-flaky.yaml";
+  if (file.empty()) file = HIL_SOURCE_DIR "/bench/scenarios/logi-auto-tour-long.yaml";
   Subject& s = subject();
   try {
     s.scenario = hil::harness::load_scenario(file);
