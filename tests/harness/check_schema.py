@@ -129,7 +129,8 @@ def main():
 
     files = []
     # Other tests' fixtures may be wrong on purpose, so only the loader's own.
-    for folder in (root / "scenarios", root / "tests" / "harness" / "data" / "scenario_yaml"):
+    for folder in (root / "scenarios", root / "bench" / "scenarios",
+                   root / "tests" / "harness" / "data" / "scenario_yaml"):
         for path in sorted(folder.rglob("*.yaml")):
             if SKIPPED_FOLDERS & set(path.relative_to(folder).parts[:-1]):
                 continue
