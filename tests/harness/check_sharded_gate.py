@@ -37,8 +37,9 @@ def check(ok, message):
 
 
 def local(command):
-    """A CI command made to run here: this tree's hil, no --client-exec."""
-    command = command.replace("hil/build/apps/hil/hil", HIL)
+    """A CI command made to run here: this tree's hil in place of the one the
+    package installs, no --client-exec."""
+    command = re.sub(r"(^|\n)(\s*)hil ", lambda m: m.group(1) + m.group(2) + HIL + " ", command)
     command = re.sub(r'--client-exec\s+"[^"]*"\s*(\\\n)?\s*', "", command)
     return command
 
@@ -117,7 +118,11 @@ def github():
     merge_cmd = next((r for r in merge_runs if "report merge" in r), None)
     if not check(merge_cmd is not None, f"{path}: the merge job does not run hil report merge"):
         return
-    check(jobs["merge"]["needs"] == "gate", f"{path}: the merge job does not need the shards")
+    check("gate" in jobs["merge"]["needs"], f"{path}: the merge job does not need the shards")
+    for job in ("gate", "merge"):
+        check("hil" in jobs[job]["needs"], f"{path}: the {job} job does not need the package job")
+        check(any("./hil_*.deb" in s.get("run", "") for s in jobs[job]["steps"]),
+              f"{path}: the {job} job does not install hil's package")
     check("--expect" in merge_cmd, f"{path}: the merge does not check every scenario ran")
 
     def env(k):
@@ -143,7 +148,11 @@ def gitlab():
                       and "report merge" in s), None)
     if not check(merge_cmd is not None, f"{path}: the merge job does not run hil report merge"):
         return
-    check(doc["merge"]["needs"] == ["gate"], f"{path}: the merge job does not need the shards")
+    check("gate" in doc["merge"]["needs"], f"{path}: the merge job does not need the shards")
+    for job in ("gate", "merge"):
+        check("hil" in doc[job]["needs"], f"{path}: the {job} job does not need the package job")
+    check(any("cpack" in str(line) for line in doc["hil"]["script"]),
+          f"{path}: the hil job does not build the package")
     check("--expect" in merge_cmd, f"{path}: the merge does not check every scenario ran")
     run_gate("gitlab", n, shard_cmd, merge_cmd,
              lambda k: {"SCENARIOS": SCENARIOS, "CI_NODE_INDEX": str(k),
