@@ -2,7 +2,8 @@
 # The long soak (`ctest -C soak -L soak`) as shard K of N, so that N
 # machines share it:
 #
-#   ci/soak-shard.sh K/N [--sessions TOTAL] [--seed BASE] [--build-dir DIR] [--dry-run]
+#   ci/soak-shard.sh K/N [--sessions TOTAL] [--seed BASE] [--build-dir DIR]
+#                        [--properties-only] [--dry-run]
 #
 # - Each property program (the soak.property_* tests: thousands of random
 #   sessions per property) runs TOTAL/N of TOTAL sessions per property
@@ -17,18 +18,18 @@
 # The default TOTAL is 5000, the soak tests' own; the default BASE is
 # $HIL_SOAK_SEED, else 1. Give every shard of one soak the same TOTAL and
 # BASE (a pipeline number makes a fresh soak each time). --dry-run prints
-# what would run and runs nothing. Exit 0 everything passed, 1 something
-# failed, 2 bad usage.
+# what would run and runs nothing; --properties-only leaves the other soak
+# tests out. Exit 0 everything passed, 1 something failed, 2 bad usage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 usage() {
-  sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'
 }
 
 die_usage() {
   echo "soak-shard: $1" >&2
-  echo "usage: ci/soak-shard.sh K/N [--sessions TOTAL] [--seed BASE] [--build-dir DIR] [--dry-run]" >&2
+  echo "usage: ci/soak-shard.sh K/N [--sessions TOTAL] [--seed BASE] [--build-dir DIR] [--properties-only] [--dry-run]" >&2
   exit 2
 }
 
@@ -39,6 +40,7 @@ sessions=5000
 base=${HIL_SOAK_SEED:-1}
 build_dir=build
 dry_run=0
+properties_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     -h | --help)
@@ -56,6 +58,10 @@ while [ $# -gt 0 ]; do
       ;;
     --dry-run)
       dry_run=1
+      shift
+      ;;
+    --properties-only)
+      properties_only=1
       shift
       ;;
     -*) die_usage "unknown option $1" ;;
@@ -108,13 +114,18 @@ else
   done <<<"$programs"
 fi
 
-others=(ctest --test-dir "$build_dir" -C soak -L soak -E '^soak\.property_' -I "$k,,$n" --output-on-failure)
-echo "the other soak tests: ${others[*]}"
+if [ "$properties_only" -eq 1 ]; then
+  others=()
+  echo "the other soak tests: left out (--properties-only)"
+else
+  others=(ctest --test-dir "$build_dir" -C soak -L soak -E '^soak\.property_' -I "$k,,$n" --output-on-failure)
+  echo "the other soak tests: ${others[*]}"
+fi
 if [ "$dry_run" -eq 1 ]; then
-  "${others[@]}" -N | sed -n 's/^ *Test *#[0-9]*: /  would run: /p'
+  [ ${#others[@]} -eq 0 ] || "${others[@]}" -N | sed -n 's/^ *Test *#[0-9]*: /  would run: /p'
   exit 0
 fi
-"${others[@]}" || status=1
+[ ${#others[@]} -eq 0 ] || "${others[@]}" || status=1
 
 if [ ${#failed[@]} -gt 0 ]; then
   echo "soak shard $k/$n: failed: ${failed[*]} (RC_PARAMS='seed=$seed max_success=$share' repeats them)"

@@ -108,6 +108,18 @@ for args, message in [
 code, out = run("1/2", "--dry-run")
 check(code == 0 and "2500 of 5000 sessions" in out, f"the default total is not 5000:\n{out}")
 
+# One real shard, the property programs only (the gate's soak runs take
+# most of an hour): 3 sessions over 3 shards is one session per property
+# for shard 2, from seed 1*3 + 2-1 = 4, and rapidcheck says it took them.
+code, out = run("2/3", "--sessions", "3", "--seed", "1", "--properties-only")
+check(code == 0 and "soak shard 2/3: passed" in out, f"a real shard did not pass:\n{out}")
+configs = [line for line in out.splitlines() if line.startswith("Using configuration:")]
+check(len(configs) > 0, f"no property program said which configuration it ran:\n{out}")
+check(all("max_success=1" in c and "seed=4" in c for c in configs),
+      f"a property program did not take the shard's sessions and seed: {configs}")
+check("would run" not in out and "left out (--properties-only)" in out,
+      f"--properties-only ran other soak tests:\n{out}")
+
 if failures:
     print(f"{len(failures)} check(s) failed")
     sys.exit(1)
