@@ -266,9 +266,13 @@ void ScenarioRun::run() {
 void ScenarioRun::play_steps() {
   using Sequence = StepSequencer::Sequence;
   steps_->start_schedule();
-  if (origin_)
-    origin_->when_fixed([this](const Origin& origin) { steps_->origin_fixed(origin.at); });
-  else
+  if (origin_) {
+    origin_->when_fixed([this](const Origin& origin) {
+      steps_->origin_fixed(origin.at);
+      // The car's clocks count from the origin too, however it was fixed.
+      car_->firmware().set_clock_origin(origin.at);
+    });
+  } else
     steps_->origin_fixed(Time(0));
   // A serial car has no `connect` step: an external program opens the port
   // when it starts, as it would connect. Its steps begin at its origin (that

@@ -112,6 +112,14 @@ class Firmware {
 
   // ---- harness side ----
 
+  /// The run's origin is `at` (an external client's first contact with the
+  /// car, harness/origin.hpp): a firmware whose clocks count from its first
+  /// connection (LogiConfig::grid_from_first_connection) counts them from
+  /// here, so its periodic frames keep their times from the origin whether
+  /// the client's first contact was its connection or a line it printed
+  /// before connecting.
+  virtual void set_clock_origin(Time /*at*/) {}
+
   /// Arms a scripted behaviour; a timed one fires on time (the driver is
   /// told that the next wakeup may have moved).
   void arm(Behaviour behaviour);

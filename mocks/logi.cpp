@@ -139,6 +139,10 @@ void LogiFirmware::on_connect(Time now) {
   next_stat_ = grid_after(now, config_.stat_period);
 }
 
+void LogiFirmware::set_clock_origin(Time at) {
+  if (config_.grid_from_first_connection && !grid_start_) grid_start_ = at;
+}
+
 void LogiFirmware::on_disconnect(Time) {
   if (!config_.stop_on_disconnect) return;
   if (state_.running) end_run(LogiRunEnd::disconnect);

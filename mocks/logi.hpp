@@ -40,10 +40,11 @@ struct LogiConfig {
   /// control work instead of all waking at once. 0..stat_period.
   Duration boot_offset = Duration::zero();
   /// The grids count from the first client's connection (plus boot_offset)
-  /// instead of from time 0: a car switched on as its client connects. The
-  /// harness sets it for an external client, whose first connection is its
-  /// run's origin, so the STATs keep the same times from the origin as
-  /// they have from time 0 with the reference client.
+  /// instead of from time 0: a car switched on as its client connects; or
+  /// from the run's origin when the harness gives one before that
+  /// (set_clock_origin()). The harness sets it for an external client, so
+  /// the STATs keep the same times from the origin as they have from time
+  /// 0 with the reference client.
   bool grid_from_first_connection = false;
   /// The obstacle lock holds the car while the sonar reads below this.
   int obstacle_stop_cm = 20;
@@ -110,6 +111,7 @@ class LogiFirmware final : public FirmwareWith<LogiConfig, LogiState> {
   LogiFirmware(sim::World& world, sim::Vehicle& vehicle, LogiConfig config = {});
 
   std::string summary() const override;
+  void set_clock_origin(Time at) override;
 
   /// The STAT message the car would send now, from the last sensor reads.
   protocol::logi::Status status() const;
@@ -153,7 +155,7 @@ class LogiFirmware final : public FirmwareWith<LogiConfig, LogiState> {
   protocol::logi::Decoder decoder_;
   std::vector<protocol::logi::Item> items_;
   Time next_stat_{0};
-  /// Where the grids count from: 0, or the first connection
+  /// Where the grids count from: 0, or the run's origin or first connection
   /// (LogiConfig::grid_from_first_connection).
   std::optional<Time> grid_start_;
   Time next_control_{0};

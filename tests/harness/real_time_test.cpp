@@ -419,6 +419,50 @@ TEST(ExternalClientOrigin, AClientThatTakes2sToStartStillMeetsAWindowFromTheStar
   EXPECT_LT(closes[0].at, o.session_end) << "the hang-up came during the session";
 }
 
+// A client that answers its first action before it connects, and takes
+// 300 ms to connect: its origin is that first result line.
+constexpr const char* kAnswersBeforeConnecting = R"py(
+import os, socket, sys, time
+car = None
+for line in sys.stdin:
+    if line.strip() == "connect":
+        time.sleep(0.3)
+        car = socket.create_connection((os.environ["HIL_HOST"], int(os.environ["HIL_PORT"])))
+        print("event connection connected", flush=True)
+    print("ok", flush=True)
+)py";
+
+TEST(ExternalClientOrigin, TheCarsClockCountsFromAFirstResultLineThatCameBeforeTheConnection) {
+  const hil::test::ScratchDir dir("hil-origin-result");
+  const auto script = dir.path() / "client.py";
+  std::ofstream(script) << kAnswersBeforeConnecting;
+  Scenario s = exec_scenario(mocks::CarKind::logi, "exec python3 " + script.string(),
+                             {action("mode MAN"), action("connect"), wait(milliseconds(1300))});
+  const ScenarioOutcome o = run_scenario(s);
+  ASSERT_TRUE(o.passed()) << summary(o);
+  const auto origins = of(o, ClientKind::origin);
+  ASSERT_EQ(origins.size(), 1u) << summary(o);
+  EXPECT_EQ(origins[0].data["cause"], "result") << origins[0].data.dump();
+  const auto opens = of(o, WireKind::open);
+  ASSERT_FALSE(opens.empty());
+  EXPECT_GE(opens[0].at, origins[0].at + milliseconds(300)) << "connected 300 ms after";
+  // The car's STATs are on its 500 ms grid from the origin, as they are
+  // from time 0 with the reference client: the first at +505 ms (its
+  // 5 ms reply latency), not 500 ms after the connection (+805 ms and
+  // later). Real time: within 100 ms.
+  std::optional<Time> first_stat;
+  for (const auto& r : of(o, WireKind::frame)) {
+    if (r.data["dir"] == "to_client" && r.data["frame"].get<std::string>().starts_with("STAT")) {
+      first_stat = r.at;
+      break;
+    }
+  }
+  ASSERT_TRUE(first_stat.has_value()) << summary(o);
+  const auto after_origin = *first_stat - origins[0].at;
+  EXPECT_GE(after_origin, milliseconds(505)) << link::format_ms(*first_stat);
+  EXPECT_LT(after_origin, milliseconds(605)) << link::format_ms(*first_stat);
+}
+
 TEST(ExternalClientEnd, AProgramThatExitsLeavingTheCarMovingFailsTheRun) {
   const hil::test::ScratchDir dir("hil-end");
   const std::vector<Step> drive = {action("connect"), action("mode MAN"), action("speed 50"),

@@ -102,6 +102,32 @@ TEST(LogiFirmware, GridsFromTheFirstConnectionCountFromItAndKeepCountingAfterIt)
   EXPECT_TRUE(again->text().starts_with("LOGI:STAT:")) << again->text();
 }
 
+TEST(LogiFirmware, AClockOriginGivenBeforeTheFirstConnectionIsWhereTheGridsCountFrom) {
+  // An external client that printed a line at 700 ms (its origin) and
+  // connected only at 729 ms: the STATs are on the grid from 700 ms, at
+  // 1200 and 1700 ms, as the scenario's windows count from 700 ms.
+  LogiConfig config;
+  config.grid_from_first_connection = true;
+  VirtualCar<LogiFirmware> car(sim::logi_car(), [config](sim::World& w, sim::Vehicle& v) {
+    return std::make_unique<LogiFirmware>(w, v, config);
+  });
+  car.run_until(at_ms(700));
+  car.firmware().set_clock_origin(at_ms(700));
+  car.run_until(at_ms(729));
+  auto client = car.connect();
+  car.run_until(at_ms(1200) - link::Duration(1));
+  EXPECT_EQ(client->text(), "");
+  car.run_until(at_ms(1200));
+  EXPECT_TRUE(client->text().starts_with("LOGI:STAT:")) << client->text();
+  // Given again later (it never is), the grid stays where it is.
+  car.firmware().set_clock_origin(at_ms(1300));
+  const auto before = client->text().size();
+  car.run_until(at_ms(1700) - link::Duration(1));
+  EXPECT_EQ(client->text().size(), before);
+  car.run_until(at_ms(1700));
+  EXPECT_GT(client->text().size(), before);
+}
+
 TEST(LogiFirmware, ABootOffsetOutsideOneStatPeriodIsRefused) {
   LogiConfig config;
   config.boot_offset = link::milliseconds(501);
