@@ -134,9 +134,15 @@ void Rfc2217Server::open() {
 }
 
 void Rfc2217Server::receive(ByteView from_client) {
-  if (from_client.empty()) return;
-  telnet_recv(telnet_->state, reinterpret_cast<const char*>(from_client.data()),
-              from_client.size());
+  // A byte at a time: on input that breaks the Telnet grammar (an IAC and a
+  // command byte inside a subnegotiation) libtelnet's recovery depends on
+  // where a read ended, so the same bytes in other TCP segments could give
+  // the device other data. Fed singly they give the same whatever the
+  // segments; at serial rates the calls cost nothing that shows.
+  for (const std::uint8_t byte : from_client) {
+    const char c = static_cast<char>(byte);
+    telnet_recv(telnet_->state, &c, 1);
+  }
 }
 
 void Rfc2217Server::send_data(ByteView from_device) {

@@ -5,6 +5,7 @@
 // same line settings; and no data byte comes out that was not sent.
 
 #include <algorithm>
+#include <cstdio>
 
 #include "link/rfc2217.hpp"
 #include "tests/fuzz/fuzz_support.hpp"
@@ -43,14 +44,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   config.line.baud = 9600;
 
   Rfc2217Server whole(config);
-  whole.open();
-  whole.receive(hil::link::ByteView(stream.data(), stream.size()));
   Seen at_once;
+  whole.open();
+  drain(whole, at_once);
+  whole.receive(hil::link::ByteView(stream.data(), stream.size()));
   drain(whole, at_once);
 
   Rfc2217Server pieces(config);
-  pieces.open();
   Seen in_pieces;
+  pieces.open();
+  drain(pieces, in_pieces);
   std::size_t at = 0;
   for (std::size_t k = 0; at < stream.size(); ++k) {
     const std::size_t want = plan.empty() ? 1 : std::max<std::size_t>(1, plan[k % plan.size()]);
@@ -60,6 +63,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     at += n;
   }
 
+  if (at_once.to_device != in_pieces.to_device) {
+    for (const auto* seen : {&at_once, &in_pieces}) {
+      for (const auto b : seen->to_device)
+        std::fprintf(stderr, "%02x ", b);
+      std::fprintf(stderr, "\n");
+    }
+  }
   hil::fuzz::check(at_once.to_device == in_pieces.to_device, "device data depends on the pieces");
   hil::fuzz::check(at_once.to_client == in_pieces.to_client, "answers depend on the pieces");
   hil::fuzz::check(same_events(at_once.events, in_pieces.events), "events depend on the pieces");
