@@ -121,21 +121,22 @@ hil_add_gate_test(logi-feedback-clearing-stale-is-rejected TIMEOUT 60 CHECK
      --client-exec "${planted} any-frame-fresh")
 
 # Correct clients pass every one of those scenarios: the same Python client
-# without a bug, and hil's logi-client. Four at a time: each run is mostly
-# waiting on its scenario's clock (as the 100-repeat hunt in CMakeLists.txt).
+# without a bug, and hil's logi-client, at hil run's own width (-j auto:
+# all fourteen at once on two cores; each run is mostly waiting on its
+# scenario's clock, docs/running-scenarios.md, "How many at a time").
 hil_add_gate_test(logi-rules-python-client-passes TIMEOUT 150 CHECK
   --exit 0 --expect [=[^14 passed, 0 failed$]=]
-  -- $<TARGET_FILE:hil> run ${logi_rules_scenarios} -j 4 --client-exec ${good_py})
+  -- $<TARGET_FILE:hil> run ${logi_rules_scenarios} --client-exec ${good_py})
 hil_add_gate_test(logi-rules-logi-client-passes TIMEOUT 150 CHECK
   --exit 0 --expect [=[^14 passed, 0 failed$]=]
-  -- $<TARGET_FILE:hil> run ${logi_rules_scenarios} -j 4 --client-exec ${logi_client})
+  -- $<TARGET_FILE:hil> run ${logi_rules_scenarios} --client-exec ${logi_client})
 
 # ---- The whole library against correct clients in real time (soak) ---------
-# `hil run scenarios/logi -j 2` with an external client takes over four
-# minutes of wall time (53 to 54 scenarios on 2 cores: 4 min 16 s with
-# logi-client, 4 min 23 s with logi_good.py, 5 min 18 s with logi-client
-# started 2 s late), too long for the default stage, so these run only
-# under `ctest -C soak -L soak`, each alone. slow_start.sh makes a correct
+# `hil run scenarios/logi` with an external client takes 35 to 40 s of wall
+# time at -j auto on 2 cores (four minutes at -j 2; docs/performance.md,
+# "The gate's width"), and its 20-repeat hunts about 13 minutes each, too
+# long for the default stage, so these run only under `ctest -C soak -L
+# soak`, each alone. slow_start.sh makes a correct
 # client connect 2 s after hil started it, as a JVM or a large Python
 # program does; windows written from the run's start count from the
 # client's first connection (docs/scenarios.md), so it must pass as well.
@@ -153,15 +154,15 @@ hil_add_gate_soak_test(logi-library-passes-a-client-that-connects-2s-late TIMEOU
   --exit 0 --expect ${logi_library_verdict}
   --expect [=[^SKIP logi-manual-keepalive ]=]
   --reject [=[^logi-\S+ +FAIL]=]
-  -- $<TARGET_FILE:hil> run ${logi_library} -j 2 --client-exec ${logi_client_slow_start})
+  -- $<TARGET_FILE:hil> run ${logi_library} --client-exec ${logi_client_slow_start})
 
 # The flakiness hunt over the whole library: 20 runs of every scenario with
-# each correct client, four runs at a time (about 45 min each).
+# each correct client, at -j auto (about 13 min each).
 hil_add_gate_soak_test(logi-library-passes-logi-client-20-repeats TIMEOUT 7200 CHECK
   --exit 0 --expect ${logi_library_verdict}
   --reject [=[^logi-\S+ #[0-9]+ +(FAIL|FLAKY)]=]
-  -- $<TARGET_FILE:hil> run ${logi_library} --repeat 20 -j 4 --client-exec ${logi_client})
+  -- $<TARGET_FILE:hil> run ${logi_library} --repeat 20 --client-exec ${logi_client})
 hil_add_gate_soak_test(logi-library-passes-python-client-20-repeats TIMEOUT 7200 CHECK
   --exit 0 --expect ${logi_library_verdict}
   --reject [=[^logi-\S+ #[0-9]+ +(FAIL|FLAKY)]=]
-  -- $<TARGET_FILE:hil> run ${logi_library} --repeat 20 -j 4 --client-exec ${good_py})
+  -- $<TARGET_FILE:hil> run ${logi_library} --repeat 20 --client-exec ${good_py})
