@@ -45,6 +45,7 @@ class FaultInjector::State {
   void poll(Time now, std::vector<InjectorOutput>& out) {
     advance(now);
     queue_.pop_due(now, out);
+    if (close_due_ && *close_due_ <= now) close_due_.reset();
   }
   std::optional<Time> next_due() const;
   bool refuse_connection(Time now);
@@ -101,6 +102,8 @@ class FaultInjector::State {
   void write(Time now, std::uint64_t frame, Bytes bytes, Duration delay,
              std::optional<std::size_t> fragment_rule);
   void schedule(Time now, std::uint64_t frame, Time desired, Bytes bytes, bool joinable = false);
+  bool limit_data(Time now, std::uint64_t frame, Bytes& bytes);
+  void slow_close(Time now);
   void release_batch(Time at, std::string_view why);
   void break_after_queue(Time now, std::size_t rule, std::uint64_t frame);
   void break_at(Time at, std::size_t rule);
@@ -127,6 +130,8 @@ class FaultInjector::State {
   std::optional<Time> held_since_;
   bool finished_ = false;
   bool broken_ = false;
+  // A slow_close rule holds the end of the stream until then.
+  std::optional<Time> close_due_;
 };
 
 // ---------------------------------------------------------------- the sender's side
@@ -186,6 +191,7 @@ void FaultInjector::State::finish(Time now) {
   take_frames(now);
   if (batch_ && !broken_) release_batch(now, "sender closed");
   finished_ = true;
+  if (!broken_) slow_close(now);
 }
 
 std::optional<Time> FaultInjector::State::next_due() const {
@@ -193,6 +199,7 @@ std::optional<Time> FaultInjector::State::next_due() const {
   next.consider(queue_.next_due());
   next.consider(partial_release());
   if (batch_) next.consider(batch_->deadline);
+  next.consider(close_due_);
   // Once the sender has closed, timed rules no longer keep the link alive.
   if (!broken_ && !finished_) next.consider(rules_.next_armed());
   return next.time();
@@ -453,6 +460,9 @@ void FaultInjector::State::write(Time now, std::uint64_t frame, Bytes bytes, Dur
 /// by the bandwidth rule active then.
 void FaultInjector::State::schedule(Time now, std::uint64_t frame, Time desired, Bytes bytes,
                                     bool joinable) {
+  if (broken_) return;  // a limit reached by an earlier piece closed the link
+  const bool limit_reached = limit_data(now, frame, bytes);
+  if (limit_reached) joinable = false;
   Time t = queue_.slot(desired);
   const auto bandwidth = rules_.bandwidth_at(t);
   if (!bandwidth) {
@@ -466,6 +476,53 @@ void FaultInjector::State::schedule(Time now, std::uint64_t frame, Time desired,
     t = paced;
   }
   queue_.add(t, std::move(bytes), pushes_, joinable);
+  if (limit_reached) {
+    queue_.add_break(std::max(now, queue_.last_due()), false);
+    broken_ = true;
+  }
+}
+
+/// Counts a write against the limit_data rules active at `now`; when it
+/// reaches the smallest limit left, cuts it there, reports it and says so
+/// (the caller queues the cut write, then the close).
+bool FaultInjector::State::limit_data(Time now, std::uint64_t frame, Bytes& bytes) {
+  std::optional<std::size_t> tightest;
+  std::uint64_t room = 0;
+  for (std::size_t i = 0; i < rules_.size(); ++i) {
+    const auto* limit = rules_.action<LimitData>(i);
+    if (!limit || !rules_.applies(i) || !rules_.rule(i).window.contains(now)) continue;
+    const std::uint64_t left = limit->bytes - std::min(limit->bytes, rules_.bytes_passed(i));
+    if (!tightest || left < room) {
+      tightest = i;
+      room = left;
+    }
+  }
+  if (!tightest) return false;
+  const std::uint64_t take = std::min<std::uint64_t>(room, bytes.size());
+  for (std::size_t i = 0; i < rules_.size(); ++i) {
+    if (rules_.action<LimitData>(i) && rules_.applies(i) && rules_.rule(i).window.contains(now))
+      rules_.bytes_passed(i) += take;
+  }
+  if (take < room) return false;
+  Bytes before = bytes;
+  bytes.resize(static_cast<std::size_t>(take));
+  std::string detail = "limit of " + std::to_string(rules_.action<LimitData>(*tightest)->bytes) +
+                       " bytes reached: " + std::to_string(take) + " of " +
+                       std::to_string(before.size()) + " bytes passed, link closed";
+  emit(now, *tightest, frame, std::move(before), bytes, std::move(detail));
+  return true;
+}
+
+/// The first slow_close rule active at `now` holds the end of the stream.
+void FaultInjector::State::slow_close(Time now) {
+  for (std::size_t i = 0; i < rules_.size(); ++i) {
+    const auto* slow = rules_.action<SlowClose>(i);
+    if (!slow || !rules_.applies(i) || !rules_.rule(i).window.contains(now)) continue;
+    close_due_ = now + slow->delay;
+    emit(now, i, 0, {}, {},
+         "sender closed; the close is passed on " + format_ms(slow->delay) + " later");
+    return;
+  }
 }
 
 void FaultInjector::State::release_batch(Time at, std::string_view why) {
@@ -479,6 +536,7 @@ void FaultInjector::State::release_batch(Time at, std::string_view why) {
 void FaultInjector::State::break_after_queue(Time now, std::size_t rule, std::uint64_t frame) {
   const bool reset = rules_.action<Reset>(rule) != nullptr;
   if (batch_) release_batch(now, "link break");
+  if (broken_) return;  // the batch reached a limit_data rule's limit
   emit(now, rule, frame, {}, {},
        std::string(reset ? "reset" : "disconnect") + " after frame " + std::to_string(frame));
   queue_.add_break(std::max(now, queue_.last_due()), reset);

@@ -27,11 +27,11 @@ struct FaultEvent {
   Time at{0};
   Direction direction = Direction::to_car;
   FaultKind kind = FaultKind::drop;  ///< the kind of the rule that acted
-  std::string rule;         ///< the rule's name in the profile (or its index)
-  std::uint64_t frame = 0;  ///< the frame acted on (1-based in this direction); 0: none
-  protocol::Bytes before;   ///< the bytes the rule acted on
-  protocol::Bytes after;    ///< what was delivered instead (empty for a drop)
-  std::string detail;       ///< what happened, for a person
+  std::string rule;                  ///< the rule's name in the profile (or its index)
+  std::uint64_t frame = 0;           ///< the frame acted on (1-based in this direction); 0: none
+  protocol::Bytes before;            ///< the bytes the rule acted on
+  protocol::Bytes after;             ///< what was delivered instead (empty for a drop)
+  std::string detail;                ///< what happened, for a person
 };
 using FaultEventSink = std::function<void(const FaultEvent&)>;
 
@@ -71,6 +71,9 @@ class FaultInjector {
   /// last one.
   void push(Time now, protocol::ByteView bytes);
   /// The sender closed: whatever is held (a partial frame) is released.
+  /// Under a slow_close rule the end is held too: next_due() stays set
+  /// until `now` plus its delay, and the end of the stream is to be passed
+  /// on once next_due() is nullopt.
   void finish(Time now);
   /// Appends every output due at or before `now`, in order.
   void poll(Time now, std::vector<InjectorOutput>& out);

@@ -7,12 +7,13 @@
 
 namespace hil::link {
 
-constexpr base::EnumNames<FaultKind, 12> kFaultKindNames = base::enum_names<FaultKind>(
+constexpr base::EnumNames<FaultKind, kFaultKindCount> kFaultKindNames = base::enum_names<FaultKind>(
     {FaultKind::fragment, "fragment"}, {FaultKind::coalesce, "coalesce"},
     {FaultKind::corrupt, "corrupt"}, {FaultKind::drop, "drop"}, {FaultKind::duplicate, "duplicate"},
     {FaultKind::garbage, "garbage"}, {FaultKind::delay, "delay"}, {FaultKind::stall, "stall"},
     {FaultKind::bandwidth, "bandwidth"}, {FaultKind::disconnect, "disconnect"},
-    {FaultKind::reset, "reset"}, {FaultKind::refuse, "refuse"});
+    {FaultKind::reset, "reset"}, {FaultKind::refuse, "refuse"},
+    {FaultKind::limit_data, "limit_data"}, {FaultKind::slow_close, "slow_close"});
 
 constexpr base::EnumNames<DirectionFilter, 3> kDirectionFilterNames =
     base::enum_names<DirectionFilter>({DirectionFilter::to_car, "to_car"},
@@ -110,6 +111,12 @@ std::optional<std::string> rule_problem(const FaultRule& rule) {
   if (kind == FaultKind::bandwidth && (t.at || t.has_frame_condition())) {
     return "bandwidth applies to every write in its window and takes no trigger";
   }
+  if (kind == FaultKind::limit_data && (t.at || t.has_frame_condition())) {
+    return "limit_data counts every byte in its window and takes no trigger";
+  }
+  if (kind == FaultKind::slow_close && (t.at || t.has_frame_condition())) {
+    return "slow_close acts when the sender closes and takes no trigger";
+  }
   if (kind == FaultKind::refuse && t.has_frame_condition()) {
     return "refuse takes 'at' and 'for', not frame triggers";
   }
@@ -154,6 +161,10 @@ std::optional<std::string> rule_problem(const FaultRule& rule) {
           if (a.duration <= Duration{0}) return "'for' must be a positive duration";
         } else if constexpr (std::is_same_v<A, Bandwidth>) {
           if (a.bytes_per_second == 0) return "the rate must be positive";
+        } else if constexpr (std::is_same_v<A, LimitData>) {
+          if (a.bytes < 1) return "'bytes' must be at least 1";
+        } else if constexpr (std::is_same_v<A, SlowClose>) {
+          if (a.delay < Duration{0}) return "'delay' must not be negative";
         }
         return std::nullopt;
       },

@@ -140,8 +140,26 @@ struct Refuse {
   friend bool operator==(const Refuse&, const Refuse&) = default;
 };
 
+/// Lets the first `bytes` bytes of its direction pass (counted from when the
+/// rule is installed, in the writes the receiver gets): the write that
+/// reaches the limit is cut at it, and then the link is closed gracefully.
+struct LimitData {
+  std::uint64_t bytes = 1;
+  friend bool operator==(const LimitData&, const LimitData&) = default;
+};
+
+/// When the sender ends its stream, the end reaches the receiver `delay`
+/// later (and never before the bytes still due).
+struct SlowClose {
+  Duration delay{0};
+  friend bool operator==(const SlowClose&, const SlowClose&) = default;
+};
+
 using FaultAction = std::variant<Fragment, Coalesce, Corrupt, Drop, Duplicate, Garbage, Delay,
-                                 Stall, Bandwidth, Disconnect, Reset, Refuse>;
+                                 Stall, Bandwidth, Disconnect, Reset, Refuse, LimitData, SlowClose>;
+
+/// How many rule kinds there are (FaultKind's values are 0 to this - 1).
+inline constexpr std::size_t kFaultKindCount = std::variant_size_v<FaultAction>;
 
 /// The rule kinds, in FaultAction order.
 enum class FaultKind : std::uint8_t {
@@ -157,11 +175,13 @@ enum class FaultKind : std::uint8_t {
   disconnect,
   reset,
   refuse,
+  limit_data,
+  slow_close,
 };
 std::string_view to_string(FaultKind k);  ///< "fragment", "coalesce", ...
 std::optional<FaultKind> parse_fault_kind(std::string_view text);
 /// The same words, in FaultKind order, for listing the kinds.
-extern const base::EnumNames<FaultKind, 12> kFaultKindNames;
+extern const base::EnumNames<FaultKind, kFaultKindCount> kFaultKindNames;
 FaultKind kind_of(const FaultAction& action);
 
 /// Which frames a rule acts on (or, with `at`, when it fires). Every
@@ -182,6 +202,7 @@ struct Trigger {
   /// Chance in [0, 1] for each frame that passed the rest.
   std::optional<double> probability;
   /// Time trigger (stall, disconnect, reset, refuse): run time it fires at.
+  /// Bandwidth, limit_data and slow_close take no trigger.
   std::optional<Time> at;
 
   bool has_frame_condition() const {

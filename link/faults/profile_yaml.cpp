@@ -56,6 +56,10 @@ std::set<std::string, std::less<>> keys_of(FaultKind kind) {
     case FaultKind::bandwidth:
       // Applies to every write in its window: no frame triggers.
       return {"kind", "name", "direction", "from", "to", "bytes_per_second", "baud"};
+    case FaultKind::limit_data:
+      return {"kind", "name", "direction", "from", "to", "bytes"};
+    case FaultKind::slow_close:
+      return {"kind", "name", "direction", "from", "to", "delay"};
     case FaultKind::refuse:
       keys = kTimeKeys;
       keys.insert("for");
@@ -89,8 +93,7 @@ class RuleReader : config::ItemReader {
     if (auto n = get("from")) rule.window.from = duration(*n, "from");
     if (auto n = get("to")) {
       rule.window.to = duration(*n, "to");
-      if (*rule.window.to <= rule.window.from)
-        bad(*n, "'to' must be after 'from'");
+      if (*rule.window.to <= rule.window.from) bad(*n, "'to' must be after 'from'");
     }
     read_trigger(rule.trigger);
     read_action(rule.action);
@@ -179,9 +182,13 @@ class RuleReader : config::ItemReader {
       case FaultKind::reset:
         return Reset{};
       case FaultKind::refuse:
+        return Refuse{};
+      case FaultKind::limit_data:
+        return LimitData{};
+      case FaultKind::slow_close:
         break;
     }
-    return Refuse{};
+    return SlowClose{};
   }
 
   void read_action(FaultAction& action) {
@@ -272,6 +279,16 @@ class RuleReader : config::ItemReader {
     // A serial byte is 10 bits on the wire (start, 8 data, stop: 8N1).
     if (baud) a.bytes_per_second = std::max<std::uint64_t>(1, count(*baud, "baud", 10) / 10);
   }
+  void read(LimitData& a) {
+    const auto n = get("bytes");
+    if (!n) bad(node_, "'bytes' is missing (how many bytes pass before the link closes)");
+    a.bytes = count(*n, "bytes");
+  }
+  void read(SlowClose& a) {
+    const auto n = get("delay");
+    if (!n) bad(node_, "'delay' is missing (how long the close is held, like 500ms)");
+    a.delay = duration(*n, "delay");
+  }
   void read(Disconnect&) {}
   void read(Reset&) {}
 
@@ -285,6 +302,16 @@ class RuleReader : config::ItemReader {
 };
 
 }  // namespace
+
+std::vector<std::string> rule_keys(FaultKind kind) {
+  const auto keys = keys_of(kind);
+  return {keys.begin(), keys.end()};
+}
+
+FaultRule parse_fault_rule(const YAML::Node& node, const std::string& source_name,
+                           std::size_t index) {
+  return RuleReader(source_name, node, index).read();
+}
 
 FaultProfile parse_fault_profile(const YAML::Node& node, const std::string& source_name) {
   YAML::Node rules = node;

@@ -7,11 +7,21 @@
 namespace hil::link::faults {
 
 void RuleBook::install(FaultProfile profile, Direction d, Time now) {
+  std::vector<std::pair<FaultRule, std::uint64_t>> kept;  // limit_data rules and their counts
+  for (std::size_t i = 0; i < profile_.rules.size(); ++i) {
+    const auto& rule = profile_.rules[i];
+    if (action<LimitData>(i) && !rule.name.empty()) kept.emplace_back(rule, state_[i].bytes_passed);
+  }
   profile_ = std::move(profile);
   state_.assign(profile_.rules.size(), RuleState{});
   for (std::size_t i = 0; i < profile_.rules.size(); ++i) {
     const auto& rule = profile_.rules[i];
     auto& st = state_[i];
+    if (action<LimitData>(i)) {
+      for (const auto& [old, passed] : kept) {
+        if (old.name == rule.name && old.action == rule.action) st.bytes_passed = passed;
+      }
+    }
     st.applies = applies_to(rule.direction, d);
     if (!st.applies || !rule.trigger.at || *rule.trigger.at < now) continue;
     const FaultKind k = rule.kind();

@@ -22,7 +22,9 @@ class RuleBook {
  public:
   /// Replaces the rules with `profile` (already valid) for direction `d`.
   /// The time triggers still to come at `now` are armed; every counter
-  /// starts again.
+  /// starts again, except the bytes a limit_data rule has let pass when the
+  /// new profile keeps that rule (same name, same limit): a link's limit
+  /// is not lifted by changing its other rules.
   void install(FaultProfile profile, Direction d, Time now);
 
   const FaultProfile& profile() const { return profile_; }
@@ -61,15 +63,19 @@ class RuleBook {
   /// When the next armed rule fires.
   std::optional<Time> next_armed() const;
 
+  /// Bytes limit_data rule `i` has let pass so far.
+  std::uint64_t& bytes_passed(std::size_t i) { return state_[i].bytes_passed; }
+
   /// The refuse rule that refuses a connection at `now`, and when its
   /// refusal ends.
   std::optional<std::pair<std::size_t, Time>> refusing(Time now) const;
 
  private:
   struct RuleState {
-    bool applies = false;       // the rule is for this direction
-    bool armed = false;         // a time trigger still to fire
-    std::uint64_t matched = 0;  // frames that passed window and match
+    bool applies = false;            // the rule is for this direction
+    bool armed = false;              // a time trigger still to fire
+    std::uint64_t matched = 0;       // frames that passed window and match
+    std::uint64_t bytes_passed = 0;  // limit_data: bytes let through
   };
 
   FaultProfile profile_;

@@ -215,11 +215,11 @@ TEST(ScenarioYamlMatchers, FaultAndCarEvents) {
       {head + "{fault: dorp}\n",
        "t.yaml:5:13: expectation 1: 'fault': unknown fault kind 'dorp' (known: fragment, "
        "coalesce, corrupt, drop, duplicate, garbage, delay, stall, bandwidth, disconnect, "
-       "reset, refuse); did you mean 'drop'?"},
+       "reset, refuse, limit_data, slow_close); did you mean 'drop'?"},
       {head + "{fault: {kind: corupt}}\n",
        "t.yaml:5:20: expectation 1: 'fault': 'kind': unknown fault kind 'corupt' (known: "
        "fragment, coalesce, corrupt, drop, duplicate, garbage, delay, stall, bandwidth, "
-       "disconnect, reset, refuse); did you mean 'corrupt'?"},
+       "disconnect, reset, refuse, limit_data, slow_close); did you mean 'corrupt'?"},
   });
 }
 

@@ -30,10 +30,11 @@ namespace gen = rc::gen;
 
 /// Which faults a generated profile may contain.
 enum class Mix {
-  lossless,    ///< fragment, coalesce, delay, stall, bandwidth: the bytes arrive unchanged
+  lossless,    ///< fragment, coalesce, delay, stall, bandwidth, slow_close: the bytes arrive
+               ///< unchanged
   frame_safe,  ///< also faults that keep frame boundaries: whole-frame drops, duplicates,
                ///< format-keeping corruption, garbage the decoder resynchronises past, breaks
-  all,         ///< every kind, blind corruption and byte drops included
+  all,         ///< every kind, blind corruption, byte drops and limit_data included
 };
 
 /// "wr8/svgui-head" is WR8 in that profile; any other name the protocol's default.
@@ -196,8 +197,9 @@ Trigger gen_frame_trigger(const std::vector<std::string>& kinds) {
 
 /// One rule of `mix` for frames of `protocol` (whose kinds are `kinds`).
 FaultRule gen_rule(Mix mix, const std::string& protocol, const std::vector<std::string>& kinds) {
-  std::vector<FaultKind> choices = {FaultKind::fragment, FaultKind::coalesce, FaultKind::delay,
-                                    FaultKind::stall, FaultKind::bandwidth};
+  std::vector<FaultKind> choices = {FaultKind::fragment,  FaultKind::coalesce,
+                                    FaultKind::delay,     FaultKind::stall,
+                                    FaultKind::bandwidth, FaultKind::slow_close};
   if (mix != Mix::lossless) {
     choices.insert(choices.end(), {FaultKind::drop, FaultKind::duplicate, FaultKind::corrupt,
                                    FaultKind::disconnect, FaultKind::reset});
@@ -205,7 +207,7 @@ FaultRule gen_rule(Mix mix, const std::string& protocol, const std::vector<std::
     // read as a length byte).
     if (mix == Mix::all || !protocol.starts_with("wr8")) choices.push_back(FaultKind::garbage);
   }
-  if (mix == Mix::all) choices.push_back(FaultKind::refuse);
+  if (mix == Mix::all) choices.insert(choices.end(), {FaultKind::refuse, FaultKind::limit_data});
 
   FaultRule r;
   r.trigger = gen_frame_trigger(kinds);
@@ -286,6 +288,14 @@ FaultRule gen_rule(Mix mix, const std::string& protocol, const std::vector<std::
       if (mix == Mix::all && *gen::arbitrary<bool>()) r.trigger = timed(*gen_ms(0, 400));
       break;
     }
+    case FaultKind::slow_close:
+      r.trigger = {};
+      r.action = SlowClose{*gen_ms(0, 50)};
+      break;
+    case FaultKind::limit_data:
+      r.trigger = {};
+      r.action = LimitData{*gen::inRange<std::uint64_t>(1, 400)};
+      break;
     default:
       r.trigger = timed(*gen_ms(0, 100));
       r.action = Refuse{*gen_ms(1, 100)};
@@ -380,6 +390,7 @@ RC_GTEST_PROP(FaultProperties, EventsAccountForEveryDeliveredByte, ()) {
   std::vector<Bytes> now(c.frames.begin(),
                          c.frames.begin() + static_cast<std::ptrdiff_t>(frames_seen));
   std::optional<Bytes> lost_at_break;
+  std::optional<FaultEvent> limit;  // the limit_data event that closed the link
   for (const auto& e : run.events) {
     RC_ASSERT(e.direction == Direction::to_car);
     if (changes_bytes(e.kind)) {
@@ -388,6 +399,11 @@ RC_GTEST_PROP(FaultProperties, EventsAccountForEveryDeliveredByte, ()) {
       now[e.frame - 1] = e.after;
     } else if ((e.kind == FaultKind::disconnect || e.kind == FaultKind::reset) && e.frame == 0) {
       lost_at_break = e.before;
+    } else if (e.kind == FaultKind::limit_data) {
+      RC_ASSERT(!limit);
+      RC_ASSERT(e.after.size() <= e.before.size());
+      RC_ASSERT(std::equal(e.after.begin(), e.after.end(), e.before.begin()));
+      limit = e;
     } else {
       RC_ASSERT(e.before == e.after);
     }
@@ -398,6 +414,22 @@ RC_GTEST_PROP(FaultProperties, EventsAccountForEveryDeliveredByte, ()) {
     RC_ASSERT(std::equal(lost_at_break->begin(), lost_at_break->end(),
                          expected.end() - static_cast<std::ptrdiff_t>(lost_at_break->size())));
     expected.resize(expected.size() - lost_at_break->size());
+  }
+  RC_CLASSIFY(limit.has_value(), "limit reached");
+  if (limit) {
+    // The stream is cut inside the write that reached the limit: what was
+    // delivered ends with the part of it that passed, and the rest of the
+    // write (and whatever came after it) is what the events leave unsent.
+    RC_ASSERT(!lost_at_break);
+    const Bytes delivered = run.delivered();
+    RC_ASSERT(delivered.size() >= limit->after.size());
+    const std::size_t write_begins = delivered.size() - limit->after.size();
+    RC_ASSERT(expected.size() >= write_begins + limit->before.size());
+    RC_ASSERT(std::equal(delivered.begin(), delivered.end(), expected.begin()));
+    RC_ASSERT(std::equal(limit->before.begin(), limit->before.end(),
+                         expected.begin() + static_cast<std::ptrdiff_t>(write_begins)));
+    RC_ASSERT(run.link_break() != nullptr && !run.link_break()->reset);
+    return;
   }
   RC_ASSERT(run.delivered() == expected);
   if (!run.link_break()) RC_ASSERT(frames_seen == c.frames.size());

@@ -183,6 +183,48 @@ TEST(FaultProfileYaml, EachProblemIsReported) {
   }
 }
 
+TEST(FaultProfileYaml, LimitDataAndSlowCloseTakeTheirKeysAndNoTriggers) {
+  const auto p = parse_fault_profile_text(R"(
+- kind: limit_data
+  direction: to_client
+  bytes: 1024
+  from: 1s
+- kind: slow_close
+  delay: 1.5s
+)",
+                                          "faults.yaml");
+  ASSERT_EQ(p.rules.size(), 2U);
+  EXPECT_EQ(p.rules[0].kind(), FaultKind::limit_data);
+  EXPECT_EQ(std::get<LimitData>(p.rules[0].action).bytes, 1024U);
+  EXPECT_EQ(p.rules[0].direction, DirectionFilter::to_client);
+  EXPECT_EQ(p.rules[0].window.from, Time{1s});
+  EXPECT_EQ(std::get<SlowClose>(p.rules[1].action).delay, Duration{1500ms});
+
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"- kind: limit_data\n", "1:3: rule 1 (limit_data): 'bytes' is missing"},
+      {"- kind: limit_data\n  bytes: 0\n",
+       "2:10: rule 1 (limit_data): 'bytes' must be a whole number >= 1"},
+      {"- kind: limit_data\n  bytes: 10\n  first: 1\n", "unknown key 'first'"},
+      {"- kind: slow_close\n", "'delay' is missing"},
+      {"- kind: slow_close\n  delay: 500\n",
+       "2:10: rule 1 (slow_close): 'delay' must be a duration"},
+      {"- kind: slow_close\n  delay: 1s\n  at: 2s\n", "unknown key 'at'"},
+  };
+  for (const auto& [yaml, part] : cases) {
+    SCOPED_TRACE(yaml);
+    EXPECT_THAT(error_of(yaml), HasSubstr(part));
+  }
+}
+
+TEST(FaultProfileYaml, OneRuleAndTheKeysOfAKind) {
+  const auto rule = parse_fault_rule(YAML::Load("{kind: drop, first: 2}"), "api");
+  EXPECT_EQ(rule.kind(), FaultKind::drop);
+  EXPECT_EQ(rule.trigger.first, 2U);
+  EXPECT_THROW(parse_fault_rule(YAML::Load("{kind: drop, frist: 2}"), "api"), config::ConfigError);
+  EXPECT_EQ(rule_keys(FaultKind::limit_data),
+            (std::vector<std::string>{"bytes", "direction", "from", "kind", "name", "to"}));
+}
+
 TEST(FaultProfileYaml, MissingFileSaysSo) {
   try {
     load_fault_profile("/nonexistent/faults.yaml");
