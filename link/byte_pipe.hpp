@@ -30,11 +30,24 @@ enum class CloseMode : std::uint8_t {
 class BytePipe {
  public:
   struct Handlers {
+    Handlers() = default;
+    /// Most users take bytes and the close only: `{on_data, on_close}`.
+    Handlers(std::function<void(ByteView)> data, std::function<void(std::error_code)> close = {},
+             std::function<void()> end = {})
+        : on_data(std::move(data)), on_close(std::move(close)), on_end(std::move(end)) {}
+
     /// Bytes from the peer, in order, in whatever pieces they arrived.
     std::function<void(ByteView)> on_data;
     /// The stream ended: peer closed (error_code is eof or a reset), or
     /// close() was called here (operation_aborted). Called once.
     std::function<void(std::error_code)> on_close;
+    /// The peer finished sending (TCP FIN) and may still read: this end
+    /// stays open for writing until shutdown_send() or close(). Called at
+    /// most once, and only when set and the transport can half-close (TCP,
+    /// mem pipes); otherwise the peer's end is on_close(eof) as usual.
+    /// Once the peer has ended and shutdown_send() was called here, the
+    /// pipe closes itself: on_close(eof), after on_end.
+    std::function<void()> on_end;
   };
 
   virtual ~BytePipe() = default;
@@ -45,6 +58,12 @@ class BytePipe {
   /// Queues bytes for the peer; never blocks. Ignored once closed.
   virtual void write(ByteView bytes) = 0;
   virtual void close(CloseMode mode = CloseMode::graceful) = 0;
+  /// Half-close: sends the end of the stream after what is queued (TCP:
+  /// FIN once the queue is flushed) and keeps reading; later writes are
+  /// ignored. Transports that cannot half-close (a pty, RFC 2217), and mem
+  /// pipes whose peer does not take on_end, close(graceful) instead:
+  /// is_open() is false at once when that happened.
+  virtual void shutdown_send() { close(CloseMode::graceful); }
   virtual bool is_open() const = 0;
   /// Caps the send backlog at `bytes` (0: no cap, the default): a write
   /// that would queue more aborts the pipe and on_close gets

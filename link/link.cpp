@@ -81,6 +81,10 @@ void Link::start(Time opened_at) {
                                                     [weak, d](std::error_code ec) {
                                                       if (auto self = weak.lock())
                                                         self->on_side_closed(d, ec);
+                                                    },
+                                                    [weak, d] {
+                                                      if (auto self = weak.lock())
+                                                        self->on_side_ended(d, Ended::half);
                                                     }});
   }
   // Timed rules (a reset at 7 s, a stall at 5 s) fire even on a quiet link.
@@ -121,8 +125,8 @@ void Link::pump(Direction d) {
     }
   }
   hold_back_if_full(d);
-  if (draining_[index(d)] && !injectors_[index(d)]->next_due()) {
-    shut(LinkClose{side_of(d), CloseMode::graceful, side_name(d) + " closed"});
+  if (ended_[index(d)] != Ended::no && !passed_[index(d)] && !injectors_[index(d)]->next_due()) {
+    pass_end(d);
     return;
   }
   schedule(d);
@@ -167,16 +171,60 @@ void Link::hold_back_if_full(Direction d) {
 
 void Link::on_side_closed(Direction d, std::error_code ec) {
   if (!open_) return;
-  if (ec && ec != end_of_stream()) {
+  if (ec && ec != end_of_stream() && ec != closed_here()) {
     shut(LinkClose{side_of(d), CloseMode::reset,
                    side_name(d) + " connection failed: " + ec.message()});
     return;
   }
-  // The sender is gone; what it sent and the injector still holds (delays,
-  // a partial frame) is delivered before the other side is closed.
-  draining_[index(d)] = true;
+  // The sender closed outright (eof from a pipe without half-closes), or
+  // a receiver that could not half-close was closed instead
+  // (closed_here()). After on_end, eof is only the pipe closing itself
+  // once both of its directions ended: nothing new then.
+  on_side_ended(d, Ended::closed);
+}
+
+void Link::on_side_ended(Direction d, Ended how) {
+  if (!open_ || ended_[index(d)] != Ended::no) return;
+  // The sender has ended; what it sent and the injector still holds
+  // (delays, a partial frame, a slow close) is delivered before the end is
+  // passed on.
+  const Direction other = d == Direction::to_car ? Direction::to_client : Direction::to_car;
+  if (ended_[index(other)] == Ended::no) first_ended_ = d;
+  ended_[index(d)] = how;
   injectors_[index(d)]->finish(executor_.now());
   pump(d);
+}
+
+void Link::pass_end(Direction d) {
+  const Direction other = d == Direction::to_car ? Direction::to_client : Direction::to_car;
+  if (passed_[index(other)]) {
+    // The other direction's end was passed on already: both are over. The
+    // receiver gets this end as it got the first (on_end for a TCP or mem
+    // peer), after what was delivered, then the link closes.
+    pipes_[index(d)]->shutdown_send();
+    const Direction second = first_ended_ == d ? other : d;
+    shut(LinkClose{side_of(first_ended_), CloseMode::graceful,
+                   side_name(first_ended_) + " and " + side_name(second) + " closed"});
+    return;
+  }
+  if (ended_[index(d)] == Ended::closed) {
+    // The sender closed outright (or cannot half-close): it reads nothing
+    // more, so the link ends, as it always did.
+    shut(LinkClose{side_of(d), CloseMode::graceful, side_name(d) + " closed"});
+    return;
+  }
+  passed_[index(d)] = true;
+  pipes_[index(d)]->shutdown_send();
+  if (!pipes_[index(d)]->is_open() && ended_[index(other)] == Ended::no) {
+    // The receiver cannot half-close (a pty): it was closed instead, and
+    // the link ends with it. (A receiver whose own peer has ended closes
+    // itself here: the other direction still finishes.)
+    shut(LinkClose{side_of(d), CloseMode::graceful, side_name(d) + " closed"});
+    return;
+  }
+  const Time now = executor_.now();
+  for (const auto& o : observers_)
+    o->on_half_close(now, d);
 }
 
 void Link::shut(LinkClose close) {

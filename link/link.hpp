@@ -42,6 +42,10 @@ class LinkObserver {
   /// Bytes handed to the receiving side, after faults.
   virtual void on_delivered(Time /*at*/, Direction /*d*/, protocol::ByteView /*bytes*/) {}
   virtual void on_fault(const FaultEvent& /*event*/) {}
+  /// Direction d's sender ended its stream (TCP FIN) while still reading,
+  /// and the end was passed on to the receiver after everything it sent:
+  /// the other direction keeps flowing until it ends too.
+  virtual void on_half_close(Time /*at*/, Direction /*d*/) {}
   /// The link closed: who closed it, how, and why.
   virtual void on_close(Time /*at*/, const LinkClose& /*close*/) {}
 };
@@ -102,8 +106,14 @@ class Link : public std::enable_shared_from_this<Link> {
  private:
   Link(Executor& executor, BytePipePtr client, BytePipePtr car, LinkOptions options);
   struct Side;
+  /// How a direction's sender ended: not yet, with a half-close (it may
+  /// still read), or with a close.
+  enum class Ended : std::uint8_t { no, half, closed };
+
   void on_bytes(Direction d, protocol::ByteView bytes);
+  void on_side_ended(Direction d, Ended how);
   void on_side_closed(Direction from, std::error_code ec);
+  void pass_end(Direction d);
   void pump(Direction d);
   void schedule(Direction d);
   void hold_back_if_full(Direction d);
@@ -114,8 +124,10 @@ class Link : public std::enable_shared_from_this<Link> {
   std::unique_ptr<FaultInjector> injectors_[2];
   Executor::TimerId timers_[2] = {0, 0};
   Time timer_due_[2] = {Time{-1}, Time{-1}};
-  bool draining_[2] = {false, false};   // the sender of that direction has closed
-  bool held_back_[2] = {false, false};  // that direction's sender is not being read
+  Ended ended_[2] = {Ended::no, Ended::no};  // how that direction's sender ended
+  bool passed_[2] = {false, false};          // its half-close reached the receiver (shutdown_send)
+  Direction first_ended_ = Direction::to_car;  // whose sender ended first
+  bool held_back_[2] = {false, false};         // that direction's sender is not being read
   std::vector<std::shared_ptr<LinkObserver>> observers_;
   LinkStats stats_;
   bool open_ = false;

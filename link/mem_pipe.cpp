@@ -32,7 +32,7 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
   }
 
   void write(ByteView bytes) override {
-    if (!open_ || bytes.empty()) return;
+    if (!open_ || send_ended_ || bytes.empty()) return;
     auto peer = peer_.lock();
     if (!peer) return;
     in_flight_ += bytes.size();
@@ -55,16 +55,27 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
         line_.clear();
         in_flight_ = 0;
         watching_line_ = false;
-        close_after_line_ = false;
+        end_after_line_ = End::none;
         executor_.post(
             [peer] { peer->remote_closed(std::make_error_code(std::errc::connection_reset)); });
-      } else if (watching_line_) {
-        close_after_line_ = true;  // the end of the stream follows the bytes on the line
-      } else {
-        executor_.post([peer] { peer->remote_closed(end_of_stream()); });
+      } else if (!send_ended_) {
+        send_end(End::close);
       }
     }
     executor_.post([self = shared_from_this()] { self->notify_close(closed_here()); });
+  }
+
+  void shutdown_send() override {
+    if (!open_ || send_ended_) return;
+    auto peer = peer_.lock();
+    // An end that cannot take a half-close sees a close, as before.
+    if (!peer || !peer->takes_half_close()) {
+      close(CloseMode::graceful);
+      return;
+    }
+    send_ended_ = true;
+    send_end(End::half);
+    if (peer_ended_) close_both_ended();
   }
 
   bool is_open() const override { return open_; }
@@ -72,6 +83,53 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
   std::string describe() const override { return "mem " + name_; }
 
  private:
+  /// How this end's stream ends at the peer: a close, or a half-close the
+  /// peer may still answer.
+  enum class End : std::uint8_t { none, close, half };
+
+  bool takes_half_close() const { return started_ && handlers_.on_end && !closed_notified_; }
+
+  /// The end of this end's stream reaches the peer after the bytes
+  /// written before it (after those still on a paced line).
+  void send_end(End end) {
+    if (watching_line_) {
+      end_after_line_ = end;
+      return;
+    }
+    post_end(end);
+  }
+
+  void post_end(End end) {
+    auto peer = peer_.lock();
+    if (!peer || end == End::none) return;
+    if (end == End::half) {
+      executor_.post([peer] { peer->remote_ended(); });
+    } else {
+      executor_.post([peer] { peer->remote_closed(end_of_stream()); });
+    }
+  }
+
+  /// The peer half-closed: on_end, and the pipe stays open for writing
+  /// until shutdown_send() or close().
+  void remote_ended() {
+    if (closed_notified_ || peer_ended_) return;
+    if (!handlers_.on_end) {
+      remote_closed(end_of_stream());
+      return;
+    }
+    peer_ended_ = true;
+    auto on_end = handlers_.on_end;  // the handler may close the pipe
+    on_end();
+    if (send_ended_) close_both_ended();
+  }
+
+  /// Both directions have ended: the pipe is over.
+  void close_both_ended() {
+    if (!open_) return;
+    open_ = false;
+    executor_.post([self = shared_from_this()] { self->notify_close(end_of_stream()); });
+  }
+
   /// While bytes are on a paced line, a timer on the executor holds this
   /// end until they are all out (so what was written arrives even if its
   /// owner lets go of it, and nothing is held once the executor is gone);
@@ -86,11 +144,7 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
     watching_line_ = true;
     line_.when_drained([this] {
       watching_line_ = false;
-      if (!close_after_line_) return;
-      close_after_line_ = false;
-      if (auto peer = peer_.lock()) {
-        executor_.post([peer] { peer->remote_closed(end_of_stream()); });
-      }
+      post_end(std::exchange(end_after_line_, End::none));
     });
   }
 
@@ -147,8 +201,10 @@ class MemPipe final : public BytePipe, public std::enable_shared_from_this<MemPi
   SerialPacer line_;  // this end's writes; unused when unpaced
   Executor::TimerId keep_timer_ = 0;
   bool watching_line_ = false;
-  bool close_after_line_ = false;
+  End end_after_line_ = End::none;  // the end to send once the line is drained
   bool open_ = true;
+  bool send_ended_ = false;  // shutdown_send(): the peer has this end's end
+  bool peer_ended_ = false;  // on_end was called
   bool started_ = false;
   bool discard_ = false;
   bool closed_notified_ = false;

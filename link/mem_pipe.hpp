@@ -3,7 +3,9 @@
 // tests: bytes written at one end reach the other end as a task on the
 // executor, in order, in the pieces they were written; on a paced line
 // (mem://name?baud=N) each byte arrives once its last bit is sent, as on a
-// serial line (link/serial_pacer.hpp), in the chunks due at each tick.
+// serial line (link/serial_pacer.hpp), in the chunks due at each tick. A
+// half-close (shutdown_send) reaches a peer end that takes on_end as
+// on_end, after the bytes written before it; close() is always a close.
 
 #include <map>
 #include <memory>

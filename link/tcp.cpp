@@ -49,11 +49,11 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
 
   void start(Handlers handlers) override {
     handlers_ = std::move(handlers);
-    if (!reading_ && state_ != State::closed) read();
+    if (!reading_ && !peer_done_ && state_ != State::closed) read();
   }
 
   void write(ByteView bytes) override {
-    if (state_ != State::open || bytes.empty()) return;
+    if (state_ != State::open || send_ended_ || bytes.empty()) return;
     if (send_limit_ != 0 && queued_ + bytes.size() > send_limit_) {
       // The peer stopped reading: dropping it bounds what it can cost.
       abort(true);
@@ -78,6 +78,12 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     }
   }
 
+  void shutdown_send() override {
+    if (state_ != State::open || send_ended_) return;
+    send_ended_ = true;
+    if (!writing_) send_fin();
+  }
+
   bool is_open() const override { return state_ == State::open; }
   void set_send_limit(std::size_t bytes) override { send_limit_ = bytes; }
   std::size_t queued_bytes() const override { return queued_; }
@@ -87,7 +93,7 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   void resume_reading() override {
     if (!paused_) return;
     paused_ = false;
-    if (state_ == State::open && !reading_) read();
+    if (state_ == State::open && !reading_ && !peer_done_) read();
   }
   void when_drained_to(std::size_t bytes, std::function<void()> callback) override {
     if (state_ == State::closed || !callback) return;
@@ -173,9 +179,20 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
     if (!ec) {
       read();
     } else if (ec == asio::error::eof) {
+      peer_done_ = true;
+      if (handlers_.on_end) {
+        // A half-close: the peer may still read, so this end stays open
+        // for writing until shutdown_send() or close().
+        auto on_end = handlers_.on_end;  // the handler may close the pipe
+        on_end();
+        if (state_ == State::open && fin_sent_) {
+          abort(false);
+          notify_close(ec);
+        }
+        return;
+      }
       // The peer will send nothing more. What we queued still goes out
       // (it may be reading until our FIN), then we close.
-      peer_done_ = true;
       close_gracefully();
       notify_close(ec);
     } else {
@@ -214,7 +231,21 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
       write_queued();
     } else if (state_ == State::flushing) {
       shut_down_send();
+    } else if (send_ended_ && !fin_sent_) {
+      send_fin();
     }
+  }
+
+  /// shutdown_send()'s FIN, once the queue is out; the pipe stays open
+  /// for reading. If the peer has ended too, both directions are over.
+  void send_fin() {
+    std::error_code ignored;
+    socket_.shutdown(tcp::socket::shutdown_send, ignored);
+    fin_sent_ = true;
+    if (!peer_done_) return;
+    abort(false);
+    asio::post(socket_.get_executor(),
+               [self = shared_from_this()] { self->notify_close(end_of_stream()); });
   }
 
   void shut_down_send() {
@@ -254,6 +285,8 @@ class TcpPipe final : public BytePipe, public std::enable_shared_from_this<TcpPi
   bool reading_ = false;
   bool writing_ = false;
   bool peer_done_ = false;
+  bool send_ended_ = false;  // shutdown_send() called: writes are ignored
+  bool fin_sent_ = false;    // shutdown_send()'s FIN is out
   bool close_notified_ = false;
   bool paused_ = false;  // pause_reading(): readable input stays in the kernel
   // A deque keeps each queued buffer in place while an async_write uses it.

@@ -123,6 +123,8 @@ void PcapWriter::begin(Time at) {
   car_.port = options_.car_port;
   client_.next_seq = kClientIsn;
   car_.next_seq = kCarIsn;
+  client_.fin_sent = false;
+  car_.fin_sent = false;
   ++connections_;
   open_ = true;
   reset_seen_ = false;
@@ -154,6 +156,16 @@ void PcapWriter::on_fault(const FaultEvent& event) {
   if (event.kind == FaultKind::reset) reset_seen_ = true;
 }
 
+void PcapWriter::on_half_close(Time at, Direction d) {
+  if (!open_) begin(at);
+  Side& sender = d == Direction::to_car ? client_ : car_;
+  Side& receiver = d == Direction::to_car ? car_ : client_;
+  if (sender.fin_sent) return;
+  write_segment(at, sender, receiver, kFin | kAck, {}, false);
+  write_segment(at, receiver, sender, kAck, {}, false);
+  sender.fin_sent = true;
+}
+
 void PcapWriter::on_close(Time at, const LinkClose& close) {
   if (!open_) return;
   // A link broken by hil or by a fault is drawn as the client's doing.
@@ -163,6 +175,14 @@ void PcapWriter::on_close(Time at, const LinkClose& close) {
   const bool reset = reset_seen_ || close.mode == CloseMode::reset;
   if (reset) {
     write_segment(at, closer, other, kRst | kAck, {}, false);
+  } else if (closer.fin_sent || other.fin_sent) {
+    // A half-close came first: the side still sending ends now.
+    Side& last = closer.fin_sent ? other : closer;
+    Side& first = closer.fin_sent ? closer : other;
+    if (!last.fin_sent) {
+      write_segment(at, last, first, kFin | kAck, {}, false);
+      write_segment(at, first, last, kAck, {}, false);
+    }
   } else {
     write_segment(at, closer, other, kFin | kAck, {}, false);
     write_segment(at, other, closer, kFin | kAck, {}, false);

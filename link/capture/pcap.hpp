@@ -57,9 +57,13 @@ class PcapWriter final : public LinkObserver {
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override;
   /// Remembers "reset" faults, so the close is written as a reset.
   void on_fault(const FaultEvent& event) override;
+  /// Writes the FIN of the side that sends in `d` (the client's for
+  /// to_car) and the other side's ACK; the other direction's data follows.
+  void on_half_close(Time at, Direction d) override;
   /// Writes FIN, FIN, ACK; or one RST when the link was reset (or a "reset"
   /// fault was seen). The car's side closes when the car closed the link,
-  /// the client's side in every other case.
+  /// the client's side in every other case. After a half-close only the
+  /// side that has not sent its FIN yet does: FIN, ACK.
   void on_close(Time at, const LinkClose& close) override;
 
   /// The first write error, if any.
@@ -72,6 +76,7 @@ class PcapWriter final : public LinkObserver {
     std::uint16_t port = 0;
     std::uint32_t next_seq = 0;  // the next sequence number this side sends
     std::uint16_t ip_id = 0;
+    bool fin_sent = false;
   };
 
   PcapWriter(CaptureFile file, std::uint32_t client_address, std::uint32_t car_address,

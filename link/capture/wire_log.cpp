@@ -169,26 +169,42 @@ void WireLog::on_close(Time at, const LinkClose& close) {
   r["reason"] = close.reason;
   // A partial frame still held at close is the last thing a reader of the
   // log wants to miss ("the car cut the STAT frame in half"): list it.
+  auto leftovers = unfinished({Direction::to_car, Direction::to_client});
+  if (!leftovers.empty()) r["unfinished"] = std::move(leftovers);
+  write_line(r);
+}
+
+void WireLog::on_half_close(Time at, Direction d) {
+  auto r = record("half_close", at);
+  r["dir"] = std::string(to_string(d));
+  r["by"] = d == Direction::to_car ? "client" : "car";
+  // Nothing more comes in this direction: a partial frame is final now.
+  auto leftovers = unfinished({d});
+  if (!leftovers.empty()) r["unfinished"] = std::move(leftovers);
+  write_line(r);
+}
+
+nlohmann::ordered_json WireLog::unfinished(std::initializer_list<Direction> dirs) {
   auto leftovers = nlohmann::ordered_json::array();
   for (std::size_t kind = 0; kind < 2; ++kind) {
-    for (std::size_t dir = 0; dir < 2; ++dir) {
-      auto& splitter = splitters_[kind][dir];
+    for (const auto d : dirs) {
+      auto& splitter = splitters_[kind][index_of(d)];
       if (!splitter) continue;
       std::vector<WireFrame> frames;
       splitter->finish(frames);
       if (frames.empty()) continue;
       leftovers.push_back({{"event", kStageNames[kind]},
-                           {"dir", std::string(to_string(static_cast<Direction>(dir)))},
+                           {"dir", std::string(to_string(d))},
                            {"frames", frames_json(frames)}});
     }
   }
-  if (!leftovers.empty()) r["unfinished"] = std::move(leftovers);
-  write_line(r);
+  return leftovers;
 }
 
 void WireLog::on_note(Time at, const char* event, const nlohmann::ordered_json& fields) {
   auto r = record(event, at);
-  for (const auto& [key, value] : fields.items()) r[key] = value;
+  for (const auto& [key, value] : fields.items())
+    r[key] = value;
   write_line(r);
 }
 
@@ -199,8 +215,8 @@ void WireLog::write_line(const nlohmann::ordered_json& record) {
   line.push_back('\n');
   // One write per line on a file opened to append: the kernel puts the
   // whole line at the end of the file even when other links log to it.
-  if (file_.write(protocol::ByteView(reinterpret_cast<const std::uint8_t*>(line.data()),
-                                     line.size())))
+  if (file_.write(
+          protocol::ByteView(reinterpret_cast<const std::uint8_t*>(line.data()), line.size())))
     ++records_written_;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -51,6 +52,7 @@ class WireLog final : public LinkObserver {
   void on_sent(Time at, Direction d, protocol::ByteView bytes) override;
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override;
   void on_fault(const FaultEvent& event) override;
+  void on_half_close(Time at, Direction d) override;
   void on_close(Time at, const LinkClose& close) override;
   /// A record of a kind the link itself never writes (a probe's `exchange`
   /// markers): `link`, `event`, `t_ms` and `wall_us`, then `fields`.
@@ -68,6 +70,9 @@ class WireLog final : public LinkObserver {
   void on_bytes(const char* event, std::size_t kind_index, Time at, Direction d,
                 protocol::ByteView bytes);
   void write_line(const nlohmann::ordered_json& record);
+  /// The partial frames still held for `dirs` (both stages), as the
+  /// "unfinished" field lists them; the splitters are left empty.
+  nlohmann::ordered_json unfinished(std::initializer_list<Direction> dirs);
 
   std::filesystem::path path_;
   CaptureFile file_;

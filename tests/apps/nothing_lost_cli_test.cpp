@@ -150,8 +150,7 @@ struct Client {
     });
     reader = std::thread([this] {
       std::vector<char> buf(64 * 1024);
-      // With a limit the client hangs up once its whole echo is back (a
-      // half-close would end the link with the echo still on its way).
+      // With a limit the client hangs up once its whole echo is back.
       while (limit == 0 || read < limit) {
         const ssize_t n = ::read(fd, buf.data(), buf.size());
         if (n <= 0) return;

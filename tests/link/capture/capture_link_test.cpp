@@ -33,8 +33,13 @@ FaultRule split_into(std::size_t size) {
 
 struct Collected {
   std::string data;
-  BytePipe::Handlers handlers() {
-    return {[this](ByteView b) { data.append(b.begin(), b.end()); }, [](std::error_code) {}};
+  bool ended = false;  // on_end: the peer half-closed
+  /// With `half_close`, the peer's half-close is on_end.
+  BytePipe::Handlers handlers(bool half_close = false) {
+    BytePipe::Handlers h{[this](ByteView b) { data.append(b.begin(), b.end()); },
+                         [](std::error_code) {}};
+    if (half_close) h.on_end = [this] { ended = true; };
+    return h;
   }
 };
 
@@ -47,8 +52,9 @@ struct CaptureLinkTest : ::testing::Test {
 
   // The client writes one frame at 10 ms, the car answers at 20 ms, the
   // client hangs up at 30 ms. to_car bytes are cut into 5-byte pieces 1 ms
-  // apart.
-  void run_exchange() {
+  // apart. With `half_close` the client half-closes right after its frame
+  // and the car half-closes after its answer instead.
+  void run_exchange(bool half_close = false) {
     std::error_code ec;
     WireLogOptions log_options;
     log_options.link_id = "logi0";
@@ -67,37 +73,45 @@ struct CaptureLinkTest : ::testing::Test {
     auto [client_app, link_client] = make_mem_pipe(ex, "client");
     auto [link_car, car_app] = make_mem_pipe(ex, "car");
     auto link = Link::create(ex, link_client, link_car, std::move(options));
-    client_app->start(at_client.handlers());
-    car_app->start(at_car.handlers());
+    client_app->start(at_client.handlers(half_close));
+    car_app->start(at_car.handlers(half_close));
     link->start();
 
     ex.run_until(milliseconds(10));
     client_app->write(to_bytes("LOGI:SP:050:D7#"));
+    if (half_close) client_app->shutdown_send();
     ex.run_until(milliseconds(20));
     car_app->write(to_bytes("LOGI:FB:SP:1:35#"));
+    if (half_close) car_app->shutdown_send();
     ex.run_until(milliseconds(30));
-    client_app->close();
+    if (!half_close) client_app->close();
     ex.run_until_idle();
     EXPECT_FALSE(log->error());
     EXPECT_FALSE(pcap->error());
+  }
+
+  /// One line per wire log record: event, time, direction, text, frames.
+  std::vector<std::string> log_summary() const {
+    std::vector<std::string> summary;
+    for (const auto& r : read_wire_log(log_file.path())) {
+      EXPECT_EQ(r["link"], "logi0");
+      EXPECT_EQ(r["wall_us"], kWallUs);
+      std::string line = r["event"].get<std::string>() + " " + r["t_ms"].dump();
+      if (r.contains("dir")) line += " " + r["dir"].get<std::string>();
+      if (r["event"] == "fault") line += " " + r["kind"].get<std::string>();
+      if (r.contains("text")) line += " " + r["text"].get<std::string>();
+      if (r.contains("frames")) line += " frames=" + std::to_string(r["frames"].size());
+      if (r.contains("reason")) line += " (" + r["reason"].get<std::string>() + ")";
+      summary.push_back(line);
+    }
+    return summary;
   }
 };
 
 TEST_F(CaptureLinkTest, WireLogShowsSentFaultAndDeliveredPiecesAtVirtualTimes) {
   run_exchange();
   ASSERT_EQ(at_car.data, "LOGI:SP:050:D7#");
-  std::vector<std::string> summary;
-  for (const auto& r : read_wire_log(log_file.path())) {
-    EXPECT_EQ(r["link"], "logi0");
-    EXPECT_EQ(r["wall_us"], kWallUs);
-    std::string line = r["event"].get<std::string>() + " " + r["t_ms"].dump();
-    if (r.contains("dir")) line += " " + r["dir"].get<std::string>();
-    if (r["event"] == "fault") line += " " + r["kind"].get<std::string>();
-    if (r.contains("text")) line += " " + r["text"].get<std::string>();
-    if (r.contains("frames")) line += " frames=" + std::to_string(r["frames"].size());
-    if (r.contains("reason")) line += " (" + r["reason"].get<std::string>() + ")";
-    summary.push_back(line);
-  }
+  const auto summary = log_summary();
   const std::vector<std::string> expected = {
       "open 0.0",
       "sent 10.0 to_car LOGI:SP:050:D7# frames=1",
@@ -125,6 +139,48 @@ TEST_F(CaptureLinkTest, PcapHoldsTheDeliveredPiecesAtWallTimePlusVirtualTime) {
             "1700000000.011000000\t40000\t5\n"
             "1700000000.012000000\t40000\t5\n"
             "1700000000.020000000\t9000\t16\n");
+}
+
+TEST_F(CaptureLinkTest, AHalfCloseIsLoggedWhenItIsPassedOnAndTheLinkClosesWithTheCar) {
+  run_exchange(true);
+  ASSERT_EQ(at_car.data, "LOGI:SP:050:D7#");
+  ASSERT_EQ(at_client.data, "LOGI:FB:SP:1:35#");
+  EXPECT_TRUE(at_car.ended && at_client.ended);
+  const std::vector<std::string> expected = {
+      "open 0.0",
+      "sent 10.0 to_car LOGI:SP:050:D7# frames=1",
+      "fault 10.0 to_car fragment",
+      "delivered 10.0 to_car LOGI: frames=0",
+      "delivered 11.0 to_car SP:05 frames=0",
+      "delivered 12.0 to_car 0:D7# frames=1",
+      "half_close 12.0 to_car",  // after the last piece the fault held
+      "sent 20.0 to_client LOGI:FB:SP:1:35# frames=1",
+      "delivered 20.0 to_client LOGI:FB:SP:1:35# frames=1",
+      "close 20.0 (client and car closed)",
+  };
+  EXPECT_EQ(log_summary(), expected);
+}
+
+TEST_F(CaptureLinkTest, APcapShowsTheClientsFinBeforeTheCarsAnswer) {
+  if (!test::tshark_installed()) {
+    GTEST_SKIP() << "tshark is not installed (ci/install-deps.sh installs it)";
+  }
+  run_exchange(true);
+  const auto out = test::tshark_output(
+      pcap_file.path(), "-T fields -e frame.time_epoch -e tcp.srcport -e tcp.flags -e tcp.len");
+  ASSERT_TRUE(out);
+  EXPECT_EQ(*out,
+            "1700000000.000000000\t40000\t0x0002\t0\n"
+            "1700000000.000000000\t9000\t0x0012\t0\n"
+            "1700000000.000000000\t40000\t0x0010\t0\n"
+            "1700000000.010000000\t40000\t0x0018\t5\n"
+            "1700000000.011000000\t40000\t0x0018\t5\n"
+            "1700000000.012000000\t40000\t0x0018\t5\n"
+            "1700000000.012000000\t40000\t0x0011\t0\n"  // the client's FIN
+            "1700000000.012000000\t9000\t0x0010\t0\n"
+            "1700000000.020000000\t9000\t0x0018\t16\n"  // the answer after it
+            "1700000000.020000000\t9000\t0x0011\t0\n"   // the car's FIN
+            "1700000000.020000000\t40000\t0x0010\t0\n");
 }
 
 TEST(CaptureLinkSvgui, APcapOfTheRealWr8ProgramsDecodesByTheLengthByteWhateverTheSegments) {

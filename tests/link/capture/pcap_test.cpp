@@ -169,6 +169,50 @@ TEST_F(PcapTest, HandshakeDataAndGracefulCloseByTheCar) {
   EXPECT_EQ(rows, expected);
 }
 
+TEST_F(PcapTest, AHalfCloseIsTheSendersFinWithTheOtherSidesDataAfterIt) {
+  REQUIRE_TSHARK();
+  auto w = make();
+  w->on_open(Time{0}, "client", "car");
+  w->on_delivered(milliseconds(10), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));
+  w->on_half_close(milliseconds(11), Direction::to_car);  // shutdown(SHUT_WR)
+  w->on_delivered(milliseconds(20), Direction::to_client, to_bytes("LOGI:FB:SP:1:35#"));
+  w->on_close(milliseconds(30),
+              {LinkClose::By::client, CloseMode::graceful, "client and car closed"});
+  const auto rows =
+      tshark(file.path(),
+             "-T fields -e frame.time_relative -e tcp.srcport -e tcp.flags -e tcp.seq -e tcp.ack "
+             "-e tcp.len");
+  const std::vector<std::vector<std::string>> expected = {
+      {"0.000000000", "40000", "0x0002", "0", "0", "0"},    // SYN
+      {"0.000000000", "9000", "0x0012", "0", "1", "0"},     // SYN, ACK
+      {"0.000000000", "40000", "0x0010", "1", "1", "0"},    // ACK
+      {"0.010000000", "40000", "0x0018", "1", "1", "15"},   // LOGI:SP:050:D7#
+      {"0.011000000", "40000", "0x0011", "16", "1", "0"},   // the client's FIN
+      {"0.011000000", "9000", "0x0010", "1", "17", "0"},    // the car acks it
+      {"0.020000000", "9000", "0x0018", "1", "17", "16"},   // the answer after it
+      {"0.030000000", "9000", "0x0011", "17", "17", "0"},   // the car's FIN
+      {"0.030000000", "40000", "0x0010", "17", "18", "0"},  // last ACK
+  };
+  EXPECT_EQ(rows, expected);
+  // Wireshark's TCP analysis finds nothing wrong with the stream.
+  EXPECT_TRUE(tshark(file.path(), "-Y 'tcp.analysis.flags' -T fields -e frame.number").empty());
+}
+
+TEST_F(PcapTest, AResetAfterAHalfCloseIsOneRst) {
+  REQUIRE_TSHARK();
+  auto w = make();
+  w->on_open(Time{0}, "client", "car");
+  w->on_half_close(milliseconds(1), Direction::to_client);
+  w->on_close(milliseconds(2),
+              {LinkClose::By::car, CloseMode::reset, "car connection failed: reset"});
+  const auto rows = tshark(file.path(), "-T fields -e tcp.srcport -e tcp.flags");
+  const std::vector<std::vector<std::string>> expected = {
+      {"40000", "0x0002"}, {"9000", "0x0012"},  {"40000", "0x0010"},
+      {"9000", "0x0011"},  {"40000", "0x0010"}, {"9000", "0x0014"},
+  };
+  EXPECT_EQ(rows, expected);
+}
+
 TEST_F(PcapTest, ResetReasonEndsWithOneRst) {
   REQUIRE_TSHARK();
   auto w = make();

@@ -226,6 +226,47 @@ TEST_F(WireLogTest, CloseRecordListsAPartialFrameStillHeld) {
   EXPECT_EQ(r[1]["unfinished"][0]["frames"][0]["valid"], false);
 }
 
+TEST_F(WireLogTest, AHalfCloseIsARecordOfItsDirectionWithItsPartialFrame) {
+  auto log = make();
+  log->on_sent(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:05"));
+  log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:05"));
+  log->on_delivered(milliseconds(2), Direction::to_client, to_bytes("LOGI:STAT:1:"));
+  log->on_half_close(milliseconds(3), Direction::to_car);
+  log->on_close(milliseconds(4),
+                {LinkClose::By::client, CloseMode::graceful, "client and car closed"});
+  const auto r = records();
+  ASSERT_EQ(r.size(), 5u);
+  expect_fields(r[3], {{"link", "car0"},
+                       {"event", "half_close"},
+                       {"t_ms", 3.0},
+                       {"wall_us", kLogWallUs},
+                       {"dir", "to_car"},
+                       {"by", "client"}});
+  // The client's half frame is final once it half-closed, in both stages;
+  // the car's is still open until the close.
+  ASSERT_EQ(r[3]["unfinished"].size(), 2u);
+  EXPECT_EQ(r[3]["unfinished"][0]["event"], "sent");
+  EXPECT_EQ(r[3]["unfinished"][1]["event"], "delivered");
+  for (const auto& u : r[3]["unfinished"]) {
+    EXPECT_EQ(u["dir"], "to_car");
+    ASSERT_EQ(u["frames"].size(), 1u);
+    EXPECT_EQ(u["frames"][0]["valid"], false);
+  }
+  ASSERT_EQ(r[4]["unfinished"].size(), 1u) << "listed once, at the half-close";
+  EXPECT_EQ(r[4]["unfinished"][0]["dir"], "to_client");
+  EXPECT_EQ(r[4]["reason"], "client and car closed");
+}
+
+TEST_F(WireLogTest, ACleanHalfCloseOfTheCarHasNoUnfinishedField) {
+  auto log = make();
+  log->on_delivered(milliseconds(1), Direction::to_client, to_bytes("LOGI:FB:SP:1:35#"));
+  log->on_half_close(milliseconds(2), Direction::to_client);
+  const auto r = records();
+  ASSERT_EQ(r.size(), 2u);
+  expect_fields(r[1], {{"event", "half_close"}, {"dir", "to_client"}, {"by", "car"}});
+  EXPECT_FALSE(r[1].contains("unfinished"));
+}
+
 TEST_F(WireLogTest, CleanCloseHasNoUnfinishedField) {
   auto log = make();
   log->on_delivered(milliseconds(1), Direction::to_car, to_bytes("LOGI:SP:050:D7#"));

@@ -11,19 +11,32 @@ namespace {
 struct PipeRecorder {
   std::string data;
   std::optional<std::error_code> closed;
-  BytePipe::Handlers handlers() {
-    return {[this](ByteView b) { data.append(b.begin(), b.end()); },
-            [this](std::error_code ec) { closed = ec; }};
+  int ends = 0;             // on_end calls
+  std::string data_at_end;  // what had arrived when on_end came
+  bool closed_before_end = false;
+  BytePipe::Handlers handlers(bool half_close = false) {
+    BytePipe::Handlers h{[this](ByteView b) { data.append(b.begin(), b.end()); },
+                         [this](std::error_code ec) {
+                           closed = ec;
+                           closed_before_end = ends == 0;
+                         }};
+    if (half_close) {
+      h.on_end = [this] {
+        ++ends;
+        data_at_end = data;
+      };
+    }
+    return h;
   }
 };
 
 // Two started ends of a mem:// line at `baud` (0: unpaced), each with its
-// recorder.
+// recorder; with `half_close` both take on_end.
 struct PacedLine {
-  explicit PacedLine(unsigned baud = 0) {
+  explicit PacedLine(unsigned baud = 0, bool half_close = false) {
     std::tie(a, b) = make_mem_pipe(ex, "t", baud);
-    a->start(ra.handlers());
-    b->start(rb.handlers());
+    a->start(ra.handlers(half_close));
+    b->start(rb.handlers(half_close));
   }
   VirtualExecutor ex;
   BytePipePtr a, b;
@@ -138,6 +151,73 @@ TEST(MemPipe, AResetOnAPacedLineDropsWhatIsStillOnIt) {
   line.ex.run_until_idle();
   EXPECT_EQ(line.rb.data, "01");  // in by 2.08 ms; the rest was still on the line
   EXPECT_EQ(line.rb.closed, std::make_error_code(std::errc::connection_reset));
+}
+
+TEST(MemPipe, AHalfCloseEndsOneDirectionAndTheOtherKeepsFlowing) {
+  PacedLine line(0, true);
+  auto& [ex, a, b, ra, rb] = line;
+  a->write(protocol::to_bytes("request"));
+  a->shutdown_send();
+  a->write(protocol::to_bytes("ignored"));
+  EXPECT_TRUE(a->is_open()) << "a still reads";
+  ex.run_until_idle();
+  EXPECT_EQ(rb.data, "request");
+  EXPECT_EQ(rb.ends, 1);
+  EXPECT_EQ(rb.data_at_end, "request") << "the end follows the bytes written before it";
+  EXPECT_FALSE(rb.closed.has_value());
+  EXPECT_FALSE(ra.closed.has_value());
+
+  b->write(protocol::to_bytes("answer"));
+  ex.run_until_idle();
+  EXPECT_EQ(ra.data, "answer");
+  EXPECT_TRUE(a->is_open());
+  EXPECT_TRUE(b->is_open());
+
+  b->shutdown_send();  // both directions have ended: both ends close
+  ex.run_until_idle();
+  EXPECT_EQ(ra.ends, 1);
+  EXPECT_EQ(ra.closed, end_of_stream());
+  EXPECT_FALSE(ra.closed_before_end);
+  EXPECT_EQ(rb.closed, end_of_stream());
+  EXPECT_FALSE(a->is_open());
+  EXPECT_FALSE(b->is_open());
+}
+
+TEST(MemPipe, AHalfCloseToAnEndWithoutOnEndIsAClose) {
+  VirtualExecutor ex;
+  auto [a, b] = make_mem_pipe(ex, "t");
+  PipeRecorder ra, rb;
+  a->start(ra.handlers(true));
+  b->start(rb.handlers(false));
+  a->write(protocol::to_bytes("bye"));
+  a->shutdown_send();
+  EXPECT_FALSE(a->is_open()) << "closed instead, at once";
+  ex.run_until_idle();
+  EXPECT_EQ(rb.data, "bye");
+  EXPECT_EQ(rb.closed, end_of_stream());
+  EXPECT_EQ(ra.closed, closed_here());
+}
+
+TEST(MemPipe, AnOutrightCloseIsNeverAHalfClose) {
+  PacedLine line(0, true);
+  auto& [ex, a, b, ra, rb] = line;
+  a->close(CloseMode::graceful);
+  ex.run_until_idle();
+  EXPECT_EQ(rb.ends, 0);
+  EXPECT_EQ(rb.closed, end_of_stream());
+}
+
+TEST(MemPipe, OnAPacedLineAHalfCloseFollowsTheBytesStillOnIt) {
+  PacedLine line(9600, true);
+  line.a->write(protocol::to_bytes("last"));  // 4.17 ms on the line
+  line.a->shutdown_send();
+  line.ex.run_until(Time(milliseconds(4)));
+  EXPECT_EQ(line.rb.data, "las");
+  EXPECT_EQ(line.rb.ends, 0) << "the end may not overtake the bytes";
+  line.ex.run_until(Time(milliseconds(5)));
+  EXPECT_EQ(line.rb.data, "last");
+  EXPECT_EQ(line.rb.ends, 1);
+  EXPECT_FALSE(line.rb.closed.has_value());
 }
 
 TEST(MemNetwork, AListenersBaudPacesEveryConnectionToIt) {

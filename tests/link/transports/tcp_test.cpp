@@ -20,23 +20,33 @@ struct Seen {
   Bytes data;
   std::optional<std::error_code> closed;
   int close_calls = 0;
+  int ends = 0;  // on_end calls
+  std::size_t bytes_at_end = 0;
 
-  BytePipe::Handlers handlers() {
-    return {[this](ByteView b) { data.insert(data.end(), b.begin(), b.end()); },
-            [this](std::error_code ec) {
-              closed = ec;
-              ++close_calls;
-            }};
+  /// With `half_close`, the peer's FIN is on_end (the pipe stays open).
+  BytePipe::Handlers handlers(bool half_close = false) {
+    BytePipe::Handlers h{[this](ByteView b) { data.insert(data.end(), b.begin(), b.end()); },
+                         [this](std::error_code ec) {
+                           closed = ec;
+                           ++close_calls;
+                         }};
+    if (half_close) {
+      h.on_end = [this] {
+        ++ends;
+        bytes_at_end = data.size();
+      };
+    }
+    return h;
   }
   std::string text() const { return {data.begin(), data.end()}; }
 };
 
 /// A listener on 127.0.0.1 with a free port, and one connected client.
 struct Connected {
-  explicit Connected(bool echo = false) : listener(io, any_port) {
-    listener.start([this, echo](BytePipePtr p) {
+  explicit Connected(bool echo = false, bool half_close = false) : listener(io, any_port) {
+    listener.start([this, echo, half_close](BytePipePtr p) {
       servers.push_back(p);
-      auto handlers = server_seen.handlers();
+      auto handlers = server_seen.handlers(half_close);
       if (echo) {
         auto keep = handlers.on_data;
         handlers.on_data = [keep, raw = p.get()](ByteView b) {
@@ -47,10 +57,10 @@ struct Connected {
       p->start(std::move(handlers));
     });
     tcp_connect(io, TcpEndpoint{"127.0.0.1", listener.port()},
-                [this](std::error_code ec, BytePipePtr p) {
+                [this, half_close](std::error_code ec, BytePipePtr p) {
                   connect_error = ec;
                   client = p;
-                  if (p) p->start(client_seen.handlers());
+                  if (p) p->start(client_seen.handlers(half_close));
                 });
     EXPECT_TRUE(test::run_until(io, [&] { return client && !servers.empty(); }));
   }
@@ -162,6 +172,53 @@ TEST(Tcp, ClientCloseIsSeenByTheServerAsEof) {
   ASSERT_TRUE(test::run_until(c.io, [&] { return c.server_seen.closed.has_value(); }));
   EXPECT_EQ(c.server_seen.text(), "last words");
   EXPECT_EQ(*c.server_seen.closed, end_of_stream());
+}
+
+TEST(Tcp, AHalfCloseLetsThePeerAnswerThenBothEndsClose) {
+  Connected c(false, true);
+  c.client->write(protocol::to_bytes("request"));
+  c.client->shutdown_send();
+  c.client->write(protocol::to_bytes("ignored after shutdown_send"));
+  ASSERT_TRUE(test::run_until(c.io, [&] { return c.server_seen.ends == 1; }));
+  EXPECT_EQ(c.server_seen.text(), "request");
+  EXPECT_EQ(c.server_seen.bytes_at_end, 7u);
+  EXPECT_TRUE(c.client->is_open()) << "the client still reads";
+  EXPECT_TRUE(c.server().is_open()) << "the server still writes";
+
+  // An answer larger than the socket buffers: it all arrives after the
+  // client's FIN, and the server's FIN after it.
+  Bytes answer(3u << 20);
+  for (std::size_t i = 0; i < answer.size(); ++i)
+    answer[i] = static_cast<std::uint8_t>(i * 13);
+  c.server().write(answer);
+  c.server().shutdown_send();
+  ASSERT_TRUE(test::run_until(
+      c.io, [&] { return c.client_seen.closed && c.server_seen.closed; }, seconds(30)));
+  EXPECT_TRUE(c.client_seen.data == answer);
+  EXPECT_EQ(c.client_seen.ends, 1);
+  EXPECT_EQ(c.client_seen.bytes_at_end, answer.size());
+  EXPECT_EQ(*c.client_seen.closed, end_of_stream());
+  EXPECT_EQ(*c.server_seen.closed, end_of_stream());
+  EXPECT_EQ(c.server_seen.text(), "request");
+  EXPECT_FALSE(c.client->is_open());
+  EXPECT_FALSE(c.server().is_open());
+  test::run_for(c.io, milliseconds(20));
+  EXPECT_EQ(c.client_seen.close_calls, 1);
+  EXPECT_EQ(c.server_seen.close_calls, 1);
+}
+
+TEST(Tcp, AClosedPeerThatTakesNoHalfCloseSeesEofAsBefore) {
+  Connected c(false, false);
+  c.client->write(protocol::to_bytes("request"));
+  c.client->shutdown_send();
+  ASSERT_TRUE(test::run_until(c.io, [&] { return c.server_seen.closed.has_value(); }));
+  EXPECT_EQ(c.server_seen.text(), "request");
+  EXPECT_EQ(*c.server_seen.closed, end_of_stream());
+  EXPECT_EQ(c.server_seen.ends, 0);
+  // The server pipe closed in turn (FIN): the client, which still read,
+  // sees the end of the stream.
+  ASSERT_TRUE(test::run_until(c.io, [&] { return c.client_seen.closed.has_value(); }));
+  EXPECT_EQ(*c.client_seen.closed, end_of_stream());
 }
 
 TEST(Tcp, ConnectToAClosedPortIsRefused) {
