@@ -261,6 +261,65 @@ TEST_F(ProxyTest, WireLogRecordsEveryLink) {
   std::filesystem::remove(path);
 }
 
+// Toxiproxy's enabled flag over TCP: a proxy asked for port 0 listens on
+// the port it first got when enabled again, so clients find it there.
+TEST_F(ProxyTest, EnablingAgainListensOnTheSamePort) {
+  EchoCar car(ctx);
+  Proxy proxy(ctx, options(car));
+  proxy.start();
+  const std::string address = proxy.address();
+  Client first;
+  first.connect_to(ctx, address, "LOGI:SP:050:D7#");
+  ASSERT_TRUE(run_until([&] { return first.received.size() == 15; }));
+
+  proxy.set_enabled(false);
+  ASSERT_TRUE(run_until([&] { return first.closed.has_value(); }));
+  Client refused;
+  refused.connect_to(ctx, address);
+  ASSERT_TRUE(run_until([&] { return refused.connect_error || refused.closed.has_value(); }));
+  EXPECT_FALSE(refused.connected) << "a disabled proxy accepted a client";
+
+  proxy.set_enabled(true);
+  EXPECT_EQ(proxy.address(), address);
+  Client again;
+  again.connect_to(ctx, address, "LOGI:MV:CW:DC#");
+  ASSERT_TRUE(run_until([&] { return again.received.size() == 14; })) << again.received;
+  EXPECT_EQ(proxy.links_opened(), 2u);
+}
+
+// Several proxies sharing one wire log tell their links apart by prefix,
+// and a pcap folder gets one file per link, named after the proxy.
+TEST_F(ProxyTest, LinkIdPrefixAndPcapFolder) {
+  EchoCar car(ctx);
+  auto o = options(car);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("hil-proxy-test-pcaps-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  o.name = "car";
+  o.link_id_prefix = "car/";
+  o.wire_log_path = (dir / "wire.ndjson").string();
+  o.pcap_dir = dir.string();
+  {
+    Proxy proxy(ctx, o);
+    proxy.start();
+    Client a, b;
+    a.connect_to(ctx, proxy.address(), "LOGI:SP:050:D7#");
+    ASSERT_TRUE(run_until([&] { return a.received.size() == 15; }));
+    b.connect_to(ctx, proxy.address(), "LOGI:SP:050:D7#");
+    ASSERT_TRUE(run_until([&] { return b.received.size() == 15; }));
+    proxy.close();
+    settle(std::chrono::milliseconds(20));
+  }
+  std::set<std::string> links;
+  for (const auto& r : read_wire_log(dir / "wire.ndjson"))
+    links.insert(r["link"].get<std::string>());
+  EXPECT_EQ(links, (std::set<std::string>{"car/link1", "car/link2"}));
+  EXPECT_GT(std::filesystem::file_size(dir / "car-link1.pcap"), 24u);
+  EXPECT_GT(std::filesystem::file_size(dir / "car-link2.pcap"), 24u);
+  std::filesystem::remove_all(dir);
+}
+
 TEST_F(ProxyTest, PtyClientReachesATcpCar) {
   EchoCar car(ctx);
   auto o = options(car);
