@@ -1,8 +1,10 @@
 #include "mocks/server.hpp"
 
+#include <array>
 #include <optional>
 #include <string>
 #include <system_error>
+#include <variant>
 
 #include "link/capture/wire_log.hpp"
 #include "link/mem_pipe.hpp"
@@ -54,14 +56,37 @@ std::string session_counts(const FirmwareStats& now, const FirmwareStats& at_sta
 
 }  // namespace
 
+// Counts the faults of every link the server opened, and its refusals, by
+// kind: the links come and go, the counts stay.
+class MockServer::FaultTally final : public link::LinkObserver {
+ public:
+  void on_fault(const link::FaultEvent& e) override {
+    ++counts_.at(static_cast<std::size_t>(e.kind));
+  }
+  std::uint64_t count(link::FaultKind kind) const {
+    return counts_.at(static_cast<std::size_t>(kind));
+  }
+  std::uint64_t total() const {
+    std::uint64_t sum = 0;
+    for (const auto n : counts_)
+      sum += n;
+    return sum;
+  }
+
+ private:
+  std::array<std::uint64_t, std::variant_size_v<link::FaultAction>> counts_{};
+};
+
 MockServer::MockServer(link::TransportContext& context, Firmware& firmware, ServerOptions options)
     : context_(context),
       firmware_(firmware),
       options_(std::move(options)),
-      timer_(context.executor, [this] {
-        firmware_.wake(context_.executor.now());
-        flush();
-      }) {
+      timer_(context.executor,
+             [this] {
+               firmware_.wake(context_.executor.now());
+               flush();
+             }),
+      tally_(std::make_shared<FaultTally>()) {
   if (!options_.protocol) options_.protocol = firmware_.adapter();
   gate_ = std::make_unique<link::FaultInjector>(
       link::Direction::to_car, options_.protocol,
@@ -69,6 +94,7 @@ MockServer::MockServer(link::TransportContext& context, Firmware& firmware, Serv
       // A refused connection never gets a link: its fault goes to the
       // observers from here.
       [this](const link::FaultEvent& e) {
+        tally_->on_fault(e);
         for (const auto& o : options_.observers)
           o->on_fault(e);
       });
@@ -115,7 +141,11 @@ bool MockServer::client_connected() const {
 }
 
 std::uint64_t MockServer::faults_injected() const {
-  return past_faults_ + (link_ ? link_->stats().faults : 0) + gate_refusals_;
+  return tally_->total();
+}
+
+std::uint64_t MockServer::faults_injected(link::FaultKind kind) const {
+  return tally_->count(kind);
 }
 
 void MockServer::on_accept(link::BytePipePtr client) {
@@ -127,7 +157,6 @@ void MockServer::on_accept(link::BytePipePtr client) {
   ++accepted_;
   if (gate_->refuse_connection(now)) {
     ++turned_away_;
-    ++gate_refusals_;
     say(options_.name + " refused a connection (fault rule): " + client->describe());
     client->close(link::CloseMode::reset);
     return;
@@ -140,7 +169,6 @@ void MockServer::on_accept(link::BytePipePtr client) {
     client->close(link::CloseMode::graceful);
     return;
   }
-  if (link_) past_faults_ += link_->stats().faults;
   const std::uint64_t number = ++served_;
   const std::string id = options_.name + "/link" + std::to_string(number);
 
@@ -149,6 +177,7 @@ void MockServer::on_accept(link::BytePipePtr client) {
   link_options.set_faults(options_.faults);
   link_options.seed = options_.seed + number - 1;
   link_options.observers = options_.observers;
+  link_options.observers.push_back(tally_);
   if (options_.log)
     link_options.observers.push_back(std::make_shared<FaultLogger>(id, options_.log));
   if (!options_.wire_log_path.empty()) {

@@ -59,8 +59,10 @@ class MockServer {
   /// Connections turned away because a client was already connected, or
   /// by a fault rule's refuse.
   std::uint64_t turned_away() const { return turned_away_; }
-  /// Faults injected on every link so far.
+  /// Faults injected on every link so far (refused connections included).
   std::uint64_t faults_injected() const;
+  /// The same, of one kind.
+  std::uint64_t faults_injected(link::FaultKind kind) const;
 
   Firmware& firmware() { return firmware_; }
 
@@ -69,6 +71,7 @@ class MockServer {
   void flush();
   void reschedule();
   void say(const std::string& line) const;
+  class FaultTally;
 
   link::TransportContext& context_;
   Firmware& firmware_;
@@ -81,8 +84,7 @@ class MockServer {
   std::uint64_t served_ = 0;
   std::uint64_t accepted_ = 0;
   std::uint64_t turned_away_ = 0;
-  std::uint64_t past_faults_ = 0;
-  std::uint64_t gate_refusals_ = 0;
+  std::shared_ptr<FaultTally> tally_;  // on every link, and told of the gate's refusals
   bool running_ = false;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };

@@ -186,8 +186,8 @@ void WireWatch::on_delivered(link::Time at, link::Direction d, protocol::ByteVie
 }
 
 void WireWatch::on_fault(const link::FaultEvent& event) {
-  faults_.push_back(
-      Fault{event.at, event.direction, std::string(link::to_string(event.kind)), event.rule, event.detail});
+  faults_.push_back(Fault{event.at, event.direction, std::string(link::to_string(event.kind)),
+                          event.rule, event.detail});
   while (faults_.size() > kFaultsKept)
     faults_.pop_front();
 }
@@ -306,6 +306,54 @@ json LiveModel::snapshot(link::Time now) const {
   for (std::size_t i = 0; i < cars_.size(); ++i)
     cars.push_back(car_json(cars_[i], i, now));
   return {{"cars", cars}};
+}
+
+std::vector<base::MetricFamily> LiveModel::metrics() const {
+  using Family = base::MetricFamily;
+  Family bytes{"hil_mock_bytes_total",
+               "Bytes at the mock car: to_car the car received (after faults), to_client the "
+               "car wrote (before faults).",
+               Family::Type::counter,
+               {}};
+  Family frames{"hil_mock_frames_total",
+                "Frames at the mock car: to_car client frames the car decoded, to_client frames "
+                "the car sent.",
+                Family::Type::counter,
+                {}};
+  Family bad_frames{"hil_mock_bad_frames_total",
+                    "Client input the car could not decode: checksum errors, garbage, malformed "
+                    "or oversized frames.",
+                    Family::Type::counter,
+                    {}};
+  Family faults{"hil_mock_faults_total",
+                "Faults injected on the car's links by rule kind, refused connections included.",
+                Family::Type::counter,
+                {}};
+  Family connections{
+      "hil_mock_connections_total", "Clients the car served.", Family::Type::counter, {}};
+  Family open{
+      "hil_mock_open_connections", "Clients connected to the car now.", Family::Type::gauge, {}};
+  for (const auto& car : cars_) {
+    const std::string& name = car.viewed.car->name();
+    const auto& firmware = car.viewed.car->firmware();
+    const auto& stats = firmware.stats();
+    const auto* server = car.viewed.server;
+    const auto count = [](std::uint64_t n) { return static_cast<double>(n); };
+    bytes.add({{"car", name}, {"direction", "to_car"}}, count(stats.bytes_in))
+        .add({{"car", name}, {"direction", "to_client"}}, count(stats.bytes_out));
+    frames.add({{"car", name}, {"direction", "to_car"}}, count(stats.frames_in))
+        .add({{"car", name}, {"direction", "to_client"}}, count(stats.frames_out));
+    bad_frames.add({{"car", name}}, count(stats.bad_frames));
+    for (const auto& kind : link::kFaultKindNames) {
+      const std::uint64_t n = server != nullptr ? server->faults_injected(kind.value) : 0;
+      faults.add({{"car", name}, {"kind", std::string(kind.name)}}, count(n));
+    }
+    connections.add({{"car", name}}, count(stats.connections));
+    const bool connected = server != nullptr ? server->client_connected() : firmware.connected();
+    open.add({{"car", name}}, connected ? 1 : 0);
+  }
+  return {std::move(bytes),  std::move(frames),      std::move(bad_frames),
+          std::move(faults), std::move(connections), std::move(open)};
 }
 
 Reply LiveModel::handle(std::string_view action, std::string_view body) {

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/prometheus_text.hpp"
 #include "link/faults/profile.hpp"
 #include "link/link.hpp"
 #include "link/protocol_adapter.hpp"
@@ -96,6 +97,12 @@ class LiveModel {
   /// "behaviour", "car", "obstacle", "reset"), `body` the request's JSON
   /// text. Bad requests answer 400 with {"error": "..."}; never throws.
   Reply handle(std::string_view action, std::string_view body);
+
+  /// The cars' counters for GET /metrics, one sample per car (labelled
+  /// with its name): hil_mock_bytes_total, hil_mock_frames_total,
+  /// hil_mock_bad_frames_total, hil_mock_faults_total (every kind, zeros
+  /// included), hil_mock_connections_total, hil_mock_open_connections.
+  std::vector<base::MetricFamily> metrics() const;
 
   std::size_t car_count() const { return cars_.size(); }
 

@@ -7,11 +7,15 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <future>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
+#include "base/prometheus_text.hpp"
 #include "view/page.hpp"
 
 namespace hil::view {
@@ -40,6 +44,32 @@ constexpr int kHttpThreads = 48;  // every open event stream holds one
 void send_json(httplib::Response& res, int status, const nlohmann::json& body) {
   res.status = status;
   res.set_content(body.dump(), "application/json");
+}
+
+// Runs `work` on the cars' thread (`io`) and waits for its result; nullopt,
+// with `why` for a 503, when the cars stop or do not answer in time. Waits
+// in short steps so stop() (which runs on the cars' thread and joins the
+// HTTP threads) never waits out the whole limit.
+template <class T, class Work>
+std::optional<T> ask_cars(asio::io_context& io, Work work, const std::function<bool()>& stopping,
+                          std::string& why) {
+  auto promise = std::make_shared<std::promise<T>>();
+  auto result = promise->get_future();
+  asio::post(io, [promise, work = std::move(work)] { promise->set_value(work()); });
+  const auto deadline = std::chrono::steady_clock::now() + kApiWait;
+  while (result.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    const bool stop = stopping();
+    if (stop || std::chrono::steady_clock::now() > deadline) {
+      why = stop ? "the cars are stopping" : "the cars did not answer in time";
+      return std::nullopt;
+    }
+  }
+  try {
+    return result.get();
+  } catch (const std::future_error&) {
+    why = "the cars are stopping";
+    return std::nullopt;
+  }
 }
 
 }  // namespace
@@ -103,34 +133,43 @@ void LiveViewServer::start() {
         },
         [shared](bool) { --shared->viewers; });
   });
+  // Whether the server is stopping, for a handler that waits for the cars.
+  const std::function<bool()> stopping = [shared] {
+    std::lock_guard lock(shared->mutex);
+    return shared->stopping;
+  };
   // Every action runs on the cars' thread; this thread waits for its reply.
-  http.Post(R"(/api/(\w+))", [this, shared](const httplib::Request& req, httplib::Response& res) {
-    auto promise = std::make_shared<std::promise<Reply>>();
-    auto reply = promise->get_future();
-    asio::post(io_, [this, promise, action = req.matches[1].str(), body = req.body] {
-      promise->set_value(model_.handle(action, body));
-    });
-    // Waits in short steps so stop() (which runs on the cars' thread and
-    // joins this one) never waits out the whole limit.
-    const auto deadline = std::chrono::steady_clock::now() + kApiWait;
-    while (reply.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
-      bool stopping = false;
-      {
-        std::lock_guard lock(shared->mutex);
-        stopping = shared->stopping;
-      }
-      if (stopping || std::chrono::steady_clock::now() > deadline) {
-        send_json(
-            res, 503,
-            {{"error", stopping ? "the cars are stopping" : "the cars did not answer in time"}});
-        return;
-      }
+  http.Post(R"(/api/(\w+))", [this, stopping](const httplib::Request& req, httplib::Response& res) {
+    std::string why;
+    const auto reply = ask_cars<Reply>(
+        io_,
+        [this, action = req.matches[1].str(), body = req.body] {
+          return model_.handle(action, body);
+        },
+        stopping, why);
+    if (!reply) {
+      send_json(res, 503, {{"error", why}});
+      return;
+    }
+    send_json(res, reply->status, reply->body);
+  });
+  // The counters are read on the cars' thread and written out here.
+  http.Get("/metrics", [this, stopping](const httplib::Request&, httplib::Response& res) {
+    std::string why;
+    const auto families = ask_cars<std::vector<base::MetricFamily>>(
+        io_, [this] { return model_.metrics(); }, stopping, why);
+    res.set_header("Cache-Control", "no-store");
+    if (!families) {
+      res.status = 503;
+      res.set_content(why + "\n", "text/plain; charset=utf-8");
+      return;
     }
     try {
-      const Reply r = reply.get();
-      send_json(res, r.status, r.body);
-    } catch (const std::future_error&) {
-      send_json(res, 503, {{"error", "the cars are stopping"}});
+      res.set_content(base::prometheus_text(*families), base::kPrometheusContentType);
+    } catch (const std::exception& e) {
+      res.status = 500;
+      res.set_content(std::string("cannot write the metrics: ") + e.what() + "\n",
+                      "text/plain; charset=utf-8");
     }
   });
   http.set_error_handler([](const httplib::Request& req, httplib::Response& res) {

@@ -1,8 +1,9 @@
 #pragma once
 // The live view's web server: serves the page, streams snapshots of the
-// cars as server-sent events, and runs the panel's API on the cars' own
-// thread. HTTP runs on threads of its own; the cars are touched only from
-// the io_context that runs them.
+// cars as server-sent events, runs the panel's API on the cars' own thread,
+// and serves the cars' counters to a Prometheus scraper (GET /metrics).
+// HTTP runs on threads of its own; the cars are touched only from the
+// io_context that runs them.
 
 #include <cstdint>
 #include <memory>

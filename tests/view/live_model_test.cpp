@@ -1,17 +1,21 @@
 // The live view's model under the virtual-time driver: what the page is
-// sent about a LOGI car a client drives, and what each API request does to
-// the car, its world and its link.
+// sent about a LOGI car a client drives, what each API request does to the
+// car, its world and its link, and the counters GET /metrics serves.
 
 #include "view/live_model.hpp"
 #include "view/server.hpp"
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <future>
+#include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -50,6 +54,10 @@ class Desk {
         });
     run_for(link::milliseconds(1));
   }
+  void disconnect() {
+    client_->close(link::CloseMode::graceful);
+    run_for(link::milliseconds(50));
+  }
   void send(const logi::Message& m) { send_bytes(logi::encode(m)); }
   void send_bytes(const protocol::Bytes& bytes) {
     client_->write(bytes);
@@ -71,6 +79,7 @@ class Desk {
     return model_->handle(action, body);
   }
   std::string take_received() { return std::exchange(received_, {}); }
+  const std::string& received() const { return received_; }
   bool closed() const { return closed_; }
   mocks::MockCar& car() { return car_; }
   link::Executor& executor() { return executor_; }
@@ -199,6 +208,128 @@ TEST(LiveViewServer, StopsAtOnceWhenStoppedRightAfterStarting) {
       std::_Exit(1);
     }
   }
+}
+
+// What GET /metrics answered.
+struct Scrape {
+  int status = 0;
+  std::string content_type;
+  std::string body;
+  std::map<std::string, double> samples;  ///< `name{labels}` -> value
+};
+
+// GET /metrics over real HTTP from another thread, while this thread (the
+// cars' thread) runs the handlers the server posts to `io`.
+Scrape scrape(asio::io_context& io, std::uint16_t port) {
+  auto reply = std::async(std::launch::async, [port] {
+    httplib::Client c("127.0.0.1", port);
+    c.set_read_timeout(10, 0);
+    Scrape s;
+    if (const auto res = c.Get("/metrics")) {
+      s.status = res->status;
+      s.content_type = res->get_header_value("Content-Type");
+      s.body = res->body;
+    }
+    return s;
+  });
+  while (reply.wait_for(std::chrono::milliseconds(1)) != std::future_status::ready) {
+    io.restart();
+    io.poll();
+  }
+  Scrape s = reply.get();
+  std::istringstream lines(s.body);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto space = line.rfind(' ');
+    if (space == std::string::npos) continue;
+    s.samples[line.substr(0, space)] = std::stod(line.substr(space + 1));
+  }
+  return s;
+}
+
+// How many frames of the car's protocol `bytes` hold.
+std::size_t frames_in(mocks::MockCar& car, const std::string& bytes) {
+  auto splitter = car.firmware().adapter()->splitter_for(link::Direction::to_client);
+  std::vector<link::WireFrame> frames;
+  splitter->feed(
+      protocol::ByteView(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
+      frames);
+  return frames.size();
+}
+
+TEST(LiveViewServer, MetricsCountWhatAClientSentAndWhatItGot) {
+  Desk desk;
+  asio::io_context io;
+  ViewOptions options;
+  options.port = 0;
+  LiveViewServer server(io, desk.executor(), desk.model(), options);
+  server.start();
+
+  // Before any client: every family, every fault kind, all at zero.
+  Scrape s = scrape(io, server.port());
+  ASSERT_EQ(s.status, 200) << s.body;
+  EXPECT_EQ(s.content_type, base::kPrometheusContentType);
+  EXPECT_EQ(s.samples.size(), 2U + 2U + 1U + link::kFaultKindNames.size() + 1U + 1U) << s.body;
+  for (const auto& [sample, value] : s.samples)
+    EXPECT_EQ(value, 0) << sample;
+  EXPECT_NE(s.body.find("# TYPE hil_mock_open_connections gauge"), std::string::npos) << s.body;
+  EXPECT_NE(s.body.find("# TYPE hil_mock_faults_total counter"), std::string::npos) << s.body;
+
+  desk.connect();
+  // No telemetry, so the car writes only its answers; and every MD frame
+  // the client sends is dropped on its way to the car.
+  ASSERT_EQ(desk.api("behaviour", {{"action", "stall-telemetry"}, {"duration_ms", 600000}}).status,
+            200);
+  ASSERT_EQ(desk.api("faults", {{"profile",
+                                 "rules:\n  - kind: drop\n    direction: to_car\n    match: MD\n"}})
+                .status,
+            200);
+  desk.run_for(link::milliseconds(10));
+  const auto speed_50 = logi::encode(logi::SetSpeed{50});
+  const auto speed_60 = logi::encode(logi::SetSpeed{60});
+  const std::string bad_checksum = "LOGI:SP:050:D8#";
+  desk.send(logi::SetSpeed{50});
+  desk.send(logi::SetSpeed{60});
+  desk.send_bytes(protocol::Bytes(bad_checksum.begin(), bad_checksum.end()));
+  desk.send(logi::SetMode{logi::Mode::manual});
+  desk.run_for(link::milliseconds(100));
+  const std::string got = desk.received();
+  ASSERT_EQ(frames_in(desk.car(), got), 2U) << "FB:SP for each good SP: " << got;
+
+  s = scrape(io, server.port());
+  ASSERT_EQ(s.status, 200) << s.body;
+  const auto sample = [&](const std::string& key) {
+    const auto it = s.samples.find(key);
+    EXPECT_NE(it, s.samples.end()) << key << " is missing from\n" << s.body;
+    return it == s.samples.end() ? -1.0 : it->second;
+  };
+  const double sent_to_car =
+      static_cast<double>(speed_50.size() + speed_60.size() + bad_checksum.size());
+  EXPECT_EQ(sample(R"(hil_mock_bytes_total{car="car0",direction="to_car"})"), sent_to_car);
+  EXPECT_EQ(sample(R"(hil_mock_bytes_total{car="car0",direction="to_client"})"),
+            static_cast<double>(got.size()));
+  EXPECT_EQ(sample(R"(hil_mock_frames_total{car="car0",direction="to_car"})"), 2);
+  EXPECT_EQ(sample(R"(hil_mock_frames_total{car="car0",direction="to_client"})"), 2);
+  EXPECT_EQ(sample(R"(hil_mock_bad_frames_total{car="car0"})"), 1);
+  EXPECT_EQ(sample(R"(hil_mock_faults_total{car="car0",kind="drop"})"), 1);
+  EXPECT_EQ(sample(R"(hil_mock_faults_total{car="car0",kind="corrupt"})"), 0);
+  EXPECT_EQ(sample(R"(hil_mock_connections_total{car="car0"})"), 1);
+  EXPECT_EQ(sample(R"(hil_mock_open_connections{car="car0"})"), 1);
+
+  // The client leaves and another comes: the counters go on, the gauge
+  // follows the connection.
+  desk.disconnect();
+  s = scrape(io, server.port());
+  EXPECT_EQ(sample(R"(hil_mock_open_connections{car="car0"})"), 0);
+  EXPECT_EQ(sample(R"(hil_mock_connections_total{car="car0"})"), 1);
+  desk.connect();
+  desk.send(logi::SetMode{logi::Mode::manual});
+  s = scrape(io, server.port());
+  EXPECT_EQ(sample(R"(hil_mock_open_connections{car="car0"})"), 1);
+  EXPECT_EQ(sample(R"(hil_mock_connections_total{car="car0"})"), 2);
+  EXPECT_EQ(sample(R"(hil_mock_faults_total{car="car0",kind="drop"})"), 2);
+  EXPECT_EQ(sample(R"(hil_mock_bytes_total{car="car0",direction="to_car"})"), sent_to_car);
+  server.stop();
 }
 
 TEST(LiveModel, PoseAndTrailFollowADrivenCar) {
