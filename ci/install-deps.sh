@@ -28,7 +28,12 @@ packages=(
   python3-serial             # pySerial's rfc2217:// client, unmodified, drives it in the tests
   libpugixml-dev             # hil report merge reads the shards' JUnit XML
   help2man                   # the Debian package's man pages, made from each program's --help
+  python3-pytest python3-pip python3-venv python3-setuptools  # python/: the pytest plugin, installed with pip and tested
+  python3-prometheus-client  # its text parser checks the /metrics pages of hil proxy and hil mock --view
 )
+# The Toxiproxy client test installs toxiproxy-node-client from the npm
+# registry with npm; a machine without Node.js gets Debian's.
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 
 if [ "$(id -u)" -ne 0 ]; then
   sudo=sudo
