@@ -129,18 +129,29 @@ void ApiServer::start() {
   const std::string too_many =
       "requests: more than " + std::to_string(options_.requests_per_second) +
       " a second (bursts of " + std::to_string(options_.burst) + "); retry in a second";
-  http.set_pre_routing_handler([state, too_many](const httplib::Request&, httplib::Response& res) {
-    bool allowed = false;
-    {
-      std::lock_guard lock(state->mutex);
-      allowed = state->rate.allow(std::chrono::steady_clock::now().time_since_epoch());
-    }
-    if (allowed) return httplib::Server::HandlerResponse::Unhandled;
-    ApiReply reply = error_reply(429, too_many);
-    reply.headers.emplace_back("Retry-After", "1");
-    send(res, reply);
-    return httplib::Server::HandlerResponse::Handled;
-  });
+  http.set_pre_routing_handler(
+      [state, too_many](const httplib::Request& req, httplib::Response& res) {
+        // A web page the user has open may send requests to 127.0.0.1 from
+        // their browser; a browser's requests are refused, as Toxiproxy
+        // refuses them, so no page can cut a link. Test code, curl and the
+        // client libraries do not call themselves Mozilla.
+        if (req.get_header_value("User-Agent").starts_with("Mozilla/")) {
+          send(res, error_reply(403,
+                                "User-Agent: browsers are refused (the API changes live "
+                                "links; use curl or a client library)"));
+          return httplib::Server::HandlerResponse::Handled;
+        }
+        bool allowed = false;
+        {
+          std::lock_guard lock(state->mutex);
+          allowed = state->rate.allow(std::chrono::steady_clock::now().time_since_epoch());
+        }
+        if (allowed) return httplib::Server::HandlerResponse::Unhandled;
+        ApiReply reply = error_reply(429, too_many);
+        reply.headers.emplace_back("Retry-After", "1");
+        send(res, reply);
+        return httplib::Server::HandlerResponse::Handled;
+      });
 
   // Every request is answered on the proxies' thread; this one waits.
   std::weak_ptr<State> alive = state_;

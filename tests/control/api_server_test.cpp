@@ -148,6 +148,18 @@ TEST_F(ApiServerTest, VersionAndAnUnknownPathAsJson) {
   EXPECT_THAT(missing.at("error").get<std::string>(), HasSubstr("/nothing/here"));
 }
 
+TEST_F(ApiServerTest, ABrowsersRequestIsRefusedAndChangesNothing) {
+  const json refused =
+      error_body(client->Post("/proxies", {{"User-Agent", "Mozilla/5.0 (X11; Linux x86_64)"}},
+                              R"({"name": "car", "upstream": "127.0.0.1:9"})", "application/json"),
+                 403);
+  EXPECT_THAT(refused.at("error").get<std::string>(), StartsWith("User-Agent: browsers"));
+  const auto proxies = client->Get("/proxies");
+  ASSERT_TRUE(proxies);
+  EXPECT_EQ(proxies->status, 200);
+  EXPECT_EQ(proxies->body, "{}");
+}
+
 TEST_F(ApiServerTest, ABodyOverTheLimitIs413AsJson) {
   const std::string big(300'000, 'x');
   const auto result = client->Post("/proxies", big, "application/json");
