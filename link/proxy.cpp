@@ -73,16 +73,21 @@ struct Tally {
 // totals, and keeps the newest frames.
 class CountingObserver final : public LinkObserver {
  public:
+  /// `closed` runs when the link closes (inside the link's own callback).
   CountingObserver(std::shared_ptr<ProxyLinkInfo> info, std::shared_ptr<Tally> tally,
-                   const ProtocolAdapter& protocol)
-      : info_(std::move(info)), tally_(std::move(tally)) {
-    for (const auto d : kProxyDirections)
-      splitters_[slot_of(d)] = protocol.splitter_for(d, tally_->keep > 0);
-  }
+                   std::shared_ptr<const ProtocolAdapter> protocol, std::function<void()> closed)
+      : info_(std::move(info)),
+        tally_(std::move(tally)),
+        protocol_(std::move(protocol)),
+        closed_(std::move(closed)) {}
 
   void on_delivered(Time at, Direction d, protocol::ByteView bytes) override {
     tally_->totals.bytes[slot_of(d)] += bytes.size();
-    splitters_[slot_of(d)]->feed(bytes, frames_);
+    // Made on a direction's first bytes: a link that carries nothing (a
+    // port scan, a client that connects and leaves) costs no decoder.
+    auto& splitter = splitters_[slot_of(d)];
+    if (!splitter) splitter = protocol_->splitter_for(d, tally_->keep > 0);
+    splitter->feed(bytes, frames_);
     count(at, d);
   }
   void on_fault(const FaultEvent& e) override {
@@ -93,11 +98,14 @@ class CountingObserver final : public LinkObserver {
   void on_close(Time at, const LinkClose& close) override {
     // What a side sent last and no frame completed is one bad frame.
     for (const auto d : kProxyDirections) {
+      if (!splitters_[slot_of(d)]) continue;
       splitters_[slot_of(d)]->finish(frames_);
+      splitters_[slot_of(d)].reset();
       count(at, d);
     }
     info_->open = false;
     info_->close_reason = close.reason;
+    if (closed_) closed_();
   }
 
  private:
@@ -118,6 +126,8 @@ class CountingObserver final : public LinkObserver {
 
   std::shared_ptr<ProxyLinkInfo> info_;
   std::shared_ptr<Tally> tally_;
+  std::shared_ptr<const ProtocolAdapter> protocol_;
+  std::function<void()> closed_;
   std::unique_ptr<FrameSplitter> splitters_[2];
   std::vector<WireFrame> frames_;
 };
@@ -272,8 +282,21 @@ void Proxy::join(BytePipePtr client, BytePipePtr car, std::size_t number) {
   link_options.protocol = options_.protocol;
   link_options.set_faults(rules_for(*record));
   link_options.seed = info.seed;
+  // A closed link's pipes and injectors are let go soon after it closes,
+  // not at the next connection: a storm of clients that all leave at once
+  // costs nothing once they have gone.
+  std::weak_ptr<bool> alive = alive_;
+  auto closed = [this, alive] {
+    if (prune_posted_) return;
+    prune_posted_ = true;
+    context_.executor.post([this, alive] {
+      if (const auto a = alive.lock(); !a || !*a) return;
+      prune_posted_ = false;
+      prune();
+    });
+  };
   link_options.observers.push_back(
-      std::make_shared<CountingObserver>(record->info, book_, *options_.protocol));
+      std::make_shared<CountingObserver>(record->info, book_, options_.protocol, closed));
   if (options_.log)
     link_options.observers.push_back(std::make_shared<TerminalObserver>(id, options_.log));
   add_captures(link_options, id, number);
@@ -376,13 +399,20 @@ bool Proxy::reset_link(std::size_t number) {
 }
 
 void Proxy::prune() {
+  // A closed link is kept as its figures only: its pipes, injectors and
+  // observers go at once, and the oldest figures beyond closed_links_kept.
   std::size_t closed_seen = 0;
   for (auto it = records_.rbegin(); it != records_.rend(); ++it) {
-    const auto& record = **it;
+    auto& record = **it;
     if (record.info->open) continue;
-    if (++closed_seen > options_.closed_links_kept) (*it)->link.reset();
+    if (record.link) {
+      record.info->stats = record.link->stats();
+      record.link.reset();
+      record.stalls.clear();
+    }
+    if (++closed_seen > options_.closed_links_kept) record.info.reset();
   }
-  std::erase_if(records_, [](const auto& record) { return record->link == nullptr; });
+  std::erase_if(records_, [](const auto& record) { return record->info == nullptr; });
 }
 
 std::vector<ProxyLinkInfo> Proxy::links() const {

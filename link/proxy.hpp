@@ -134,6 +134,7 @@ class Proxy {
  private:
   /// One link and what is counted on it; shared with its observer.
   struct LinkRecord;
+  bool prune_posted_ = false;  // a prune() is scheduled (a link closed)
   /// The totals and the recent frames; shared with every link's observer.
   struct Book;
 
@@ -145,7 +146,8 @@ class Proxy {
   /// options.faults, then link_faults(link), then the link's own stalls.
   FaultProfile rules_for(const LinkRecord& record) const;
   LinkRecord* open_record(std::size_t number);
-  /// Forgets the oldest closed links beyond options.closed_links_kept.
+  /// Keeps closed links as their figures only, and forgets the oldest
+  /// beyond options.closed_links_kept.
   void prune();
   void say(const std::string& line) const;
 

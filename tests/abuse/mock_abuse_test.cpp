@@ -289,7 +289,8 @@ class Abuse : public ::testing::TestWithParam<Car> {
   }
 
   /// What every abuse ends with.
-  void expect_recovered(const std::string& what) {
+  /// `bound_kib`: how far resident memory may stay above its value before.
+  void expect_recovered(const std::string& what, long bound_kib = kRssBoundKib) {
     ASSERT_TRUE(target_->process().alive()) << what << "\n" << target_->log();
     if (car().name == "proxy") {
       ASSERT_TRUE(target_->mock().alive()) << target_->log();
@@ -299,7 +300,7 @@ class Abuse : public ::testing::TestWithParam<Car> {
     EXPECT_TRUE(target_->answers()) << what;
     long rss_after_kib = target_->process().rss_kib();
     // Freed memory goes back to the system lazily; give it a moment.
-    for (int i = 0; i < 20 && rss_after_kib > rss_before_kib_ + kRssBoundKib; ++i) {
+    for (int i = 0; i < 20 && rss_after_kib > rss_before_kib_ + bound_kib; ++i) {
       std::this_thread::sleep_for(100ms);
       rss_after_kib = target_->process().rss_kib();
     }
@@ -308,7 +309,7 @@ class Abuse : public ::testing::TestWithParam<Car> {
     // The memory bound holds in the default and TSan builds; under ASan the
     // quarantine keeps freed blocks resident (kAddressSanitizerBuild).
     if (!kAddressSanitizerBuild) {
-      EXPECT_LE(rss_after_kib, rss_before_kib_ + kRssBoundKib) << what;
+      EXPECT_LE(rss_after_kib, rss_before_kib_ + bound_kib) << what;
     }
   }
 
@@ -574,7 +575,15 @@ TEST_P(Abuse, AThousandConcurrentConnectionAttempts) {
     ::close(fd);
   std::cout << "[ figures  ] " << car().name << ": " << connected
             << " of 1000 concurrent connection attempts started\n";
-  expect_recovered("1000 concurrent connections");
+  // The mock turns the clients it cannot serve away at once, and the proxy
+  // passes that close on as a half-close: each of the 1,000 links lives
+  // until its client ends too, so all are open together (about 8 KiB each
+  // in the default build, 7.8 MiB in all). Under ThreadSanitizer each costs
+  // about 35 KiB of the process's memory (its allocator's metadata and
+  // shadow), so the bound there is for 1,000 live links.
+  const bool live_links = car().name == "proxy";
+  expect_recovered("1000 concurrent connections",
+                   live_links && kThreadSanitizerBuild ? 64 * 1024 : kRssBoundKib);
 }
 
 TEST_P(Abuse, ConnectDisconnectCycles) {
